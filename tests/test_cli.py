@@ -2777,3 +2777,67 @@ def test_a_bad_option_value_is_said_in_the_option_s_name(
     assert status == 2
     assert capsys.readouterr().err == said.replace("{tmp}", str(tmp_path)) + "\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+
+
+@pytest.mark.parametrize("text", ["5M", "2FT", ".5m", "1e3mm", "+5m", "5 cm", '5"', "-.5 in"])
+def test_every_way_of_typing_a_unit_after_a_metre_value_is_told_to_leave_it_out(
+    text: str,
+) -> None:
+    """A mutation audit found the unit pattern's cases untested: an upper-case unit, a value
+    without its leading 0, an exponent, a '+' sign and inches (a ") each lost the "without a
+    unit" hint, which said only "expected a number of metres"."""
+    import argparse
+
+    from stereovision.cli import metres, positive_metres
+
+    for kind, above in ((positive_metres, " above 0"), (metres, "")):
+        with pytest.raises(argparse.ArgumentTypeError) as err:
+            kind(text)
+        assert str(err.value) == (
+            f"expected a number of metres{above} without a unit (5 for 5 m), got {text!r}"
+        )
+    with pytest.raises(argparse.ArgumentTypeError) as err:  # a word is no unit-suffixed number
+        positive_metres("far")
+    assert str(err.value) == "expected a number of metres above 0, got 'far'"
+
+
+def test_a_value_starting_with_a_dash_is_told_in_the_options_long_form(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A mutation audit: the hint's `--output=-x` (the long name, which takes the `=` form
+    whatever the value) was asserted only up to "give it"."""
+    with pytest.raises(SystemExit):
+        main(["depth", str(CONES / "left.png"), str(CONES / "right.png"), "-o", "-x"])
+    assert capsys.readouterr().err == (
+        "stereovision depth: error: argument -o/--output: '-x' starts with '-' and was taken "
+        "for an option; give it as --output=-x (see stereovision depth --help)\n"
+    )
+
+
+def test_an_option_given_twice_the_last_without_its_value_says_expected_one_argument(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A mutation audit: only a value typed after the option with a '-' is the one argparse
+    took for an option; the earlier `--max-depth 25` (a value without a '-') is no such value."""
+    args = ["depth", str(CONES / "left.png"), str(CONES / "right.png")]
+    with pytest.raises(SystemExit):
+        main([*args, "--max-depth", "25", "--max-depth"])
+    assert capsys.readouterr().err == (
+        "stereovision depth: error: argument --max-depth: expected one argument "
+        "(see stereovision depth --help)\n"
+    )
+
+
+def test_a_scene_folder_after_a_switch_is_still_said_to_be_a_folder_holding_a_pair(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A mutation audit: a switch (no value) before the folder, `depth --ground cones`, was not
+    asserted; taken as an option with a value it hides the folder, and argparse's bare
+    "required: right" is said."""
+    with pytest.raises(SystemExit):
+        main(["depth", "--ground", str(CONES)])
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"stereovision depth: error: the right image is missing; {CONES} is a folder holding a "
+        f"pair: give its two images, {CONES / 'left.png'} and {CONES / 'right.png'}"
+    ), err
