@@ -18,7 +18,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import cv2
 import distributed
@@ -2557,3 +2557,27 @@ def test_a_cli_runs_words_said_again_are_the_same() -> None:
     assert (
         advice_for(line + "max_disparity below 96.5", "cli") == line + "--max-disparity below 96.5"
     )
+
+
+def test_the_checking_progress_says_a_plain_line_every_progress_seconds_while_reading(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A mutation audit: _Checking's clock was not asserted (a line at each pair, or none at
+    exactly PROGRESS_SECONDS), nor that a stream that is no terminal gets no bar whatever
+    CHECK_BAR_DELAY, nor that no line is said while no file is read again."""
+    import stereovision.batch as batch
+
+    clock = iter([0.0, 4.0, 10.0, 13.0, 21.0, 30.0, 40.0])  # t0, then one per pair
+    monkeypatch.setattr(batch.time, "monotonic", lambda: next(clock))
+    monkeypatch.setattr(batch, "PROGRESS_SECONDS", 10.0)
+    monkeypatch.setattr(batch, "CHECK_BAR_DELAY", 0.0)
+    err = io.StringIO()
+    monkeypatch.setattr("sys.stderr", err)
+    checking = batch._Checking(6, True)
+    for i, _ in enumerate(checking.over([cast(Any, None)] * 6)):
+        checking.reading = i >= 1  # the first pair's files not read again
+    said = re.findall(r": (\d)/6 pairs, (\d+) s$", err.getvalue(), re.MULTILINE)
+    # 1 (4 s): no file read yet; 2 (10 s) and 4 (21 s, 11 s after) said; 3 and 5 too soon;
+    # 6: the last, the pairs' bar follows
+    assert said == [("2", "10"), ("4", "21")], err.getvalue()
+    assert "checking files" not in err.getvalue()
