@@ -826,3 +826,22 @@ def test_a_reset_filter_behaves_as_a_new_one(data_dir: Path) -> None:
     assert list(used._sigmas) == list(fresh._sigmas)
     for m, n in zip(used._means, fresh._means, strict=True):
         assert np.array_equal(m.mean, n.mean) and np.array_equal(m.count, n.count)
+
+
+def test_int_levels_of_every_integer_type_read_as_their_uint8_image(data_dir: Path) -> None:
+    """A mutation audit: unsigned types other than uint8 and uint16 (uint32, uint64) were not
+    asserted to be read as their uint8 image, nor the edges of 0-255 (255 taken, 256 and -1
+    refused, -1 as negative, not as 16-bit)."""
+    img = noisy(load_scene(data_dir / VENUS).left, 8.0, np.random.default_rng(0))
+    want = noise_sigma(img)
+    for dtype in (np.uint32, np.uint64, np.int16, ">i4"):
+        assert noise_sigma(img.astype(dtype)) == want > 4.8
+    edge = img.astype(np.int32)
+    edge[0, 0] = 255
+    assert noise_sigma(edge) == noise_sigma(edge.astype(np.uint8))
+    edge[0, 0] = 256
+    with pytest.raises(ValueError, match=r"got 0-256 \(a 16-bit image: pass it as uint16\)$"):
+        noise_sigma(edge)
+    edge[0, 0] = -1
+    with pytest.raises(ValueError, match=r"got -1-255 \(a grey level cannot be negative\)$"):
+        noise_sigma(edge)
