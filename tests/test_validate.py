@@ -654,3 +654,24 @@ def test_scalar_checks_take_the_same_numbers() -> None:
             positive_finite(bad, "f")
     with pytest.raises(ValueError, match=r"^blur: expected a finite number, got array\(nan\)$"):
         finite_number(np.array(np.nan), "blur")
+
+
+def test_real_array_reads_an_object_array_of_real_numbers_only() -> None:
+    """A mutation audit: what ``_real_array`` gives was asserted only through its callers'
+    values. Real numbers in an object array are their float64 array (float32 would round a
+    float64 depth); a complex number, text or an empty text array is no real array (None)."""
+    from stereovision._validate import _real_array
+
+    got = _real_array(np.array([1, 2.5, 1e300, True], dtype=object))
+    assert got is not None and got.dtype == np.float64
+    np.testing.assert_array_equal(got, [1.0, 2.5, 1e300, 1.0])
+    u8 = np.arange(4, dtype=np.uint8)
+    assert _real_array(u8) is not None and _real_array(u8).dtype == np.uint8  # kept as given
+    for bad in (
+        np.array([1.0, 1 + 2j], dtype=object),
+        np.array([1.0, "2"], dtype=object),
+        np.array([], dtype="U1"),
+        np.array([1 + 2j]),
+        None,
+    ):
+        assert _real_array(bad) is None, bad
