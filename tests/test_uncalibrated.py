@@ -1330,7 +1330,16 @@ def test_opencv_finding_no_homographies_is_refused(
         rectify_uncalibrated(sc.left, sc.right, model="projective")
 
 
-@pytest.mark.parametrize(("text", "kind"), [("[1, 2]", "array"), ("null", "null"), ("5", "number")])
+@pytest.mark.parametrize(
+    ("text", "kind"),
+    [
+        ("[1, 2]", "array"),
+        ("null", "null"),
+        ("5", "number"),
+        ("true", "true/false"),
+        ('"H1"', "string"),
+    ],
+)
 def test_json_that_is_no_object_given_as_the_rectification_says_what_was_expected(
     tmp_path: Path, text: str, kind: str
 ) -> None:
