@@ -3977,3 +3977,17 @@ def test_a_streams_password_is_not_said_in_captures_lines(
     assert not any(s in said + err + said2 + err2 for s in _SECRETS)
     for path in out.iterdir():
         assert not any(s.encode() in path.read_bytes() for s in _SECRETS)
+
+
+def test_a_glob_matching_one_folder_is_not_told_to_be_given_as_that_file(
+    tmp_path: Path,
+) -> None:
+    """A mutation audit: one match that is a folder (``--left 'runs/run*'``) was told "give
+    the file it matches, runs/run1" when the file check was dropped; a folder opens nothing."""
+    from stereovision.capture import _glob_hint
+
+    (tmp_path / "run1").mkdir()
+    assert _glob_hint("left", f"{tmp_path}/run*") == (
+        f"left source {tmp_path}/run* is a glob, which OpenCV does not expand: give a video "
+        f"file, an image-sequence pattern such as {tmp_path}/left_%04d.png or a camera index"
+    )
