@@ -2581,3 +2581,9 @@ def test_the_checking_progress_says_a_plain_line_every_progress_seconds_while_re
     # 6: the last, the pairs' bar follows
     assert said == [("2", "10"), ("4", "21")], err.getvalue()
     assert "checking files" not in err.getvalue()
+    clock = iter([0.0, 20.0, 40.0, 60.0])  # progress off (enabled False): nothing said
+    quiet = batch._Checking(3, False)
+    quiet.reading = True
+    before = err.getvalue()
+    assert list(quiet.over([cast(Any, None)] * 3)) == [None] * 3
+    assert err.getvalue() == before
