@@ -72,6 +72,9 @@ def test_bench_cli_json_lines(data_dir: Path, capsys: pytest.CaptureFixture[str]
             "--runs: at least 5 (evaluation.md: the median of >= 5 runs), got 4",
         ),
         (["bench", "/no/such/folder"], "not found"),
+        # any count was taken: 10**20 timed the cases until killed
+        (["bench", "--runs", "1001", "/no/such"], "--runs: at most 1000, got 1001"),
+        (["bench", "--runs", str(10**20), "/no/such"], f"--runs: at most 1000, got {10**20}"),
     ],
 )
 def test_bench_cli_errors_one_line(

@@ -89,6 +89,29 @@ def test_eval_refuses_a_bad_runs_in_one_line(data_dir: Path, value: str) -> None
     ]
 
 
+@pytest.mark.parametrize("value", ["1001", "100000000000000000000"])
+def test_eval_refuses_runs_beyond_its_limit_in_one_line(data_dir: Path, value: str) -> None:
+    """Any count was taken: --runs 100000000000000000000 timed the scene until killed. Refused
+    before any work: the missing folder is not reached."""
+    proc = subprocess.run(
+        [*SV, "eval", str(data_dir / "no_such_scene"), f"--runs={value}"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"stereovision eval: error: argument --runs: expected at most 1000 runs, got {value!r} "
+        "(see stereovision eval --help)"
+    ]
+
+
+def test_run_count_takes_one_to_the_limit() -> None:
+    from stereovision.cli import MAX_RUNS, run_count
+
+    assert (run_count("1"), run_count("5"), run_count("1000")) == (1, 5, 1000) == (1, 5, MAX_RUNS)
+
+
 def _eval(*argv: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run([*SV, "eval", *argv], capture_output=True, text=True, check=False)
 

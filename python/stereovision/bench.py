@@ -313,15 +313,19 @@ def cmd_bench(args: argparse.Namespace) -> int:
     Raises
     ------
     ValueError
-        If ``runs`` < :data:`MIN_RUNS`, or a folder holds no scene.
+        If ``runs`` < :data:`MIN_RUNS` or > :data:`stereovision.cli.MAX_RUNS`, or a folder
+        holds no scene.
     FileNotFoundError
         If a scene folder does not exist.
     """
     from tqdm import tqdm
 
+    from stereovision.cli import MAX_RUNS
     from stereovision.io import load_scene, scene_too_narrow
 
     _check_runs(args.runs, "--runs")
+    if args.runs > MAX_RUNS:  # any count was taken: --runs 10**20 ran until killed
+        raise ValueError(f"--runs: at most {MAX_RUNS}, got {args.runs}")
     dirs = _scene_dirs(args.scenes)
     all_cases: list[BenchCase] = []
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
@@ -346,6 +350,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision bench`` on the CLI's sub-parsers."""
+    from stereovision.cli import MAX_RUNS
+
     p = subparsers.add_parser(
         "bench",
         help="time and accuracy of every method beside OpenCV StereoBM / SGBM-3WAY",
@@ -358,7 +364,8 @@ def add_cli(subparsers: Any) -> None:
         "--runs",
         type=int,
         default=DEFAULT_RUNS,
-        help=f"timed runs per case, at least {MIN_RUNS} (default {DEFAULT_RUNS})",
+        help=f"timed runs per case, at least {MIN_RUNS} (default {DEFAULT_RUNS}), "
+        f"at most {MAX_RUNS}",
     )
     p.add_argument("--json", action="store_true", help="only the JSON lines")
     p.set_defaults(func=cmd_bench)

@@ -1741,6 +1741,20 @@ def positive_count(text: str) -> int:
     return _whole_above_zero(text, "a whole number above 0")
 
 
+#: Most timed rounds ``eval --runs`` and ``bench --runs`` take: generous (evaluation.md asks for
+#: >= 5), while a typo's ``--runs 100000`` ran for days and ``--runs`` of 20 digits until killed.
+MAX_RUNS = 1000
+
+
+def run_count(text: str) -> int:
+    """argparse type of ``eval --runs``: a whole number from 1 to :data:`MAX_RUNS`, refused in
+    the option's name (any count was taken: 10**20 ran until killed)."""
+    value = positive_count(text)
+    if value > MAX_RUNS:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_RUNS} runs, got {text!r}")
+    return value
+
+
 def _whole_above_zero(text: str, what: str) -> int:
     try:
         value = int(text)
@@ -2174,12 +2188,13 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--no-opencv", action="store_true", help="skip the OpenCV references")
     d.add_argument(
         "--runs",
-        type=positive_count,
+        type=run_count,
         default=None,
         metavar="N",
         help="time every method N times, interleaved with OpenCV's, after a warm-up round, and "
         "print the medians (a time line per scene; --json: always, one run without --runs); "
-        "evaluation.md's speed figures need >= 5; accuracy is the same for any N",
+        f"evaluation.md's speed figures need >= 5 (at most {MAX_RUNS}); accuracy is the same "
+        "for any N",
     )
     d.set_defaults(func=cmd_eval)
 
