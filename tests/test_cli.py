@@ -524,6 +524,46 @@ def test_info_on_paper_refuses_a_bad_value_in_one_line(capsys: pytest.CaptureFix
     assert out == "" and err.startswith("stereovision: error: --baseline: expected a positive")
 
 
+@pytest.mark.parametrize("baseline", ["1e308", "1000001"])
+def test_info_on_paper_refuses_a_baseline_past_1000_km(
+    baseline: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``info --baseline 1e308`` printed NumPy's "overflow encountered" warnings, then "baseline
+    inf m" and depths of inf, exit 0; a baseline past 1000 km is now refused in one line."""
+    assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", baseline]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.splitlines() == [
+        "stereovision: error: --baseline: expected at most 1e+06 m (a rig on paper), "
+        f"got {float(baseline):g}"
+    ]
+    assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", "1e6"]) == 0
+    assert "farthest depth, at a disparity of 1 px: 640000000.00 m" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("option", ["--forward", "--up", "--right"])
+@pytest.mark.parametrize("value", ["1e308", "-1000001", "nan", "inf"])
+def test_view_refuses_a_camera_move_past_its_limit_in_one_line(
+    option: str, value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``view --forward 1e308`` printed NumPy's "overflow encountered in multiply" and wrote an
+    empty screenshot, exit 0: refused by argparse now, naming the option, before any work."""
+    shot = tmp_path / "v.png"
+    with pytest.raises(SystemExit) as exc:
+        main(["view", str(tmp_path / "missing.ply"), option, value, "-o", str(shot)])
+    assert exc.value.code == 2 and not shot.exists()
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision view: error: argument {option}: expected metres from -1e+06 to 1e+06, "
+        f"got {value!r} (see stereovision view --help)"
+    ]
+
+
+def test_view_camera_move_takes_its_limit() -> None:
+    from stereovision.render import _camera_move
+
+    assert [_camera_move(v) for v in ("1e6", "-1e6", "0.5", "-2")] == [1e6, -1e6, 0.5, -2.0]
+
+
 def test_info_on_paper_says_the_baseline_is_in_metres(capsys: pytest.CaptureFixture[str]) -> None:
     """``info ... --baseline 120`` (meant as mm) was warned about in the library's words: 'are T
     (or the board's square size) in another unit than unit='m'? With unit='mm' it would be

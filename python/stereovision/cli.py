@@ -1262,6 +1262,12 @@ def _paper_baseline_words(text: str, baseline: float) -> str:
     return f"--baseline {baseline:g}: {baseline:g} m is {why}; --baseline is in metres{hint}"
 
 
+#: Longest ``info --baseline``, in metres: 1000 km, far past a robot's rig (warned of above 5 m,
+#: with the unit meant: 4000 is a 4 m rig in mm); ``--baseline 1e308`` overflowed (NumPy's
+#: RuntimeWarnings, then "baseline inf m", exit 0).
+MAX_PAPER_BASELINE_M = 1e6
+
+
 def cmd_info(args: argparse.Namespace) -> int:
     """``stereovision info CALIB``: what the rig can measure; ``info BAG``: what a recording
     holds (its topics, the stereo pair found) and, from its ``camera_info``, what its rig can
@@ -1281,6 +1287,11 @@ def cmd_info(args: argparse.Namespace) -> int:
 
         size = parse_size(args.size, "--size")
         assert size is not None
+        if math.isfinite(args.baseline) and args.baseline > MAX_PAPER_BASELINE_M:
+            raise CliError(
+                f"--baseline: expected at most {MAX_PAPER_BASELINE_M:g} m (a rig on paper), "
+                f"got {args.baseline:g}"
+            )
         try:  # the rig before its heading: a bad value is the one line said, in the CLI's words
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")

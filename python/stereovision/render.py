@@ -1472,6 +1472,26 @@ def cmd_view(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Farthest ``view --forward`` / ``--up`` / ``--right`` moves the camera, in metres: 1000 km, far
+#: past any cloud a stereo rig measures (``--forward 1e200`` overflowed NumPy's distances: a
+#: RuntimeWarning, an empty screenshot and exit 0).
+VIEW_MAX_MOVE_M = 1e6
+
+
+def _camera_move(text: str) -> float:
+    """argparse type of ``view``'s ``--forward``, ``--up`` and ``--right``: finite metres within
+    :data:`VIEW_MAX_MOVE_M` either way, refused in the option's name."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and abs(value) <= VIEW_MAX_MOVE_M):
+        raise argparse.ArgumentTypeError(
+            f"expected metres from -{VIEW_MAX_MOVE_M:g} to {VIEW_MAX_MOVE_M:g}, got {text!r}"
+        )
+    return value
+
+
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision view`` on the CLI's sub-parsers."""
     p = subparsers.add_parser(
@@ -1489,7 +1509,7 @@ def add_cli(subparsers: Any) -> None:
     for name, axis in (("forward", "+Z"), ("up", "-Y"), ("right", "+X")):
         p.add_argument(
             f"--{name}",
-            type=float,
+            type=_camera_move,
             default=0.0,
             help=f"move the camera {name}, metres (along the left camera's {axis})",
         )
