@@ -1315,3 +1315,33 @@ def test_the_voxel_warning_starts_at_the_clouds_extent():
         warnings.simplefilter("error")
         out, _ = export.voxel_downsample(pts, voxel=0.9)
     assert len(out) == len(np.unique(np.floor(pts / 0.9), axis=0))  # 7 of 2 x 2 x 2 cubes
+
+
+def test_export_result_refused_writes_nothing(result, tmp_path):
+    """A result without calibration asked for ("npz", "ply") replaced the folder's good
+    depth.npz by an all-NaN bundle, then raised at "ply"; a folder where cloud.pcd goes was
+    found after cloud.ply had been replaced. Both are refused before any file is written."""
+    out = tmp_path / "out"
+    export.export_result(result, out)
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
+    with pytest.raises(ValueError, match="without a calibration") as err:
+        export.export_result(bare, out, ("npz", "disp16", "ply"))
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert np.isfinite(export.read_npz(out / "depth.npz")["depth"]).any()
+    assert "formats ['ply'] need one" in str(err.value)
+    # nor is a folder made for a refused call
+    with pytest.raises(ValueError, match=r"formats \['depth16'\]"):
+        export.export_result(bare, tmp_path / "new", ("disp16", "depth16"))
+    assert not (tmp_path / "new").exists()
+    # a folder in the way of a later format: the earlier ones are not replaced either
+    (out / "cloud.pcd").unlink()
+    (out / "cloud.pcd").mkdir()
+    stale = out / "cloud.ply"
+    stale.write_bytes(b"earlier")
+    with pytest.raises(IsADirectoryError, match=r"cloud\.pcd: it is a folder"):
+        export.export_result(result, out, ("ply", "pcd"))
+    assert stale.read_bytes() == b"earlier"
+    # the formats that need no calibration are still written for such a result
+    written = export.export_result(bare, tmp_path / "bare", ("npz", "disp16"))
+    assert sorted(written) == ["depth.npz", "disparity_16.png"]

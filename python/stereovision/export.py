@@ -76,6 +76,9 @@ EXPORT_FORMATS = {
     "disp16": "disparity_16.png",
 }
 
+#: The :data:`EXPORT_FORMATS` that need a metric depth (a calibration).
+_METRIC_FORMATS = ("ply", "pcd", "depth16")
+
 _PCD_MAGIC = (b"# .PCD", b"VERSION")
 _PLY_MAGIC = b"ply"
 _ZIP_MAGIC = b"PK\x03\x04"
@@ -1020,6 +1023,13 @@ def export_result(
         If ``formats`` is one string (``"ply"``), not a tuple of them.
     ValueError
         Unknown format, or PLY / PCD / depth PNG asked for a result without calibration.
+    IsADirectoryError
+        If a folder stands where one of the files goes.
+
+    Notes
+    -----
+    These are checked before any file is written: a call refused for them leaves the folder
+    as it was.
     """
     if isinstance(formats, str):
         # set("ply") is its letters: "unknown export format(s) ['l', 'p', 'y']"
@@ -1032,7 +1042,23 @@ def export_result(
         raise ValueError(
             f"unknown export format(s) {sorted(unknown)}: expected {list(EXPORT_FORMATS)}"
         )
+    _require_type(result, "DepthResult", "result")
+    # Refused before any file is written: found at its turn, after the formats before it were
+    # written, it left a folder's good depth.npz replaced by an all-NaN one (and a new
+    # disparity_16.png beside an earlier run's cloud.ply), then raised.
+    metric = [f for f in formats if f in _METRIC_FORMATS]
+    if metric and (result.depth is None or result.calibration is None):
+        raise ValueError(
+            f"no depth: depth_map was called without a calibration; formats {metric} need "
+            "one (npz and disp16 do not); nothing was written"
+        )
     out = Path(directory)
+    for fmt in formats:  # a folder in the way, refused before the formats before it are written
+        target = out / EXPORT_FORMATS[fmt]
+        if target.is_dir():
+            raise IsADirectoryError(
+                f"cannot write {target}: it is a folder; move it away (nothing was written)"
+            )
     make_folder(out)
     writers: dict[str, Callable[[Path, DepthResult], Path]] = {
         "ply": write_cloud_ply,
