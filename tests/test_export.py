@@ -1345,3 +1345,28 @@ def test_export_result_refused_writes_nothing(result, tmp_path):
     # the formats that need no calibration are still written for such a result
     written = export.export_result(bare, tmp_path / "bare", ("npz", "disp16"))
     assert sorted(written) == ["depth.npz", "disparity_16.png"]
+
+
+def test_mesh_ply_colours_float_0_1_and_out_of_range(tmp_path):
+    """A uint8 cast made a mesh's 0-1 float colours (pyvista's) black, 0.5 grey became 0, and
+    wrapped integers (300 came out 44, -1 255): floats are scaled from 0-1, and colours that do
+    not fit are refused before anything is written."""
+    from stereovision.io import read_ply
+
+    pts = np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1]], np.float32)
+    mesh = _fake_mesh(pts, [3, 0, 1, 2])
+    mesh.point_data["RGB"] = np.array([[1.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.2, 0.2, 1.0]])
+    _, cols = read_ply(export.write_mesh_ply(tmp_path / "f.ply", mesh))
+    np.testing.assert_array_equal(cols, [[255, 0, 0], [0, 128, 0], [51, 51, 255]])
+    # integers 0-255 of a wider type, and RGBA, keep their values
+    mesh.point_data["RGB"] = np.array([[255, 0, 7, 9], [0, 128, 0, 9], [1, 2, 3, 9]], np.int64)
+    _, cols = read_ply(export.write_mesh_ply(tmp_path / "i.ply", mesh))
+    np.testing.assert_array_equal(cols, [[255, 0, 7], [0, 128, 0], [1, 2, 3]])
+    for bad, match in (
+        (np.array([[300, 0, 0], [0, 0, 0], [-1, 0, 0]]), "colours 0-255, got values -1 to 300"),
+        (np.array([[255.0, 0, 0], [0, 0, 0], [np.nan, 0, 0]]), "float colours are 0-1, got 2"),
+    ):
+        mesh.point_data["RGB"] = bad
+        with pytest.raises(ValueError, match=match):
+            export.write_mesh_ply(tmp_path / "bad.ply", mesh)
+    assert not (tmp_path / "bad.ply").exists()

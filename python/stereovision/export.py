@@ -160,6 +160,30 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     return Path(path)
 
 
+def _mesh_rgb(rgb: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
+    """A mesh's point data ``RGB`` as uint8 0-255: floats are 0-1 (pyvista's and VTK's colour
+    scalars), integers 0-255. A plain uint8 cast made 0-1 floats black (0.5 became 0), 300
+    came out 44 and -1 255, without a word."""
+    if rgb.ndim != 2 or rgb.shape[1] not in (3, 4):
+        raise ValueError(f"mesh RGB: expected (N, 3) colours, got shape {rgb.shape}")
+    rgb = rgb[:, :3]
+    if rgb.dtype == np.uint8:
+        return rgb
+    if rgb.dtype.kind == "f":
+        bad = ~(np.isfinite(rgb) & (rgb >= 0) & (rgb <= 1))
+        if bad.any():
+            raise ValueError(
+                f"mesh RGB: float colours are 0-1, got {int(bad.any(axis=1).sum())} point(s) "
+                "outside (or NaN); give 0-255 colours as uint8"
+            )
+        return np.rint(rgb * 255.0).astype(np.uint8)
+    if rgb.dtype.kind in "iu" and rgb.size and (rgb.min() < 0 or rgb.max() > 255):
+        raise ValueError(f"mesh RGB: expected colours 0-255, got values {rgb.min()} to {rgb.max()}")
+    if rgb.dtype.kind not in "iu":
+        raise ValueError(f"mesh RGB: expected uint8 or 0-1 float colours, got {rgb.dtype}")
+    return rgb.astype(np.uint8)
+
+
 def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     """Triangle mesh with per-vertex colours as binary PLY (MeshLab / Open3D / pyvista readable).
 
@@ -168,7 +192,7 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     path : path
     mesh : pyvista.PolyData
         E.g. :func:`stereovision.render.surface_mesh`; triangles only; colours from point data
-        ``"RGB"`` when present.
+        ``"RGB"`` when present (uint8 0-255, or floats 0-1 as pyvista takes them).
 
     Returns
     -------
@@ -178,7 +202,7 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     Raises
     ------
     ValueError
-        If the mesh has non-triangle faces.
+        If the mesh has non-triangle faces, or colours outside 0-255 (0-1 for floats).
     """
     pts = np.asarray(mesh.points, dtype=np.float32)
     faces = np.asarray(mesh.faces, dtype=np.int64)
@@ -203,7 +227,7 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     vert = np.empty(len(pts), dtype=np.dtype(vfields))
     vert["x"], vert["y"], vert["z"] = pts[:, 0], pts[:, 1], pts[:, 2]
     if has_rgb:
-        rgb = np.asarray(mesh.point_data["RGB"], dtype=np.uint8)
+        rgb = _mesh_rgb(np.asarray(mesh.point_data["RGB"]))
         vert["red"], vert["green"], vert["blue"] = rgb[:, 0], rgb[:, 1], rgb[:, 2]
     face = np.empty(len(tris), dtype=np.dtype([("n", "u1"), ("i", "<i4", (3,))]))
     face["n"] = 3
