@@ -845,3 +845,26 @@ def test_int_levels_of_every_integer_type_read_as_their_uint8_image(data_dir: Pa
     edge[0, 0] = -1
     with pytest.raises(ValueError, match=r"got -1-255 \(a grey level cannot be negative\)$"):
         noise_sigma(edge)
+
+
+def test_black_frames_before_a_still_scene_are_no_estimate_of_its_noise(data_dir: Path) -> None:
+    """A webcam's black frames while it starts have no unclipped pixel, so no noise estimate:
+    counted as noise 0 they held the median at 0 (then at half the noise), and of the still
+    scene's first frames after 6 of them 4 were taken for motion and not averaged (4 restarts,
+    not 1)."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(21)
+    tf = TemporalFilter()
+    black = np.zeros_like(sc.left)
+    for _ in range(6):
+        tf(black, black)
+    assert tf.sigma == 0.0 and tf.restarts == 0
+    each = []
+    for _ in range(5):
+        left = noisy(sc.left, 8.0, rng)
+        each.append(noise_sigma(left))
+        tf(left, noisy(sc.right, 8.0, rng))
+    assert tf.restarts == 1  # the black view to the scene, once
+    assert tf.sigma == pytest.approx(float(np.median(each)), rel=1e-12)
+    assert tf.mean_frames() == pytest.approx(5.0, abs=0.05)
+    assert noise_sigma(black) == 0.0  # the function itself still says 0 for "no noise seen"

@@ -19,7 +19,8 @@ camera's frames while the scene holds still and starts again where it does not:
   over every 16th pixel, refitted on those within 3 noise sigmas (a moving object is not a
   change of light); a gain outside 0.5-2 counts as another view.
 - **The noise**: estimated from each frame itself (:func:`noise_sigma`, a Laplacian's mean over
-  the image's flattest 30 %; Immerkaer 1996), the median of the last 8 frames' estimates.
+  the image's flattest 30 %; Immerkaer 1996), the median of the last 8 frames' estimates (a
+  frame all black or white has none, and is left out).
 
 A still, noiseless pair comes out unchanged (the mean of equal frames is the frame).
 
@@ -170,6 +171,13 @@ def noise_sigma(image: npt.ArrayLike) -> float:
                 f"image: {img.dtype} grey levels must lie in 0-255, got {lo}-{hi} ({why})"
             )
         img = img.astype(np.uint8)
+    estimate = _noise_estimate(img)
+    return 0.0 if estimate is None else estimate
+
+
+def _noise_estimate(img: np.ndarray) -> float | None:
+    """:func:`noise_sigma` of an image it has checked and converted (uint8 or float levels,
+    0-255); None where it has no unclipped pixel to measure (all black or white)."""
     g = _grey(img)
     lap = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
     resp = np.abs(cv2.filter2D(g, -1, lap))[1:-1, 1:-1]
@@ -181,7 +189,7 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     unclipped = ((g > 0) & (g < 255)).astype(np.uint8)
     unclipped = cv2.erode(unclipped, np.ones((3, 3), np.uint8))[1:-1, 1:-1].astype(bool)
     if not unclipped.any():
-        return 0.0  # all black or white: no noise to see
+        return None  # all black or white: no noise to see
     resp, grad = resp[unclipped], grad[unclipped]
     flat = grad <= np.percentile(grad[:: _STRIDE * _STRIDE], 30)
     return float(np.sqrt(np.pi / 2) * resp[flat].mean() / 6.0)
@@ -216,7 +224,8 @@ class TemporalFilter:
     restarts : int
         Pairs on which the rig was found moving (both means started again).
     sigma : float
-        The current noise estimate (grey levels), 0 before the first pair.
+        The current noise estimate (grey levels), 0 before the first pair with an unclipped
+        pixel (a frame all black or white has no estimate).
     relit : int
         Images whose mean was brought to a new brightness (a light that flickers, an
         auto-exposure step) before the motion test.
@@ -321,8 +330,13 @@ class TemporalFilter:
             )
         imgs = [np.ascontiguousarray(img) for img in imgs]
         self.frames += 1
-        self._sigmas.append(noise_sigma(imgs[0]))
-        self.sigma = float(np.median(self._sigmas))
+        # A black (or white) frame has no estimate, not one of 0: a webcam's dark frames while
+        # it starts took the median to 0 and the first still frames after them were each
+        # "moving" (6 dark frames: 3 restarts more, the next 4 frames not averaged).
+        estimate = _noise_estimate(imgs[0])
+        if estimate is not None:
+            self._sigmas.append(estimate)
+        self.sigma = float(np.median(self._sigmas)) if self._sigmas else 0.0
         if not self._means or self._means[0].mean.shape != imgs[0].shape:
             return self._restart(imgs)
         # Grey value of frame - mean per pixel (Rust; tests/reference/temporal_ref.py), after
