@@ -868,3 +868,37 @@ def test_black_frames_before_a_still_scene_are_no_estimate_of_its_noise(data_dir
     assert tf.sigma == pytest.approx(float(np.median(each)), rel=1e-12)
     assert tf.mean_frames() == pytest.approx(5.0, abs=0.05)
     assert noise_sigma(black) == 0.0  # the function itself still says 0 for "no noise seen"
+
+
+@pytest.mark.parametrize(
+    ("red", "gains", "fit"),
+    [
+        (400.0, (1.0, 1.0, 1.0, 0.96), 0.96),  # clipped in the mean (and the frame)
+        (220.0, (1.0, 1.0, 1.0, 1.3), 1.3),  # clipped in the brighter frame only
+    ],
+)
+def test_a_clipped_colour_channel_is_no_part_of_the_lights_fit(
+    data_dir: Path, red: float, gains: tuple[float, ...], fit: float
+) -> None:
+    """A red object over a fifth of art's view, its red channel clipped at 255 where the grey
+    stays well inside 5-250: it does not follow the light. Fitted on grey alone, a 4 % dimming
+    read 3.4 % (1.3 brighter: 1.278), the relit means were off, and the still rig was taken for
+    moving (1 restart, nothing averaged); the channels clipped in the mean or the frame are left
+    out now, as _SATURATED says."""
+    from stereovision.temporal import _brightness_change
+
+    sc = load_scene(data_dir / "middlebury2005" / "art")
+    scene = sc.left.astype(np.float64) * (0.7 if red < 255 else 1.0)
+    scene[:, : scene.shape[1] // 5, 2] = red
+    rng = np.random.default_rng(22)
+    tf = TemporalFilter()
+    for gain in gains:
+        frame = noisy(scene * gain, 4.0, rng)
+        mean = tf._means[0].mean.copy() if tf._means else None
+        tf(frame, frame)
+    assert tf.restarts == 0 and tf.relit == 2
+    assert tf.mean_frames() > 3.7
+    assert mean is not None
+    diff = sv._core.temporal_grey_difference(frame, mean)
+    # within 3e-3: noisy() truncates, both frame and mean half a level low
+    assert _brightness_change(diff, mean, tf.sigma, frame) == pytest.approx(fit, abs=3e-3)
