@@ -1562,3 +1562,34 @@ def test_mutation_audit_boundaries_of_the_band_the_range_and_the_tolerance() -> 
     disp[:12] = 11.0  # exactly 1 px off: off the plane
     disp[12:18] = 9.5
     assert flat.support(disp, small, inlier_px=1.0) == pytest.approx(2 / 3)
+
+
+def test_cli_depth_ground_says_why_no_floor_was_tried(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A map with fewer disparities than a fit needs (MIN_PIXELS) is not fitted at all: the
+    line says so, where it said that no near-level plane held 3 % of the pixels (of none)."""
+    from stereovision.cli import main
+    from stereovision.ground import MIN_PIXELS
+
+    kitti = data_dir / "kitti2015" / "000005_10"
+    flat = tmp_path / "flat.png"
+    cv2.imwrite(str(flat), np.full((375, 1242, 3), 128, np.uint8))  # nothing to match
+    argv = ["depth", str(flat), str(flat), "--calib", str(kitti), "--ground", "--no-fill"]
+    assert main([*argv, "--max-disparity", "64", "-o", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "ground plane: none found (0 pixels have a disparity; a fit needs 500)" in out
+    assert not (tmp_path / "o" / "ground.json").exists()
+    from stereovision.cli import _no_floor_line
+
+    calib = load_scene(kitti).calib
+    disp = np.full((375, 1242), np.nan)
+    disp.flat[: MIN_PIXELS - 1] = 40.0  # one short of a fit
+    disp.flat[MIN_PIXELS - 1] = -1.0  # behind the camera (doffs 0): no disparity
+    assert _no_floor_line(disp, calib) == (
+        f"ground plane: none found ({MIN_PIXELS - 1} pixels have a disparity; a fit needs 500)"
+    )
+    disp.flat[MIN_PIXELS - 1] = 40.0  # enough to try: then no plane held the floor's share
+    assert _no_floor_line(disp, calib) == (
+        "ground plane: none found (no near-level plane holds 3 % of the pixels)"
+    )
