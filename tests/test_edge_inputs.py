@@ -9,7 +9,9 @@ array types and allocation failures given to the extension, tests/test_bindings_
 
 from __future__ import annotations
 
+import os
 import re
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -515,3 +517,143 @@ def test_match_refuses_a_method_it_does_not_have(method: str) -> None:
     assert METHODS == ("hopfield", "best", "mcgm", "fused", "gabor")
     with pytest.raises(ValueError, match=f"unknown method '{method}'"):
         sv.match(LEFT, RIGHT, method=method, max_disparity=8)
+
+
+# --- images too large for the kernels: refused from their shape, before any copy ----------------
+
+#: Each entry point given shape-only (broadcast) arrays past the kernels' 32-bit pixel indices, in
+#: a child under ``ulimit -v`` 3 GB: the grey, BGR, float32 or byte-order copies made before any
+#: check needed 4.6-14 GiB, so the user got a MemoryError instead of the limit. Each outcome is
+#: printed as it comes: a crash leaves the rest unsaid.
+_TOO_LARGE_SCRIPT = """
+import resource, sys
+import numpy as np
+resource.setrlimit(resource.RLIMIT_AS, (3_000_000 * 1024, 3_000_000 * 1024))
+import stereovision as sv
+from stereovision.matching import hopfield, mcgm, sgm
+
+SQ, ROW = (70000, 70000), (1, 5_000_000_000)
+def u8(shape): return np.broadcast_to(np.uint8(0), shape)
+def f32(shape): return np.broadcast_to(np.float32(0), shape)
+kw = {"max_disparity": 64}
+CASES = {
+    "depth_map": lambda: sv.depth_map(u8(SQ), u8(SQ), **kw),
+    "depth_map_bgr_row": lambda: sv.depth_map(u8(ROW + (3,)), u8(ROW + (3,)), **kw),
+    "depth_map_big_endian": lambda: sv.depth_map(
+        np.broadcast_to(np.zeros((), ">u2"), SQ), np.broadcast_to(np.zeros((), ">u2"), SQ), **kw
+    ),
+    "match_hopfield_row": lambda: sv.match(u8(ROW), u8(ROW), **kw),
+    "match_mcgm": lambda: sv.match(u8(SQ), u8(SQ), method="mcgm", **kw),
+    "match_gabor": lambda: sv.match(f32(SQ), f32(SQ), method="gabor", **kw),
+    "estimate_max_disparity": lambda: sv.estimate_max_disparity(u8(SQ), u8(SQ)),
+    "check_rectification": lambda: sv.check_rectification(u8(SQ), u8(SQ)),
+    "mcgm_curves": lambda: mcgm.curves(u8(SQ)),
+    "sgm_disparity": lambda: sgm.sgm_disparity(u8(SQ), u8(SQ), **kw),
+    "hopfield_match": lambda: hopfield.hopfield_match(u8(SQ), u8(SQ), **kw),
+    "interest_points_row": lambda: hopfield.interest_points(u8(ROW)),
+}
+for name, call in CASES.items():
+    try:
+        call()
+        print(name, "returned", flush=True)
+    except Exception as exc:
+        print(name, type(exc).__name__ + ":", str(exc).splitlines()[0][:300], flush=True)
+"""
+
+_TOO_LARGE = {
+    "depth_map": "left: image of 70000x70000",
+    "depth_map_bgr_row": "left: image of 5000000000x1",
+    "depth_map_big_endian": "left: image of 70000x70000",
+    "match_hopfield_row": "left: image of 5000000000x1",
+    "match_mcgm": "left: image of 70000x70000",
+    "match_gabor": "left: image of 70000x70000",
+    "estimate_max_disparity": "left: image of 70000x70000",
+    "check_rectification": "left: image of 70000x70000",
+    "mcgm_curves": "image: image of 70000x70000",
+    "sgm_disparity": "left: image of 70000x70000",
+    "hopfield_match": "left: image of 70000x70000",
+    "interest_points_row": "image: image of 5000000000x1",
+}
+
+
+@pytest.fixture(scope="module")
+def too_large_outcomes() -> dict[str, str]:
+    import subprocess
+    import sys
+
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", _TOO_LARGE_SCRIPT],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    said = dict(line.split(" ", 1) for line in out.stdout.splitlines())
+    if out.returncode != 0:  # a crash: the cases after the last one said have no outcome
+        gone = f"no outcome: the child exited {out.returncode} ({out.stderr[-300:]!r})"
+        said = {case: said.get(case, gone) for case in _TOO_LARGE}
+    return said
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS is Linux's")
+@pytest.mark.parametrize("case", list(_TOO_LARGE))
+def test_an_image_past_32_bit_indices_is_refused_before_any_copy(
+    case: str, too_large_outcomes: dict[str, str]
+) -> None:
+    """Refused from the shape alone, naming the argument and the limit: no MemoryError for a
+    copy of a broadcast image that takes no memory as given (the child has 3 GB)."""
+    want = (
+        f"ValueError: {_TOO_LARGE[case]} pixels is too large: the kernels index pixels with "
+        "32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
+    )
+    assert too_large_outcomes[case] == want
+
+
+def test_check_index_range_at_the_kernels_limits() -> None:
+    """The same limits as ``image::check_index_range`` in Rust, on the shape alone."""
+    from stereovision._validate import MAX_PIXELS, MAX_SIDE, check_index_range, u8_pair
+
+    for shape in [(1, 1), (MAX_PIXELS // 3, 3), (2, MAX_SIDE), (65537, 65535), (1, MAX_SIDE, 3)]:
+        check_index_range(shape, "left")
+    for shape in [(65536, 65536), (1, MAX_SIDE + 1), (MAX_SIDE + 1, 1), (2, MAX_PIXELS // 2 + 1)]:
+        with pytest.raises(ValueError, match=rf"^left: image of {shape[1]}x{shape[0]} pixels"):
+            check_index_range(shape, "left")
+    # u8_pair leaves a pair too large to check_pair's refusal, without copying it first
+    big = np.broadcast_to(np.uint8(0), (65536, 65536))
+    assert u8_pair(big, big) is None
+    fits = np.broadcast_to(np.uint8(7), (3, 4, 3))
+    pair = u8_pair(fits, fits)
+    assert pair is not None
+    np.testing.assert_array_equal(pair[0], np.full((3, 4, 3), 7, np.uint8))
+
+
+@pytest.mark.parametrize("make", [np.broadcast_to, "read-only"])
+def test_a_broadcast_or_read_only_pair_gives_the_contiguous_result(make: object) -> None:
+    """A real pair as a broadcast view (strides of 0 nowhere, but not writeable) or a read-only
+    copy: depth_map and match give the contiguous pair's results, bit for bit."""
+    from pathlib import Path
+
+    import cv2
+
+    cones = Path(sv.__file__).parent / "data" / "cones"
+    left = cv2.imread(str(cones / "left.png"))
+    right = cv2.imread(str(cones / "right.png"))
+    assert left.shape == (375, 450, 3)
+    if make == "read-only":
+        views = [left.copy(), right.copy()]
+        for v in views:
+            v.flags.writeable = False
+    else:
+        views = [np.broadcast_to(left, left.shape), np.broadcast_to(right, right.shape)]
+        assert not views[0].flags.writeable
+    want = sv.depth_map(left, right, max_disparity=64)
+    got = sv.depth_map(*views, max_disparity=64)
+    np.testing.assert_array_equal(got.disparity, want.disparity)
+    np.testing.assert_array_equal(got.confidence, want.confidence)
+    for method in ("hopfield", "mcgm"):
+        mw = sv.match(left, right, method=method, max_disparity=64)
+        mg = sv.match(*views, method=method, max_disparity=64)
+        assert len(mw) > 100
+        np.testing.assert_array_equal(mg.xl, mw.xl)
+        np.testing.assert_array_equal(mg.xr, mw.xr)

@@ -88,6 +88,49 @@ def path_given(obj: object) -> str | None:
     return None
 
 
+#: Most pixels of an image the kernels take, and its longest side: the Rust kernels hold pixel
+#: indices and counts in u32 and columns and rows in i32 (``MAX_PIXELS``, ``MAX_SIDE`` of
+#: rust/core/src/image.rs, whose ``TooLarge`` message :func:`check_index_range` repeats).
+MAX_PIXELS = 2**32 - 1
+MAX_SIDE = 2**31 - 1
+
+
+def check_index_range(shape: tuple[int, ...], name: str, what: str = "image") -> None:
+    """Refuse an ``(H, W, ...)`` shape past the kernels' 32-bit pixel indices, from the shape alone.
+
+    Called before any copy or conversion: a broadcast or memory-mapped image of 70000 x 70000
+    takes no memory as given, but its grey or BGR copy needs 5-20 GiB, so without this check
+    the user got a MemoryError (or the OOM killer) instead of the limit the kernel would state.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The array's shape, ``(H, W)`` or ``(H, W, C)``.
+    name : str
+        Argument name used in the error message.
+    what : str
+        What the array is, for the message: ``"image"``, or ``"map"`` for a disparity map.
+
+    Raises
+    ------
+    ValueError
+        If the width or height exceeds :data:`MAX_SIDE` or ``W * H`` exceeds :data:`MAX_PIXELS`.
+
+    Examples
+    --------
+    >>> check_index_range((70000, 70000), "left")
+    Traceback (most recent call last):
+    ...
+    ValueError: left: image of 70000x70000 pixels is too large: ...
+    """
+    h, w = int(shape[0]), int(shape[1])
+    if w > MAX_SIDE or h > MAX_SIDE or w * h > MAX_PIXELS:
+        raise ValueError(
+            f"{name}: {what} of {w}x{h} pixels is too large: the kernels index pixels with 32-bit "
+            f"integers (at most {MAX_PIXELS} pixels, {MAX_SIDE} per side)"
+        )
+
+
 def as_image_array(img: object, name: str = "image") -> np.ndarray:
     """Convert ``img`` to a NumPy image array and check its shape and dtype (no value checks).
 
@@ -110,7 +153,9 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
     ValueError
         If ``img`` is None (what ``cv2.imread`` returns for a file it cannot read: the message
         says so), is not array-like, has the wrong number of dimensions or channels, is empty,
-        or has an unsupported dtype (bool, signed integer, complex, object, strings, ...).
+        has an unsupported dtype (bool, signed integer, complex, object, strings, ...), or is
+        past the kernels' 32-bit pixel indices (:func:`check_index_range`, from its shape
+        alone: a broadcast image too large to copy is refused before any copy).
     """
     if img is None:
         # most often cv2.imread's answer for a path it could not read: say so
@@ -137,6 +182,8 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
             f"{name}: expected a numeric image array, got {type(img).__name__} "
             f"converting to dtype {arr.dtype}"
         )
+    if arr.ndim in (2, 3):
+        check_index_range(arr.shape, name)  # before the byte-order copy below and the callers'
     if not arr.dtype.isnative:
         # Big-endian data (FITS, some TIFF and PNG readers): the same values in native order.
         # ">u2" is not np.uint16, so a big-endian 16-bit image was refused as an "unsupported
@@ -589,6 +636,9 @@ def u8_pair(left: object, right: object) -> tuple[np.ndarray, np.ndarray] | None
     ok = left.ndim == 2 or (left.ndim == 3 and left.shape[2] in (1, 3, 4))
     if not ok or left.size == 0:
         return None
+    h, w = left.shape[:2]
+    if w > MAX_SIDE or h > MAX_SIDE or w * h > MAX_PIXELS:
+        return None  # too large: check_pair refuses it from its shape, before any copy
     return np.ascontiguousarray(left), np.ascontiguousarray(right)
 
 
