@@ -523,14 +523,17 @@ def test_match_refuses_a_method_it_does_not_have(method: str) -> None:
 
 #: Each entry point given shape-only (broadcast) arrays past the kernels' 32-bit pixel indices, in
 #: a child under ``ulimit -v`` 3 GB: the grey, BGR, float32 or byte-order copies made before any
-#: check needed 4.6-14 GiB, so the user got a MemoryError instead of the limit. Each outcome is
-#: printed as it comes: a crash leaves the rest unsaid.
+#: check needed 4.6-18.6 GiB, so the user got a MemoryError instead of the limit. segments of a
+#: 1 x 5e9 row went to OpenCV's blur, which wrapped the width: a (1, 705032704) label map came
+#: back under ``ulimit -v`` 8 GB, a SIGSEGV under 3 GB (cv2.error for 70000 x 70000). Each
+#: outcome is printed as it comes: a crash leaves the rest unsaid.
 _TOO_LARGE_SCRIPT = """
 import resource, sys
 import numpy as np
 resource.setrlimit(resource.RLIMIT_AS, (3_000_000 * 1024, 3_000_000 * 1024))
 import stereovision as sv
-from stereovision.matching import hopfield, mcgm, sgm
+from stereovision import refine
+from stereovision.matching import gabor, hopfield, mcgm, planes, sgm
 
 SQ, ROW = (70000, 70000), (1, 5_000_000_000)
 def u8(shape): return np.broadcast_to(np.uint8(0), shape)
@@ -551,6 +554,12 @@ CASES = {
     "sgm_disparity": lambda: sgm.sgm_disparity(u8(SQ), u8(SQ), **kw),
     "hopfield_match": lambda: hopfield.hopfield_match(u8(SQ), u8(SQ), **kw),
     "interest_points_row": lambda: hopfield.interest_points(u8(ROW)),
+    "gabor_disparity": lambda: gabor.gabor_disparity(f32(SQ), f32(SQ), **kw),
+    "gabor_responses_row": lambda: gabor.gabor_responses(f32(ROW)),
+    "refine_disparity": lambda: refine.refine_disparity(u8(SQ), u8(SQ), f32(SQ), **kw),
+    "segments_row": lambda: planes.segments(u8(ROW)),
+    "fill_planes": lambda: planes.fill_planes(f32(SQ), u8(SQ)),
+    "plane_fill": lambda: planes.plane_fill(f32(SQ), np.broadcast_to(np.uint32(0), SQ)),
 }
 for name, call in CASES.items():
     try:
@@ -573,6 +582,12 @@ _TOO_LARGE = {
     "sgm_disparity": "left: image of 70000x70000",
     "hopfield_match": "left: image of 70000x70000",
     "interest_points_row": "image: image of 5000000000x1",
+    "gabor_disparity": "left: image of 70000x70000",
+    "gabor_responses_row": "image: image of 5000000000x1",
+    "refine_disparity": "left: image of 70000x70000",
+    "segments_row": "image: image of 5000000000x1",
+    "fill_planes": "disparity: map of 70000x70000",
+    "plane_fill": "disparity: map of 70000x70000",
 }
 
 

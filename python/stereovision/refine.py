@@ -25,7 +25,12 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import check_unit_range, disparity_range, number_shown
+from stereovision._validate import (
+    check_index_range,
+    check_unit_range,
+    disparity_range,
+    number_shown,
+)
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
 
@@ -100,6 +105,8 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
         raise ValueError(f"{name} must be real numbers, got dtype {arr.dtype}")
     if arr.ndim != 2 or arr.size == 0:
         raise ValueError(f"{name} must be a non-empty 2-D (H, W) array, got shape {arr.shape}")
+    # before the float32 copy: a broadcast image past the kernel's limit may not fit in memory
+    check_index_range(arr.shape, name, "image" if name in ("left", "right") else "map")
     return np.ascontiguousarray(arr, dtype=np.float32)
 
 

@@ -19,6 +19,7 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    check_index_range,
     check_unit_range,
     disparity_range,
     float_sized,
@@ -99,6 +100,7 @@ def _as_grey(img: object, name: str) -> npt.NDArray[np.float32]:
         raise ValueError(f"{name} is empty: shape {arr.shape}")
     if not np.issubdtype(arr.dtype, np.floating):
         raise ValueError(f"{name} must be float32 grey levels in [0, 1], got dtype {arr.dtype}")
+    check_index_range(arr.shape, name)  # before the copy: a broadcast image may not fit in memory
     out = np.ascontiguousarray(arr, dtype=np.float32)
     check_unit_range(out, name)
     return out

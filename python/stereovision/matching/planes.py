@@ -30,7 +30,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import finite_number, float_sized, int_in_range, renamed_keyword
+from stereovision._validate import (
+    check_index_range,
+    finite_number,
+    float_sized,
+    int_in_range,
+    renamed_keyword,
+)
 
 __all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
 
@@ -91,7 +97,8 @@ def segments(
     Raises
     ------
     ValueError
-        A non-2-D/3-D image, a ``step`` below 1 or not finite, a non-finite ``offset``, a
+        A non-2-D/3-D image or one past the kernels' 32-bit pixel indices (checked on its
+        shape, before the blur), a ``step`` below 1 or not finite, a non-finite ``offset``, a
         ``blur`` outside [0, 64] px, a ``min_size`` outside 0 to 2**31 - 1, a ``k`` that is no
         number (or a bool) or a negative ``k``.
     """
@@ -100,6 +107,7 @@ def segments(
     im = np.asarray(image)
     if im.ndim not in (2, 3) or im.size == 0 or im.dtype.kind not in "iuf":
         raise ValueError(f"image: expected a real (H, W) or (H, W, C) array, got {im.shape}")
+    check_index_range(im.shape, "image")  # before the blur's copy (OpenCV wrapped a 5e9 row)
     # A NaN step or offset passed this test and made every key NaN: "image: contains NaN".
     if not finite_number(step, "step") >= 1 or finite_number(blur, "blur") < 0:
         raise ValueError(f"step must be >= 1 and blur >= 0, got step={step}, blur={blur}")
@@ -142,6 +150,8 @@ def _real_map(disparity: npt.ArrayLike) -> F32:
     raw = np.asarray(disparity)
     if raw.dtype.kind not in "biuf":
         raise ValueError(f"disparity: expected real values, got dtype {raw.dtype}")
+    if raw.ndim == 2:  # before the float32 copy (other shapes: the caller's message)
+        check_index_range(raw.shape, "disparity", "map")
     return np.ascontiguousarray(raw, dtype=np.float32)
 
 
