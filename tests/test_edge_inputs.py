@@ -521,9 +521,10 @@ def test_match_refuses_a_method_it_does_not_have(method: str) -> None:
 
 # --- images too large for the kernels: refused from their shape, before any copy ----------------
 
-#: Each entry point given shape-only (broadcast) arrays past the kernels' 32-bit pixel indices, in
+#: Each entry point given shape-only (broadcast) arrays past the kernels' 32-bit pixel indices (the
+#: images, and maps of their size that triangulation, evaluation, export and ground read), in
 #: a child under ``ulimit -v`` 3 GB: the grey, BGR, float32 or byte-order copies made before any
-#: check needed 4.6-18.6 GiB, so the user got a MemoryError instead of the limit. segments of a
+#: check needed 4.6-37 GiB, so the user got a MemoryError instead of the limit. segments of a
 #: 1 x 5e9 row went to OpenCV's blur, which wrapped the width: a (1, 705032704) label map came
 #: back under ``ulimit -v`` 8 GB, a SIGSEGV under 3 GB (cv2.error for 70000 x 70000). Each
 #: outcome is printed as it comes: a crash leaves the rest unsaid.
@@ -532,8 +533,12 @@ import resource, sys
 import numpy as np
 resource.setrlimit(resource.RLIMIT_AS, (3_000_000 * 1024, 3_000_000 * 1024))
 import stereovision as sv
-from stereovision import refine
+import pathlib, tempfile
+from stereovision import evaluate, export, io, refine, temporal, triangulation
 from stereovision.matching import gabor, hopfield, mcgm, planes, sgm
+
+CALIB = sv.Calibration.from_file(pathlib.Path(sv.__file__).parent / "data/cones/calib.txt")
+OUT = tempfile.mkdtemp()
 
 SQ, ROW = (70000, 70000), (1, 5_000_000_000)
 def u8(shape): return np.broadcast_to(np.uint8(0), shape)
@@ -560,6 +565,18 @@ CASES = {
     "segments_row": lambda: planes.segments(u8(ROW)),
     "fill_planes": lambda: planes.fill_planes(f32(SQ), u8(SQ)),
     "plane_fill": lambda: planes.plane_fill(f32(SQ), np.broadcast_to(np.uint32(0), SQ)),
+    "depth_from_disparity": lambda: sv.depth_from_disparity(f32(SQ), CALIB),
+    "reproject_row": lambda: triangulation.reproject(f32(ROW), CALIB),
+    "gt_depth": lambda: evaluate.gt_depth(f32(SQ), CALIB),
+    "fit_ground_plane": lambda: sv.fit_ground_plane(f32(SQ), CALIB),
+    "dense_metrics": lambda: evaluate.dense_metrics(f32(SQ), f32(SQ)),
+    "depth_metrics_row": lambda: evaluate.depth_metrics(f32(ROW), f32(ROW)),
+    "encode_depth_png": lambda: export.encode_depth_png(f32(SQ)),
+    "write_depth_png": lambda: export.write_depth_png(OUT + "/d.png", f32(SQ)),
+    "write_disparity_png_row": lambda: export.write_disparity_png(OUT + "/p.png", f32(ROW)),
+    "write_pfm": lambda: io.write_pfm(OUT + "/d.pfm", f32(SQ)),
+    "noise_sigma": lambda: temporal.noise_sigma(u8(SQ)),
+    "TemporalFilter": lambda: sv.TemporalFilter()(u8(SQ), u8(SQ)),
 }
 for name, call in CASES.items():
     try:
@@ -588,6 +605,18 @@ _TOO_LARGE = {
     "segments_row": "image: image of 5000000000x1",
     "fill_planes": "disparity: map of 70000x70000",
     "plane_fill": "disparity: map of 70000x70000",
+    "depth_from_disparity": "disparity: map of 70000x70000",
+    "reproject_row": "disparity: map of 5000000000x1",
+    "gt_depth": "disparity: map of 70000x70000",
+    "fit_ground_plane": "disparity: map of 70000x70000",
+    "dense_metrics": "disparity: map of 70000x70000",
+    "depth_metrics_row": "depth: map of 5000000000x1",
+    "encode_depth_png": "depth: map of 70000x70000",
+    "write_depth_png": "depth: map of 70000x70000",
+    "write_disparity_png_row": "disparity: map of 5000000000x1",
+    "write_pfm": "arr: map of 70000x70000",
+    "noise_sigma": "image: image of 70000x70000",
+    "TemporalFilter": "left: image of 70000x70000",
 }
 
 

@@ -23,6 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    check_index_range,
     known_unit,
     number_shown,
     renamed_keyword,
@@ -69,6 +70,7 @@ def _real_2d(a: object, name: str, field: str = "disparity") -> npt.NDArray[np.f
         raise ValueError(
             f"{name}: expected a real (H, W) array, got shape {arr.shape} dtype {arr.dtype}"
         )
+    check_index_range(arr.shape, name, "map")  # before the float64 copy (8 bytes a pixel)
     return arr.astype(np.float64)
 
 
@@ -315,6 +317,8 @@ def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     if e.dtype.kind not in "iuf" or g.dtype.kind not in "iuf":
         raise ValueError(f"depth maps must be real arrays, got {e.dtype} and {g.dtype}")
     _same_shape(e, g, "depth", "gt")
+    if e.ndim == 2:  # before the float64 copies (any shape is taken: a map's is checked)
+        check_index_range(e.shape, "depth", "map")
     e = e.astype(np.float64)
     g = g.astype(np.float64)
     both = _depth_valid(e) & _depth_valid(g)

@@ -34,7 +34,12 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import not_a_result, number_shown, renamed_keyword
+from stereovision._validate import (
+    check_index_range,
+    not_a_result,
+    number_shown,
+    renamed_keyword,
+)
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -862,6 +867,8 @@ def _check_scale(scale: float) -> float:
 
 def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
     scale = _check_scale(scale)
+    if isinstance(arr, np.ndarray) and arr.ndim == 2:  # before the float64 copy
+        check_index_range(arr.shape, name, "map")
     a = np.asarray(arr, dtype=np.float64)
     if a.ndim != 2 or a.size == 0:
         raise ValueError(f"{name}: expected a non-empty (H, W) array, got shape {a.shape}")

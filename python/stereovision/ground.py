@@ -596,11 +596,13 @@ def fit_ground_plane(
         of range.
     """
     _require_type(calib, "Calibration", "calib")
-    from stereovision._validate import not_a_result, positive_finite
+    from stereovision._validate import check_index_range, not_a_result, positive_finite
 
     not_a_result(disparity, "disparity", "disparity")
     if np.iscomplexobj(disparity):  # NumPy would drop the imaginary part with a warning
         raise ValueError("disparity: expected a real map, got complex values")
+    if isinstance(disparity, np.ndarray) and disparity.ndim == 2:  # before the float64 copy
+        check_index_range(disparity.shape, "disparity", "map")
     disp = np.asarray(disparity, np.float64)
     if disp.ndim != 2:
         raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")

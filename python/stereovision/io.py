@@ -1120,6 +1120,9 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
         raise ValueError(f"arr: expected a non-empty real array, got {_describe(a)}")
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] == 3)):
         raise ValueError(f"arr: expected shape (H, W) or (H, W, 3), got {a.shape}")
+    from stereovision._validate import check_index_range
+
+    check_index_range(a.shape, "arr", "map")  # before the float32 copy and the file's bytes
     if a.dtype.kind == "f" and a.dtype.itemsize > 4:
         # the cast made a finite 1e300 an inf without a word (no integer reaches float32's max)
         with np.errstate(invalid="ignore"):

@@ -41,6 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
+from stereovision._validate import check_index_range
 
 __all__ = ["MOTION_MARGIN", "TemporalFilter", "noise_sigma"]
 
@@ -162,6 +163,7 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     if img.ndim == 3 and img.shape[2] not in (1, 3, 4):
         # OpenCV's colour conversion raised its own error (cv2.error, not a ValueError)
         raise ValueError(f"image: expected 1, 3 or 4 channels, got {img.shape[2]}")
+    check_index_range(img.shape, "image")  # before the float32 and grey copies
     if img.dtype == np.bool_ or not (
         np.issubdtype(img.dtype, np.integer) or np.issubdtype(img.dtype, np.floating)
     ):
@@ -340,6 +342,7 @@ class TemporalFilter:
                 f"left and right: {w}x{h} px, too small to measure their noise: images of at "
                 "least 3 x 3 px are needed"
             )
+        check_index_range(imgs[0].shape, "left")  # before the copies and the float32 means
         imgs = [np.ascontiguousarray(img) for img in imgs]
         self.frames += 1
         # A black (or white) frame has no estimate, not one of 0: a webcam's dark frames while

@@ -295,7 +295,7 @@ def triangulate(
 
 
 def _disparity(disparity: npt.ArrayLike) -> F64:
-    from stereovision._validate import not_a_result
+    from stereovision._validate import check_index_range, not_a_result
 
     not_a_result(disparity, "disparity", "disparity")
     d = np.asarray(disparity)
@@ -303,6 +303,7 @@ def _disparity(disparity: npt.ArrayLike) -> F64:
         raise ValueError(
             f"disparity: expected a real (H, W) array, got shape {d.shape} dtype {d.dtype}"
         )
+    check_index_range(d.shape, "disparity", "map")  # before the float64 copy (8 bytes a pixel)
     return d.astype(np.float64)
 
 
