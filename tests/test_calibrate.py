@@ -1932,6 +1932,49 @@ def test_a_vertical_rig_whose_t_leans_right_is_not_said_to_be_swapped(
     assert list(cal.T) == [0.05, -3.3, 0.0] and rep.baseline == pytest.approx(math.hypot(0.05, 3.3))
 
 
+@pytest.mark.parametrize(
+    ("turn", "way", "where"),
+    [
+        (cv2.ROTATE_90_CLOCKWISE, "counter-clockwise", "below"),
+        (cv2.ROTATE_90_COUNTERCLOCKWISE, "clockwise", "above"),
+    ],
+)
+def test_cli_refuses_a_vertical_rig_before_writing_and_says_how_to_turn_it(
+    cached_corners: None, tmp_path: Path, turn: int, way: str, where: str
+) -> None:
+    """OpenCV's pairs turned to portrait (a rig on its side) calibrate as a vertical rig, which
+    nothing here rectifies: the CLI wrote -o, then failed in describe() with "the rig is
+    vertical" (exit 2, the file written unsaid, --report and --ros not written). Now refused
+    before any file, with the turn that puts the right camera on the right; turned that way
+    back, the pairs calibrate as the side-by-side rig they are."""
+    left, right = _chessboard_paths()
+    for i, (lp, rp) in enumerate(zip(left[:5], right[:5], strict=True)):
+        cv2.imwrite(str(tmp_path / f"left{i}.png"), cv2.rotate(cv2.imread(str(lp)), turn))
+        cv2.imwrite(str(tmp_path / f"right{i}.png"), cv2.rotate(cv2.imread(str(rp)), turn))
+    out, report, ros = tmp_path / "rig.yaml", tmp_path / "report", tmp_path / "ros"
+    args = _parser().parse_args(
+        ["calibrate", "--left", str(tmp_path / "left*.png"), "--right",
+         str(tmp_path / "right*.png"), "--square", "25", "--unit", "mm", "-o", str(out),
+         "--report", str(report), "--ros", str(ros)]
+    )  # fmt: skip
+    with pytest.raises(
+        ValueError,
+        match=rf"^R, T: the rig is vertical \(stereoRectify produced a vertical baseline\); "
+        rf"only horizontal rigs are supported; nothing written: the right camera sits {where} "
+        rf"the left one; turn both cameras' images 90 degrees {way} \(cv2\.rotate\) to put it "
+        "on the right, and calibrate them$",
+    ):
+        args.func(args)
+    assert not out.exists() and not report.exists() and not ros.exists()
+    back = cv2.ROTATE_90_COUNTERCLOCKWISE if way == "counter-clockwise" else cv2.ROTATE_90_CLOCKWISE
+    cal, _ = calibrate(
+        [cv2.rotate(cv2.imread(str(tmp_path / f"left{i}.png")), back) for i in range(5)],
+        [cv2.rotate(cv2.imread(str(tmp_path / f"right{i}.png")), back) for i in range(5)],
+        square_size=25.0, unit="mm",
+    )  # fmt: skip
+    assert cal.image_size == (640, 480) and cal.T[0] < -80 and abs(cal.T[1]) < 5
+
+
 def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_end() -> None:
     """_calibrate_from_camera (calibrate_from_video's, from_bag's reader): a frame that fails
     to decode (SourceError with end=False) is raised, not taken for the recording's end and

@@ -2910,6 +2910,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             rep.pair_selection[key] = _cli_words(rep.pair_selection[key])
     from stereovision.io import keep_previous, replaced_words
 
+    try:
+        # before any file: a vertical rig (portrait images of a rig on its side) is calibrated,
+        # but nothing here rectifies it, and describe() refused it after -o was written (exit 2,
+        # the file written unsaid, --ros and --report not written)
+        description = cal.describe()
+    except ValueError as exc:
+        raise ValueError(f"{exc}; nothing written{_upright_hint(cal)}") from None
     # the same result again (a rerun on the same pairs) replaces nothing: no copy is kept
     existed = Path(out).is_file()
     kept = keep_previous(out, cal._file_text(out).encode("utf-8"))
@@ -2917,7 +2924,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         record_outputs(folder, claimed, CALIBRATE_MANIFEST, CALIBRATE_OUTPUTS)
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
-    print(cal.describe())
+    print(description)
     print(f"calibration written to {out}{replaced_words(kept, existed)}")
     if ros_dir is not None:
         try:
@@ -2943,6 +2950,20 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         paths = rep.write(args.report)
         print(f"report written to {paths['html']}")
     return 0
+
+
+def _upright_hint(cal: Calibration) -> str:
+    """How to turn the images of a vertical rig so that the right camera sits on the right
+    (``""`` for a rig that is not vertical)."""
+    centre = -cal.R.T @ cal.T  # the right camera's centre in the left camera's frame (y down)
+    if abs(centre[1]) <= abs(centre[0]):
+        return ""
+    # turning an image by 90 degrees counter-clockwise takes its downward direction to the right
+    way, where = ("counter-clockwise", "below") if centre[1] > 0 else ("clockwise", "above")
+    return (
+        f": the right camera sits {where} the left one; turn both cameras' images 90 degrees "
+        f"{way} (cv2.rotate) to put it on the right, and calibrate them"
+    )
 
 
 def _cli_board(args: argparse.Namespace, *, printing: bool) -> CharucoBoard | None:
