@@ -1975,6 +1975,28 @@ def test_cli_refuses_a_vertical_rig_before_writing_and_says_how_to_turn_it(
     assert cal.image_size == (640, 480) and cal.T[0] < -80 and abs(cal.T[1]) < 5
 
 
+def test_a_vertical_rigs_epipolar_error_is_taken_across_its_baseline(
+    cached_corners: None, chessboard: tuple[Calibration, CalibrationReport]
+) -> None:
+    """OpenCV rectifies a vertical rig (the sample pairs turned to portrait) to columns: its
+    report's "rectified epipolar error |dy|" was the corners' vertical disparity, mean 140 px
+    for a 0.19 px solution. It is now |dx|, as small as the side-by-side rig's |dy|."""
+    left, right = _chessboard_paths()
+    turn = cv2.ROTATE_90_CLOCKWISE
+    _, rep = calibrate(
+        [cv2.rotate(cv2.imread(str(p)), turn) for p in left[:5]],
+        [cv2.rotate(cv2.imread(str(p)), turn) for p in right[:5]],
+        square_size=1.0,
+    )
+    assert rep.epipolar_mean_dy < 0.3 and rep.epipolar_max_dy < 1.0
+    assert "rectified epipolar error |dx|: mean " in rep.summary()
+    html = calmod._render_html(rep)
+    assert "rectified |dx| mean" in html and "rectified |dy|" not in html
+    side_by_side = chessboard[1]
+    assert side_by_side.epipolar_mean_dy < 0.3
+    assert "rectified epipolar error |dy|: mean " in side_by_side.summary()
+
+
 def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_end() -> None:
     """_calibrate_from_camera (calibrate_from_video's, from_bag's reader): a frame that fails
     to decode (SourceError with end=False) is raised, not taken for the recording's end and

@@ -600,7 +600,8 @@ class CalibrationReport:
     outlier_pairs : list of str
         Pairs flagged as outliers (dropped or not, see ``drop_outliers``).
     epipolar_mean_dy, epipolar_max_dy : float
-        Mean and max ``|y_left - y_right|`` of all used corners after rectification (px).
+        Mean and max ``|y_left - y_right|`` of all used corners after rectification (px); of a
+        vertical rig, which OpenCV rectifies to columns, ``|x_left - x_right|`` (``|dx|``).
     square_size, square_size_measured, square_size_std : float
         Given square side, median and standard deviation of the sides between triangulated
         adjacent corners (in ``unit``). The triangulation's scale is the given square's (``T``
@@ -722,7 +723,8 @@ class CalibrationReport:
             f"(left {self.stereo_rms_left:.3f}, right {self.stereo_rms_right:.3f}; each camera "
             f"calibrated alone {self.rms_left:.3f} / {self.rms_right:.3f}; "
             f"model {self.distortion_model})",
-            f"rectified epipolar error |dy|: mean {self.epipolar_mean_dy:.3f} px, "
+            f"rectified epipolar error {_epipolar_label(self)}: mean "
+            f"{self.epipolar_mean_dy:.3f} px, "
             f"max {self.epipolar_max_dy:.3f} px",
             f"baseline {self.baseline:.6g} {self.unit}, fx {self.focal_left:.2f} / "
             f"{self.focal_right:.2f} px; triangulated square sides spread "
@@ -1139,13 +1141,16 @@ def _rectified_checks(
     is measured between grid neighbours both seen.
     """
     _, _, P1, P2, _ = cal._stereo_rectify(0.0)
+    # the coordinate across the rectified baseline: a vertical rig's corners share columns (its
+    # |dy| was the 140 px of the baseline's disparity, for a 0.19 px solution)
+    across = _across_baseline(P2)
     dys: list[F64] = []
     sides: list[F64] = []
     cols, rows = pattern
     for cl, cr, idx in zip(left, right, ids, strict=True):
         ul = cal.rectify_points(cl, "left")
         ur = cal.rectify_points(cr, "right")
-        dys.append(np.abs(ul[:, 1] - ur[:, 1]))
+        dys.append(np.abs(ul[:, across] - ur[:, across]))
         Xh = cv2.triangulatePoints(P1, P2, ul.T, ur.T)
         flat = np.full((rows * cols, 3), np.nan)
         flat[idx] = (Xh[:3] / Xh[3]).T
@@ -1161,6 +1166,21 @@ def _rectified_checks(
 
 
 # ------------------------------------------------------------------------------------ loading
+
+
+def _across_baseline(p2: F64) -> int:
+    """The rectified image axis across the baseline: 1 (y) for a side-by-side rig, 0 (x) for a
+    vertical one, which ``cv2.stereoRectify`` aligns by columns (``P2[1, 3]`` holds its baseline).
+    """
+    return 0 if abs(p2[1, 3]) > abs(p2[0, 3]) else 1
+
+
+def _epipolar_label(rep: CalibrationReport) -> str:
+    """``|dy|``, or ``|dx|`` for a vertical rig's report (see :func:`_across_baseline`)."""
+    cal = rep._calibration
+    if cal is None or cal.rectified:
+        return "|dy|"
+    return "|dy|" if _across_baseline(cal._stereo_rectify(0.0)[3]) else "|dx|"
 
 
 def _warn(notes: list[str], message: str, category: type[Warning]) -> None:
@@ -2311,8 +2331,8 @@ def _render_html(rep: CalibrationReport) -> str:
                 else f" (reading stopped by {sel['option']}: {sel['rule']})"
             ),
         ),
-        ("rectified |dy| mean", f"{rep.epipolar_mean_dy:.3f} px"),
-        ("rectified |dy| max", f"{rep.epipolar_max_dy:.3f} px"),
+        (f"rectified {_epipolar_label(rep)} mean", f"{rep.epipolar_mean_dy:.3f} px"),
+        (f"rectified {_epipolar_label(rep)} max", f"{rep.epipolar_max_dy:.3f} px"),
         (
             "triangulated square sides",
             f"spread {100 * rep.square_size_std / rep.square_size:.2f} % (std "
