@@ -1115,7 +1115,10 @@ def test_max_pairs_names_kept_and_left_out_pairs_by_one_numbering(
         for files, into in ((left, lefts), (right, rights)):
             for f in files:
                 link = tmp_path / session / f.name
-                link.symlink_to(f)
+                if session == "a":
+                    link.symlink_to(f)
+                else:  # other pixels: the same images again are repeats, used once
+                    cv2.imwrite(str(link), cv2.imread(str(f)), [cv2.IMWRITE_JPEG_QUALITY, 90])
                 into.append(str(link))
     argv = ["calibrate", "--left", *lefts, "--right", *rights, "--square", "1"]
     argv += ["--report", str(tmp_path / "rep"), "--max-pairs", "5", "-o", str(tmp_path / "c.yaml")]
@@ -1995,6 +1998,38 @@ def test_a_vertical_rigs_epipolar_error_is_taken_across_its_baseline(
     side_by_side = chessboard[1]
     assert side_by_side.epipolar_mean_dy < 0.3
     assert "rectified epipolar error |dy|: mean " in side_by_side.summary()
+
+
+def test_a_repeated_pair_is_used_once_and_does_not_make_up_the_pairs_needed(
+    cached_corners: None,
+) -> None:
+    """The same pair given twice (overlapping globs, a copied file) was used twice: two distinct
+    views given twice calibrated as "4/4 pairs used" where 3 are needed, and a view left out of
+    the distortion model's cross-validation kept its twin. A repeat is now rejected by name, said
+    in a UserWarning, and not counted."""
+    left, right = _chessboard_paths()
+    with (
+        pytest.warns(UserWarning, match=r"repeat an earlier pair \(the same board corners in"),
+        pytest.raises(
+            ValueError,
+            match=r"was found in both images of only 2 of 4 pairs \(2 more repeat an earlier "
+            r"pair\); at least 3 are needed \(rejected: 02:left01\.jpg / right01\.jpg, ",
+        ),
+    ):
+        calibrate(left[:2] * 2, right[:2] * 2, square_size=1.0)
+    names = ["a", "b", "c", "d", "b2", "c2"]
+    with pytest.warns(UserWarning, match=r"^b2, c2 repeat an earlier pair .*: each view is used"):
+        cal, rep = calibrate(
+            left[:4] + left[1:3], right[:4] + right[1:3], square_size=1.0, names=names
+        )
+    assert rep.used_pairs == ["a", "b", "c", "d"]
+    assert rep.rejected_pairs == {
+        "b2": "the same board corners as b in both images (a repeated pair)",
+        "c2": "the same board corners as c in both images (a repeated pair)",
+    }
+    once, _ = calibrate(left[:4], right[:4], square_size=1.0)
+    np.testing.assert_array_equal(cal.T, once.T)
+    np.testing.assert_array_equal(cal.K1, once.K1)
 
 
 def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_end() -> None:

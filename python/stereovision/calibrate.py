@@ -51,7 +51,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import cv2
 import numpy as np
@@ -1577,6 +1577,7 @@ def calibrate(
 
     rejected: dict[str, str] = {}
     used: list[int] = []
+    repeats: list[str] = []
     for i, (cl, cr) in enumerate(zip(corners_l, corners_r, strict=True)):
         if i in short:
             rejected[pair_names[i]] = short[i]
@@ -1586,8 +1587,40 @@ def calibrate(
                 "either image" if cl is None and cr is None else "left" if cl is None else "right"
             )
             rejected[pair_names[i]] = f"board not found in {where}"
+        elif (
+            twin := next(
+                (
+                    j
+                    for j in used
+                    if np.array_equal(cast(F64, corners_l[j]), cl)
+                    and np.array_equal(cast(F64, corners_r[j]), cr)
+                    and np.array_equal(cast(Any, corner_ids[j]), cast(Any, corner_ids[i]))
+                ),
+                None,
+            )
+        ) is not None:
+            # The same images given twice (overlapping globs, a file copied): counted twice, 2
+            # views passed for the 3 needed, and a view left out kept its twin in the
+            # cross-validation that picks the distortion model.
+            repeats.append(pair_names[i])
+            rejected[pair_names[i]] = (
+                f"the same board corners as {pair_names[twin]} in both images (a repeated pair)"
+            )
         else:
             used.append(i)
+    if repeats:
+        shown = ", ".join(repeats[:WORST_PAIRS_SHOWN])
+        more = (
+            f" and {len(repeats) - WORST_PAIRS_SHOWN} more"
+            if len(repeats) > WORST_PAIRS_SHOWN
+            else ""
+        )
+        _warn(
+            notes,
+            f"{shown}{more} repeat{'s' if len(repeats) == 1 else ''} an earlier pair (the same "
+            "board corners in both images): each view is used once",
+            UserWarning,
+        )
     board_text = (
         f"chessboard {pat[0]}x{pat[1]} inner corners" if board is None else board.describe(unit)
     )
@@ -1632,7 +1665,9 @@ def calibrate(
     if len(used) < MIN_PAIRS:
         raise ValueError(
             f"the {board_text} was found in both images of only {len(used)} of "
-            f"{len(lefts)} pairs; at least {MIN_PAIRS} are needed"
+            f"{len(lefts)} pairs"
+            + (f" ({len(repeats)} more repeat an earlier pair)" if repeats else "")
+            + f"; at least {MIN_PAIRS} are needed"
             + (f"; {board_hint}" if board_hint else "")
             + (f" (rejected: {', '.join(rejected)})" if rejected else "")
         )
