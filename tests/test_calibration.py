@@ -207,6 +207,34 @@ def test_yaml_readable_by_opencv(tmp_path: Path) -> None:
     fs.release()
 
 
+def test_a_calibration_written_as_json_by_opencv_filestorage_loads(tmp_path: Path) -> None:
+    """cv::FileStorage writes JSON for a .json name (in C++, Python, ...), each matrix an object
+    {"type_id": "opencv-matrix", "rows", "cols", "dt", "data"} (a 1-D array an
+    "opencv-nd-matrix"): it was refused as "K1: expected a real array, got dict". It loads with
+    OpenCV's meaning, bit for bit, also after a blank line (which OpenCV takes for YAML)."""
+    rng = np.random.default_rng(5)
+    c = raw_calib(D1=rng.standard_normal(8) * 1e-3, T=np.array([-0.1 / 3, 1e-17, np.pi * 1e-3]))
+    path = tmp_path / "rig.json"
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    for key, value in c._to_record().items():
+        # D1 as a 1-D array, T as a column, the rest as saved
+        fs.write(key, value.reshape(-1, 1) if key == "T" else value)
+    fs.release()
+    text = path.read_text()
+    assert text.lstrip().startswith("{") and '"type_id": "opencv-matrix"' in text
+    assert '"type_id": "opencv-nd-matrix"' in text  # D1
+    for body in (text, "\n  " + text):
+        path.write_text(body)
+        for loaded in (Calibration.load(path), Calibration.from_file(path)):
+            _bits_equal(c, loaded)
+    # a matrix of OpenCV's beside a nested list: the list is named, not read as a matrix
+    obj = json.loads(text)
+    obj["R"] = c.R.tolist()
+    path.write_text(json.dumps(obj))
+    with pytest.raises(ValueError, match=r"rig\.json: field 'R' is not a matrix: expected rows, "):
+        Calibration.load(path)
+
+
 def test_json_content(tmp_path: Path) -> None:
     rect_calib(doffs=0.0).save(tmp_path / "c.json")
     obj = json.loads((tmp_path / "c.json").read_text())

@@ -1375,6 +1375,15 @@ class Calibration:
             )
         if not any(k in obj for k in _CALIBRATION_FIELDS):  # as a YAML file says it
             raise ValueError(_not_a_calibration_keys([str(k) for k in obj], source))
+        if any(
+            isinstance(v, dict) and str(v.get("type_id", "")).startswith("opencv-")
+            for v in obj.values()
+        ):
+            # cv::FileStorage's JSON (a .json name in any language): its matrices are
+            # {"type_id": "opencv-matrix", "rows", "cols", "data"}, refused as "K1: expected a
+            # real array, got dict"; read as OpenCV reads it (which takes a file starting with a
+            # blank for YAML)
+            return cls._from_filestorage_text(text.lstrip(), source)
         return cls._from_mapping(obj.get, source)
 
     @staticmethod
@@ -1397,8 +1406,9 @@ class Calibration:
     def load(cls, path: PathLike) -> Calibration:
         """Read a calibration written by :meth:`save` (OpenCV YAML/XML or JSON).
 
-        The format is recognised from the content. ``M1``/``M2`` (OpenCV's ``stereo_calib``
-        sample names) are accepted for ``K1``/``K2``.
+        The format is recognised from the content; JSON is :meth:`save`'s nested lists or
+        ``cv::FileStorage``'s JSON (matrices as ``opencv-matrix`` objects). ``M1``/``M2``
+        (OpenCV's ``stereo_calib`` sample names) are accepted for ``K1``/``K2``.
 
         Parameters
         ----------
