@@ -1964,8 +1964,8 @@ def test_cli_refuses_a_vertical_rig_before_writing_and_says_how_to_turn_it(
         ValueError,
         match=rf"^R, T: the rig is vertical \(stereoRectify produced a vertical baseline\); "
         rf"only horizontal rigs are supported; nothing written: the right camera sits {where} "
-        rf"the left one; turn both cameras' images 90 degrees {way} \(cv2\.rotate\) to put it "
-        "on the right, and calibrate them$",
+        rf"the left one; turn both cameras' images 90 degrees {way} to put it on the right, and "
+        "calibrate them$",
     ):
         args.func(args)
     assert not out.exists() and not report.exists() and not ros.exists()

@@ -3017,7 +3017,7 @@ def _upright_hint(cal: Calibration) -> str:
     way, where = ("counter-clockwise", "below") if centre[1] > 0 else ("clockwise", "above")
     return (
         f": the right camera sits {where} the left one; turn both cameras' images 90 degrees "
-        f"{way} (cv2.rotate) to put it on the right, and calibrate them"
+        f"{way} to put it on the right, and calibrate them"
     )
 
 
