@@ -2787,3 +2787,79 @@ def test_a_streams_password_is_not_said_in_its_reports(
     assert opened == [left_url, right_url]
     for secret in ("s3cret", "tok77", "pw99"):
         assert secret not in out + err
+
+
+class _Unplugged:
+    """A camera device (``cv2.VideoCapture(index)`` stand-in) that delivers ``frames`` frames,
+    then none: unplugged, a loose cable."""
+
+    frames = 3
+    gone: tuple[int, ...] = (0, 1)  # the device indexes unplugged
+
+    def __init__(self, index: int, *args: Any) -> None:
+        self.index, self.n = index, 0
+        self.frame = _frame(0).left if index == 0 else np.roll(_frame(0).left, -2, axis=1)
+
+    def isOpened(self) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        self.n += 1
+        return self.n <= self.frames or self.index not in self.gone
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, self.frame.copy()
+
+    def get(self, prop: int) -> float:
+        return {cv2.CAP_PROP_FRAME_WIDTH: 64.0, cv2.CAP_PROP_FRAME_HEIGHT: 48.0}.get(prop, 0.0)
+
+    def set(self, prop: int, value: float) -> bool:
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+@PIPELINED
+@pytest.mark.parametrize(
+    ("gone", "said"),
+    [
+        ((0,), "left source camera 0 stopped delivering frames after 3 (disconnected?); the "
+               "right source still had frames"),
+        ((0, 1), "left source camera 0 stopped delivering frames after 3 (disconnected?); "
+                 "right source camera 1 stopped delivering frames after 3 (disconnected?)"),
+    ],
+)  # fmt: skip
+def test_a_camera_that_stops_delivering_fails_the_stream(
+    gone: tuple[int, ...],
+    said: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A camera device has no end: one unplugged mid-stream ended it as ``"end of stream"``,
+    exit 0 (with one warning; both unplugged, without a word). It ends as ``"source failed"``
+    now, the error naming the cameras, the pairs done kept in the summary; exit 2."""
+    monkeypatch.setattr(_Unplugged, "gone", gone)
+    monkeypatch.setattr(cv2, "VideoCapture", _Unplugged)
+    for pipelined in (True, False):
+        with StereoCamera(0, 1) as cam, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rep = run_stream(cam, max_disparity=8, check=False, pipelined=pipelined)
+        assert (rep.frames, rep.ended, rep.error) == (3, "source failed", said)
+        assert [str(w.message) for w in caught] == []
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check", "--json"]
+    assert main([*argv, "--max-disparity", "8"]) == 2
+    out, err = capsys.readouterr()
+    summary = json.loads(out.splitlines()[-1])
+    assert (summary["frames"], summary["ended"], summary["error"]) == (3, "source failed", said)
+    assert err.splitlines()[-1] == f"stereovision: error: {said}"
+
+
+def test_a_video_file_read_to_its_end_still_ends_its_stream(tmp_path: Path) -> None:
+    """Files and sequences do end: read to their last frame, the stream ends as before."""
+    for side, shift in (("l", 0), ("r", -2)):
+        for i in range(3):
+            cv2.imwrite(str(tmp_path / f"{side}{i}.png"), np.roll(_frame(0).left, shift, axis=1))
+    with StereoCamera(str(tmp_path / "l%d.png"), str(tmp_path / "r%d.png")) as cam:
+        rep = run_stream(cam, max_disparity=8, check=False)
+    assert (rep.frames, rep.ended, rep.error) == (3, "end of stream", None)

@@ -1701,7 +1701,8 @@ class StereoCamera(PairSource):
         gone = [side for side in ("left", "right") if not ok[side]]
         short = [t for side in gone if (t := self._short(side)) is not None]
         gaps = [g[0] for side in gone if (g := self._gap(side)) is not None]
-        if len(gone) == 2 and not short and not gaps:
+        devices = [s for s in gone if isinstance(self.sources[s], (int, np.integer))]
+        if len(gone) == 2 and not short and not gaps and not devices:
             message = f"both sources ended after {self.count} frames"
         elif len(gone) == 2:
             message = "; ".join(self._end_phrase(side) for side in gone)

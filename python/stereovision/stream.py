@@ -172,9 +172,10 @@ class StreamReport:
     ended : str
         ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C),
         ``"terminated"`` (SIGTERM, under the CLI), ``"source failed"`` (a source failed
-        after the first pair: a frame that does not decode or of another shape; see
-        :attr:`error`) or ``"output failed"`` (``on_result`` or ``on_stamped_result`` raised
-        an OSError, e.g. a bag on a full disk: that pair is not counted; see :attr:`error`).
+        after the first pair: a frame that does not decode or of another shape, a camera
+        device that stopped delivering, unplugged; see :attr:`error`) or ``"output failed"``
+        (``on_result`` or ``on_stamped_result`` raised an OSError, e.g. a bag on a full disk:
+        that pair is not counted; see :attr:`error`).
     rectification : dict or None
         :func:`~stereovision.rectification_check.check_rectification` of the first pair, as a
         dict (None when ``check=False`` or no pair came).
@@ -477,6 +478,10 @@ def _pairs(
             # one source ended before the other or before the frames its file announced
             if camera.count == 0 or not getattr(exc, "end", True):
                 raise
+            if _device_ended(camera, exc):
+                # a camera has no end: one that stops delivering (unplugged, a loose cable)
+                # ended a robot's stream as "end of stream", exit 0, silently when both did
+                raise SourceError(str(exc), side=exc.side, end=False, frames=exc.frames) from exc
             if getattr(exc, "ended_early", False):
                 yield _Note(str(exc))
             return
@@ -570,6 +575,16 @@ def _pairs(
             filtered=filtered,
         )
         n += 1
+
+
+def _device_ended(camera: Any, exc: SourceError) -> bool:
+    """Whether the source(s) whose end ``exc`` reports include a camera device (an index):
+    a file or sequence ends, a device that stops delivering was lost."""
+    sources = getattr(camera, "sources", None)
+    if not isinstance(sources, dict):
+        return False
+    sides = ("left", "right") if exc.side in (None, "both") else (exc.side,)
+    return any(isinstance(sources.get(side), (int, np.integer)) for side in sides)
 
 
 def _media_period_ns(camera: Any) -> int | None:
@@ -849,7 +864,8 @@ def run_stream(
     ------
     SourceError
         If a source delivers no first frame, or fails on the first pair. A failure after it
-        (a frame that does not decode or of another shape) ends the stream instead: the pairs
+        (a frame that does not decode or of another shape; a camera device, unlike a file,
+        that stops delivering) ends the stream instead: the pairs
         done are reported, with ``ended`` ``"source failed"`` and the error in ``error``; an
         OSError of ``on_result`` or ``on_stamped_result`` (an output that cannot be written)
         ends it likewise, ``ended`` ``"output failed"``.
