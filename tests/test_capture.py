@@ -1557,7 +1557,9 @@ def test_capture_refuses_to_save_into_the_sequence_it_reads(
     with StereoCamera(lpat, rpat) as cam, pytest.raises(ValueError, match="without end"):
         capture(cam, pairs, count=20)
     other = _write_sequence(tmp_path / "other", "left", [_numbered(i) for i in range(3)])
-    with StereoCamera(other, rpat) as cam:  # the right pattern alone reads them too
+    with pytest.warns(UserWarning, match="images are paired in order"):  # 0 beside 1
+        cam = StereoCamera(other, rpat)
+    with cam:  # the right pattern alone reads them too
         with pytest.raises(ValueError, match=f"the source {re.escape(rpat)} would read"):
             capture(cam, pairs, count=20)
     assert sorted(p.name for p in pairs.iterdir()) == before
@@ -3991,3 +3993,32 @@ def test_a_glob_matching_one_folder_is_not_told_to_be_given_as_that_file(
         f"left source {tmp_path}/run* is a glob, which OpenCV does not expand: give a video "
         f"file, an image-sequence pattern such as {tmp_path}/left_%04d.png or a camera index"
     )
+
+
+def test_sequences_that_start_at_other_numbers_are_said_to_pair_in_order(tmp_path: Path) -> None:
+    """A left image sequence that starts at 1 (its image 0 deleted, blurred) beside a right
+    one starting at 0 paired every left image with the right one before its own, without a
+    word until the end (one source ended first). One line now says so at the open, naming both
+    first images; sequences starting at the same number are paired as before, silently."""
+    for i in range(4):
+        if i:
+            cv2.imwrite(str(tmp_path / f"left_{i:04d}.png"), _numbered(i))
+        cv2.imwrite(str(tmp_path / f"right_{i:04d}.png"), _numbered(i))
+    left, right = str(tmp_path / "left_%04d.png"), str(tmp_path / "right_%04d.png")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with StereoCamera(left, right) as cam:
+            fr = cam.read()
+    assert [str(w.message) for w in caught] == [
+        "the left sequence starts at left_0001.png, the right one at right_0000.png: images are "
+        "paired in order (left_0001.png with right_0000.png), not by their numbers; if the "
+        "numbers name the pairs, remove the images without a partner (or renumber)"
+    ]
+    assert caught[0].filename == __file__  # the caller's line
+    assert (_read_stamp(fr.left), _read_stamp(fr.right)) == (1, 0)  # what it warns of
+    (tmp_path / "right_0000.png").unlink()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with StereoCamera(left, right) as cam:
+            fr = cam.read()
+    assert (_read_stamp(fr.left), _read_stamp(fr.right)) == (1, 1)

@@ -1528,6 +1528,23 @@ class StereoCamera(PairSource):
         except BaseException:
             self.close()
             raise
+        starts = self._sequence_start
+        if len(starts) == 2 and starts["left"] != starts["right"]:
+            # pairs are read in order, not by number: left_0001.png deleted (blurred) paired
+            # every left image with the right one before its own, without a word until the end
+            first = {
+                side: os.path.basename(_sequence_name(os.fspath(src), starts[side]))
+                for side, src in self.sources.items()
+                if isinstance(src, (str, os.PathLike))  # a sequence is a path
+            }
+            warnings.warn(
+                f"the left sequence starts at {first['left']}, the right one at "
+                f"{first['right']}: images are paired in order ({first['left']} with "
+                f"{first['right']}), not by their numbers; if the numbers name the pairs, "
+                "remove the images without a partner (or renumber)",
+                UserWarning,
+                stacklevel=3,  # __init__, renamed_keyword's wrapper, the caller
+            )
 
     def _open(self, side: str, src: Source, fps: float | None, timeout: float | None) -> Any:
         configure = functools.partial(self._configure, side, fps)
