@@ -1580,7 +1580,7 @@ def test_cli_depth_ground_says_why_no_floor_was_tried(
     out = capsys.readouterr().out
     assert "ground plane: none found (0 pixels have a disparity; a fit needs 500)" in out
     assert not (tmp_path / "o" / "ground.json").exists()
-    from stereovision.cli import _no_floor_line
+    from stereovision.ground import _no_floor_line
 
     calib = load_scene(kitti).calib
     disp = np.full((375, 1242), np.nan)

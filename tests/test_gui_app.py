@@ -1511,6 +1511,47 @@ def test_find_floor_says_its_heights_in_the_unit_on_show(data_dir):
     assert floor_text(None, "ft").startswith("ground plane: none found")
 
 
+def test_find_floor_says_why_no_floor_was_found(data_dir):
+    """Find floor said "no near-level plane holds 3 % of the pixels" of any map without a
+    floor, also of one with fewer disparities than a fit needs (ground.MIN_PIXELS), where no
+    fit was tried. It gives ``depth --ground``'s reason now, from the same code."""
+    pytest.importorskip("trame")
+    from types import SimpleNamespace
+
+    from trame.app import get_server
+
+    from stereovision.ground import MIN_PIXELS
+    from stereovision.gui.app import StereoApp, floor_text
+
+    scene = data_dir / "kitti2015" / "000005_10"
+    app = StereoApp(
+        get_server("test-floor-why", client_type="vue3"), AllowedFolders([data_dir]), scene
+    )
+    app._spawn = lambda coro: coro.close()
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    res = app.view.result
+    disparity = res.disparity.copy()
+    res.disparity[:] = np.nan  # nothing matched: no fit is tried
+    _run(app, app.find_floor)
+    assert app.state.error == ""
+    assert app.state.floor_label == (
+        f"ground plane: none found (0 pixels have a disparity; a fit needs {MIN_PIXELS})"
+    )
+    assert app.state.img_floor == ""
+    # enough disparities to try a fit (the pixels the fit counts: finite, in front of the rig)
+    disparity[:] = np.nan
+    disparity.flat[:MIN_PIXELS] = 40.0
+    enough = SimpleNamespace(disparity=disparity, calibration=res.calibration)
+    assert floor_text(None, "ft", enough) == (
+        "ground plane: none found (no near-level plane holds 3 % of the pixels)"
+    )
+    disparity.flat[0] = -1e9  # behind the camera: not a disparity the fit counts
+    assert floor_text(None, "ft", enough) == (
+        f"ground plane: none found ({MIN_PIXELS - 1} pixels have a disparity; a fit needs 500)"
+    )
+
+
 def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_path):
     """The page had no way to keep a result. "Save" writes the pair on show with the depth
     command's writer (disparity PNG + PFM, 16-bit depth PNG in mm, cloud.ply) into a folder

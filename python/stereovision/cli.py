@@ -858,25 +858,6 @@ def _depth_range(depth: np.ndarray, unit: str) -> str:
     return f"depth {lo:.3g}-{hi:.3g} {unit} (median {mid:.3g} {unit})"
 
 
-def _no_floor_line(disparity: np.ndarray, calib: Any) -> str:
-    """``depth --ground``'s line when no floor was found: too few disparities to try a fit
-    (:data:`~stereovision.ground.MIN_PIXELS`), or no plane that holds the floor's share."""
-    from stereovision.ground import MIN_INLIER_SHARE, MIN_PIXELS
-
-    rc = calib if calib.rectified else calib.rectified_calibration()
-    with np.errstate(invalid="ignore"):
-        known = int(np.count_nonzero(np.isfinite(disparity) & (disparity + rc.doffs_px > 0)))
-    if known < MIN_PIXELS:
-        # the fit is not tried: "no plane holds 3 %" named a reason that was not the one
-        return (
-            f"ground plane: none found ({known} pixels have a disparity; a fit needs {MIN_PIXELS})"
-        )
-    return (
-        f"ground plane: none found (no near-level plane holds {100 * MIN_INLIER_SHARE:.0f} % "
-        "of the pixels)"
-    )
-
-
 def _ground_outputs(
     res: Any,
     calib: Any,
@@ -894,7 +875,13 @@ def _ground_outputs(
     (:meth:`DepthResult.point_image`)."""
     import cv2
 
-    from stereovision.ground import fit_ground_plane, laser_scan, obstacle_mask, occupancy_grid
+    from stereovision.ground import (
+        _no_floor_line,
+        fit_ground_plane,
+        laser_scan,
+        obstacle_mask,
+        occupancy_grid,
+    )
     from stereovision.io import atomic_write
 
     plane = fit_ground_plane(res.disparity, calib)

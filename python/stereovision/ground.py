@@ -705,6 +705,26 @@ def fit_ground_plane(
     )
 
 
+def _no_floor_line(disparity: npt.ArrayLike, calib: Calibration) -> str:
+    """The line for a map :func:`fit_ground_plane` found no floor in, with the reason that holds.
+
+    Under :data:`MIN_PIXELS` disparities the fit is not tried, and "no near-level plane holds
+    3 %" named a reason that was not the one; the pixels are counted as the fit counts them
+    (finite, in front of the camera). ``depth --ground`` and the GUI's Find floor say it.
+    """
+    disp = np.asarray(disparity, np.float64)
+    with np.errstate(invalid="ignore"):
+        known = int(np.count_nonzero(np.isfinite(disp) & (disp + _rig(calib)[4] > 0)))
+    if known < MIN_PIXELS:
+        return (
+            f"ground plane: none found ({known} pixels have a disparity; a fit needs {MIN_PIXELS})"
+        )
+    return (
+        f"ground plane: none found (no near-level plane holds {100 * MIN_INLIER_SHARE:.0f} % "
+        "of the pixels)"
+    )
+
+
 def _number(value: object, name: str) -> float:
     """``value`` as a float, after a ``ValueError`` naming ``name`` for what is not a real number:
     ``float()`` read ``"1"`` as 1 m and True as 1 without a word. An int beyond a float's range

@@ -681,8 +681,9 @@ def _length(metres: float, unit: str) -> str:
     return f"{metres / UNIT_TO_METRES[unit]:.2f}{NBSP}{unit}"
 
 
-#: What Find floor says when the depth map has no floor.
-NO_FLOOR = "ground plane: none found (no near-level plane holds 3 % of the pixels)"
+#: What :func:`floor_text` says of no floor without the depth result to say why (Find floor
+#: gives it: too few disparities for a fit, or no near-level plane holding the floor's share).
+NO_FLOOR = "ground plane: none found"
 #: The heights above the floor (metres) that Find floor paints as obstacles.
 OBSTACLE_HEIGHTS = (0.15, 2.0)
 
@@ -703,11 +704,17 @@ def floor_caption(unit: str = "m") -> str:
     return f"floor (green), obstacles {lo:g}-{hi:g}{NBSP}{unit} (red)"
 
 
-def floor_text(plane: Any, unit: str = "m") -> str:
-    """Find floor's line for a ground plane (None: none found), its height in ``unit``:
-    ``GroundPlane.describe(unit)``, numbers kept with their units."""
+def floor_text(plane: Any, unit: str = "m", result: Any = None) -> str:
+    """Find floor's line for a ground plane, its height in ``unit``: ``GroundPlane.describe(unit)``,
+    numbers kept with their units. For None (none found) the reason that holds for ``result``'s
+    disparity map, as ``depth --ground`` says it: too few disparities for a fit to be tried, or
+    no near-level plane holding the floor's share (:data:`NO_FLOOR` without a result)."""
     if plane is None:
-        return NO_FLOOR
+        if result is None:
+            return NO_FLOOR
+        from stereovision.ground import _no_floor_line
+
+        return _no_floor_line(result.disparity, result.calibration)
     return nowrap_units(str(plane.describe(unit)))
 
 
@@ -2681,7 +2688,7 @@ class StereoApp:
         self._done()
         view.floor = plane
         with self.state:
-            self.state.floor_label = floor_text(plane, self._unit)
+            self.state.floor_label = floor_text(plane, self._unit, res)
             self.state.img_floor = url
 
     def save_clicked(self, folder: str | None = None) -> None:
