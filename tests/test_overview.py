@@ -573,6 +573,63 @@ def test_a_grey_left_image_is_drawn_grey() -> None:
     np.testing.assert_array_equal(drawn, np.repeat(res.left_rectified[:, :, None], 3, axis=2))
 
 
+@pytest.mark.parametrize("channels", [None, 1, 3, 4])
+def test_grey_bgr_and_bgra_left_images_are_drawn_as_bgr(channels: int | None) -> None:
+    """A hand-made result whose left image was (H, W, 1) or BGRA failed with NumPy's "could
+    not broadcast" (the panel has 3 channels): grey ones are drawn grey, BGR and BGRA ones
+    as their BGR, alpha left out."""
+    res = _small_result(30, 40)
+    rng = np.random.default_rng(7)
+    bgr = rng.integers(0, 256, (30, 40, 3), dtype=np.uint8)
+    if channels is None:
+        grey = bgr[:, :, 0].copy()
+        res.left_rectified, expected = grey, np.repeat(grey[:, :, None], 3, axis=2)
+    elif channels == 1:
+        grey = bgr[:, :, :1].copy()
+        res.left_rectified, expected = grey, np.repeat(grey, 3, axis=2)
+    elif channels == 3:
+        res.left_rectified, expected = bgr, bgr
+    else:
+        alpha = rng.integers(0, 256, (30, 40, 1), dtype=np.uint8)
+        res.left_rectified, expected = np.concatenate([bgr, alpha], axis=2), bgr
+    ov = overview_image(res, "t")
+    x, y, w, h = ov.panels["left"]
+    np.testing.assert_array_equal(ov.image[y : y + h, x : x + w], expected)
+
+
+@pytest.mark.parametrize(
+    ("disparity", "left", "match"),
+    [
+        (
+            (0, 0),
+            (0, 0, 3),
+            r"^result: expected a \(H, W\) disparity map with pixels, got shape \(0, 0\)$",
+        ),
+        ((0, 40), None, r"disparity map with pixels, got shape \(0, 40\)$"),
+        ((30, 40, 2), None, r"disparity map with pixels, got shape \(30, 40, 2\)$"),
+        (
+            (30, 40),
+            (30, 40, 2),
+            r"^result: expected a grey .* BGRA left image, got shape \(30, 40, 2\)$",
+        ),
+        ((30, 40), (0, 0, 3), r"BGRA left image, got shape \(0, 0, 3\)$"),
+        ((30, 40), (30,), r"BGRA left image, got shape \(30,\)$"),
+    ],
+)
+def test_an_empty_result_or_a_left_image_of_other_channels_is_a_value_error(
+    disparity: tuple[int, ...], left: tuple[int, ...] | None, match: str
+) -> None:
+    """A 0x0 result divided by its width (ZeroDivisionError); a left image of 2 channels or
+    none was NumPy's broadcast error or OpenCV's: each is a ValueError naming the shape."""
+    res = _small_result(30, 40)
+    res.disparity = np.zeros(disparity, np.float32)
+    res.confidence = np.zeros(disparity, np.float32)
+    res.depth = None
+    res.left_rectified = None if left is None else np.zeros(left, np.uint8)
+    with pytest.raises(ValueError, match=match):
+        overview_image(res, "t")
+
+
 def test_holes_of_the_disparity_are_not_called_filled() -> None:
     """The depth's "none where filled" is for pixels with a disparity (confidence 0) but no
     depth; where the disparity itself is missing nothing was filled."""

@@ -277,7 +277,8 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     Parameters
     ----------
     result : DepthResult
-        Its left (rectified) image, disparity, depth (None without calibration) and confidence.
+        Its left (rectified) image (grey ``(H, W)`` or ``(H, W, 1)``, BGR or BGRA, drawn as BGR;
+        None: black), disparity, depth (None without calibration) and confidence.
     title : str
         The one-line title (scaled down to fit; a character outside ASCII is drawn, and kept
         in :attr:`Overview.title`, as ``?``).
@@ -295,7 +296,8 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     Raises
     ------
     ValueError
-        An unknown ``unit`` (the message names the allowed ones).
+        An unknown ``unit`` (the message names the allowed ones), a disparity map that is not
+        ``(H, W)`` or has no pixel, or a left image that is not grey, BGR or BGRA.
     """
     from stereovision._validate import known_unit
     from stereovision.calibration import UNIT_TO_METRES
@@ -303,14 +305,33 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     unit = known_unit(unit, UNIT_TO_METRES)
     size = UNIT_TO_METRES[unit]  # metres in one unit
     disparity = np.asarray(result.disparity, np.float32)
-    h, w = disparity.shape[:2]
+    if disparity.ndim != 2 or disparity.size == 0:
+        # a 0x0 map divided the panel's width by 0 (ZeroDivisionError)
+        raise ValueError(
+            f"result: expected a (H, W) disparity map with pixels, got shape {disparity.shape}"
+        )
+    h, w = disparity.shape
     scale = min(1.0, PANEL_WIDTH / w)
     pw, ph = max(1, round(w * scale)), max(1, round(h * scale))
     left = result.left_rectified
     if left is None:
         left = np.zeros((h, w, 3), np.uint8)
-    elif left.ndim == 2:
-        left = cv2.cvtColor(left, cv2.COLOR_GRAY2BGR)
+    else:
+        # a hand-made result's (H, W, 1) or BGRA image failed to fit the panel's 3 channels
+        left = np.asarray(left)
+        if left.size == 0 or not (
+            left.ndim == 2 or (left.ndim == 3 and left.shape[2] in (1, 3, 4))
+        ):
+            raise ValueError(
+                "result: expected a grey (H, W) or (H, W, 1), BGR or BGRA left image, got shape "
+                f"{left.shape}"
+            )
+        if left.ndim == 3 and left.shape[2] == 4:
+            left = left[:, :, :3]  # BGRA: drawn without its alpha
+        elif left.ndim == 3 and left.shape[2] == 1:
+            left = left[:, :, 0]
+        if left.ndim == 2:
+            left = cv2.cvtColor(np.ascontiguousarray(left), cv2.COLOR_GRAY2BGR)
     valid = np.isfinite(disparity)
     confidence = np.where(valid, np.asarray(result.confidence, np.float32), np.nan)
     # name, values as mapped, fixed ends, caption, labelled value -> mapped value, tick values
