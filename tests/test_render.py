@@ -6,6 +6,7 @@ import argparse
 import dataclasses
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -1504,6 +1505,63 @@ def test_write_render_creates_nested_folders(tmp_path):
     path = render.write_render(img, tmp_path / "a" / "b")["render.png"]
     assert path == tmp_path / "a" / "b" / "render.png"
     assert cv2.imread(str(path))[0, 0].tolist() == [200, 0, 0]
+
+
+@pytest.mark.parametrize(
+    ("image", "said"),
+    [
+        (None, "got None"),
+        (np.zeros((4, 6), np.uint8), "got uint8 (4, 6)"),  # was written mirrored
+        (np.zeros((4, 6, 4), np.uint8), "got uint8 (4, 6, 4)"),  # was written as ABGR
+        (np.zeros((4, 6, 3), np.uint16), "got uint16 (4, 6, 3)"),  # a 16-bit PNG
+        (np.zeros((4, 6, 3), np.float64), "got float64 (4, 6, 3)"),  # clipped to 8 bits
+        ([[[0, 0, 0]]], "got int64 (1, 1, 3)"),
+    ],
+)
+def test_write_render_refuses_what_is_not_an_rgb_render(tmp_path, image, said):
+    """write_render checked nothing: None was a TypeError, a grey image was written with its
+    columns reversed (``[..., ::-1]`` of a 2-D array), RGBA as ABGR, uint16 and float images
+    as 16-bit or clipped PNGs. Each is a ValueError naming what it got; nothing is written."""
+    with pytest.raises(
+        ValueError, match=rf"^image: expected a \(H, W, 3\) uint8 RGB render, {re.escape(said)}$"
+    ):
+        render.write_render(image, tmp_path)
+    assert not (tmp_path / "render.png").exists()
+
+
+def test_write_render_refuses_an_empty_render(tmp_path):
+    """OpenCV's "!_img.empty()" assertion (cv2.error) before; a ValueError now."""
+    with pytest.raises(ValueError, match=r"^image: the render has no pixel \(shape \(0, 5, 3\)\)$"):
+        render.write_render(np.zeros((0, 5, 3), np.uint8), tmp_path)
+    assert not (tmp_path / "render.png").exists()
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS is Linux's")
+@pytest.mark.parametrize("shape", [(70000, 70000, 3), (1, 5_000_000_000, 3)])
+def test_write_render_refuses_a_render_past_32_bit_indices_before_its_copy(tmp_path, shape):
+    """A shape-only (broadcast) render of 70000 x 70000 takes no memory as given, but its BGR
+    copy needs 14 GiB: a MemoryError (in a child under ``ulimit -v`` 3 GB) before; now the
+    shape is refused first, with the kernels' limit, and nothing is written."""
+    script = f"""
+import resource
+resource.setrlimit(resource.RLIMIT_AS, (3_000_000 * 1024, 3_000_000 * 1024))
+import numpy as np
+from stereovision import render
+try:
+    render.write_render(np.broadcast_to(np.uint8(0), {shape!r}), {str(tmp_path)!r})
+    print("returned")
+except Exception as exc:
+    print(type(exc).__name__ + ":", str(exc).splitlines()[0])
+"""
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, env=env
+    )
+    assert out.stdout.strip() == (
+        f"ValueError: image: image of {shape[1]}x{shape[0]} pixels is too large: the kernels "
+        "index pixels with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
+    ), out.stderr[-500:]
+    assert not (tmp_path / "render.png").exists()
 
 
 def test_screenshot_in_a_folder_that_is_a_file_is_refused(tmp_path):

@@ -1160,14 +1160,31 @@ def write_render(image: npt.NDArray[np.uint8], out_dir: str | os.PathLike[str]) 
 
     Raises
     ------
+    ValueError
+        ``image`` is None, not ``(H, W, 3)`` uint8, empty, or past the kernels' 32-bit pixel
+        indices (checked from its shape, before the BGR copy).
     OSError
         The image could not be encoded or written.
     """
     import cv2
 
+    from stereovision._validate import check_index_range
     from stereovision.io import atomic_write
 
-    ok, buf = cv2.imencode(".png", np.ascontiguousarray(image[..., ::-1]))
+    # unchecked, a grey image came out mirrored (its columns reversed as if channels), RGBA as
+    # ABGR, uint16 or float as a 16-bit or clipped PNG, and a broadcast 70000 x 70000 render
+    # was a MemoryError for its 14 GiB BGR copy
+    if image is None:
+        raise ValueError("image: expected a (H, W, 3) uint8 RGB render, got None")
+    img = image if isinstance(image, np.ndarray) else np.asarray(image)
+    if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8:
+        raise ValueError(
+            f"image: expected a (H, W, 3) uint8 RGB render, got {img.dtype} {img.shape}"
+        )
+    if img.size == 0:
+        raise ValueError(f"image: the render has no pixel (shape {img.shape})")
+    check_index_range(img.shape, "image")
+    ok, buf = cv2.imencode(".png", np.ascontiguousarray(img[..., ::-1]))
     if not ok:
         raise OSError("could not encode render.png")
     out = Path(out_dir)
