@@ -1424,6 +1424,39 @@ def test_laser_scan_range_max_is_finite() -> None:
         laser_scan(pts, plane, **angles, range_max=math.inf)
 
 
+def test_scan_dict_keeps_the_sign_of_an_infinity_and_is_strict_json() -> None:
+    """A hand-made scan's -inf (REP 117: an obstacle too near to measure) was written "inf",
+    the beam free; its scalar fields went to json.dumps as they were: an infinite range_max as
+    Infinity (not JSON: a strict reader refused scan.json), a float32 angle as a TypeError.
+    The dict keeps the sign, maps every field as the ranges, and a strict reader gets back
+    what the docs (robotics.md) say."""
+    from typing import Any
+
+    from stereovision.ground import LaserScan
+
+    def strict(text: str) -> Any:
+        def refuse(name: str) -> None:
+            raise ValueError(f"not JSON: {name}")
+
+        return json.loads(text, parse_constant=refuse)
+
+    ranges = np.float32([-np.inf, 1.5, np.inf, np.nan])
+    scan = LaserScan(np.float32(-0.5), 0.5, 0.25, 0.0, math.inf, ranges)
+    d = strict(json.dumps(scan.as_dict()))
+    assert d["ranges"] == ["-inf", 1.5, "inf", None]
+    assert (d["angle_min"], d["range_max"]) == (-0.5, "inf")
+    # a scan laser_scan made is written as before: numbers, "inf" and null
+    plane, pts = _level_floor()
+    made = laser_scan(pts, plane, angle_min=-0.5, angle_max=0.5)
+    d = strict(json.dumps(made.as_dict()))
+    assert d["range_max"] == made.range_max and d["angle_min"] == made.angle_min
+    assert {type(v) for v in d["ranges"]} <= {float, str, type(None)}
+    assert {v for v in d["ranges"] if isinstance(v, str)} <= {"inf"}
+    doc = (Path(__file__).parents[1] / "docs" / "robotics.md").read_text()
+    assert '`+inf` the string `"inf"`' in " ".join(doc.split())
+    assert '`"-inf"`' in doc and "a NaN range is `null`" in doc
+
+
 def test_support_counts_as_the_fit_counts() -> None:
     """support() of the plane's own map is its inlier_share: at a focal length under
     GROUND_FOCAL_PX (200 px) with the tolerance scaled as the fit's (0.625 px), and with 0 and

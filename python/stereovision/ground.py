@@ -1099,7 +1099,8 @@ class LaserScan:
 
     def as_dict(self) -> dict[str, Any]:
         """The ``sensor_msgs/LaserScan`` fields, JSON-ready: JSON has no NaN or infinity, so
-        a NaN range is ``null`` and ``+inf`` the string ``"inf"``.
+        a NaN range is ``null``, ``+inf`` the string ``"inf"`` and ``-inf`` (REP 117: too near
+        to measure) ``"-inf"``; so are the other fields of a scan made by hand.
 
         Returns
         -------
@@ -1107,19 +1108,26 @@ class LaserScan:
             ``sensor_msgs/LaserScan``'s field names (``time_increment`` and ``scan_time`` 0) to
             their values, ``ranges`` a list.
         """
-        ranges: list[Any] = [
-            None if math.isnan(v) else ("inf" if math.isinf(v) else round(float(v), 4))
-            for v in self.ranges
-        ]
+
+        def number(v: Any, digits: int | None = None) -> Any:
+            # "inf" for -inf too said "free" of an obstacle too near to measure, and a scalar
+            # field of a hand-made scan went to json.dumps as Infinity or NaN (not JSON)
+            v = float(v)
+            if math.isnan(v):
+                return None
+            if math.isinf(v):
+                return "inf" if v > 0 else "-inf"
+            return v if digits is None else round(v, digits)
+
         return {
-            "angle_min": self.angle_min,
-            "angle_max": self.angle_max,
-            "angle_increment": self.angle_increment,
+            "angle_min": number(self.angle_min),
+            "angle_max": number(self.angle_max),
+            "angle_increment": number(self.angle_increment),
             "time_increment": 0.0,
             "scan_time": 0.0,
-            "range_min": self.range_min,
-            "range_max": self.range_max,
-            "ranges": ranges,
+            "range_min": number(self.range_min),
+            "range_max": number(self.range_max),
+            "ranges": [number(v, 4) for v in self.ranges],
             "intensities": [],
         }
 
