@@ -3869,6 +3869,15 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
         ("http://u@host:8080?mail=a@b", "http://u@host:8080?mail=a@b"),
         # the query is looked for after the password: a "?key=" in a password is the password's
         ("rtsp://u:a?key=b@cam/0", "rtsp://u:***@cam/0"),
+        # no "@" in the authority (RFC 3986: up to the first "/", "?" or "#"): a port, then a
+        # query holding an "@" was said "rtsp://cam:***@b"; a raw "?" or "#" after digits
+        # without a key= (a password still, maybe) stays hidden
+        ("rtsp://cam:554?x=a@b", "rtsp://cam:554?x=a@b"),
+        ("rtsp://cam:554?mail=a@b&token=t", "rtsp://cam:554?mail=a@b&token=***"),
+        ("rtspsrc location=rtsp://cam:554?x=a@b ! appsink",) * 2,
+        ("rtsp://u:1234?x@cam/0", "rtsp://u:***@cam/0"),
+        ("rtsp://cam:554#a@b", "rtsp://cam:***@b"),
+        ("rtsp://u:12?w@cam:554?x=a@b", "rtsp://u:***@b"),
         # one URL is the whole source, spaces and all (a leading space too)
         ("http://cam/my video.avi?token=x", "http://cam/my video.avi?token=***"),
         (" http://cam/a b?token=x", " http://cam/a b?token=***"),

@@ -401,6 +401,11 @@ _SCHEME = r"[A-Za-z][A-Za-z0-9+.-]*://"
 _URL_PASSWORD = re.compile(
     r"(" + _SCHEME + r"[^/?#:]*):[^/?#]*@|(" + _SCHEME + r"[^/?#@:]*):[^/]*@"
 )
+#: What :data:`_URL_PASSWORD`'s fallback (a raw "?" or "#" in a password) took for a user
+#: part but is a host's port and then a query: ``rtsp://cam:554?x=a@b`` (nothing but digits
+#: before the "?", a key=value after it). A password such as ``1234?k=v`` is said in full
+#: (the one shape this reading leaks); ``u:a?key=b@``, ``u:1234?x@``, ``cam:554#a@`` stay hidden.
+_PORT_THEN_QUERY = re.compile(_SCHEME + r"[^/?#@:]*:\d{1,5}\?[^=@]*=")
 #: A URL inside other text (a GStreamer pipeline's ``location=rtsp://...``): its scheme at
 #: the start or after a space, "=" or a quote; it ends at a space or a quote.
 _URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
@@ -446,6 +451,16 @@ def mask_url_secrets(source: str) -> str:
         ``source`` unchanged unless it is a URL (``scheme://``) holding a password or a secret
         parameter: ``rtsp://admin:s3cret@cam/0?token=abc`` is ``rtsp://admin:***@cam/0?token=***``.
 
+    Notes
+    -----
+    The user part is looked for in the authority (RFC 3986: before the first ``/``, ``?`` or
+    ``#``) and ends at its last ``@`` (``me@mail.com:pw@cam`` hides ``pw``). Where that holds no
+    ``@``, a ``user:password@`` running on to the first ``/`` is hidden all the same: a
+    password typed with a raw ``?`` or ``#`` (``admin:pa?ss@cam``) reads like the start of a
+    query, and a leak is worse than too much hidden. One shape of that is read as a query: a
+    host, a port (1 to 5 digits), ``?`` and a ``key=`` before the ``@`` (``cam:554?x=a@b``
+    is said as given); ``cam:554#a@b`` and ``u:1234?x@cam`` stay hidden.
+
     Examples
     --------
     >>> mask_url_secrets("http://user:pw@host:8080/x?size=2&access_token=abc")
@@ -475,6 +490,8 @@ def _url_secrets(source: str) -> list[tuple[int, int, str]]:
     parts = []
     for first, last in spans:
         password = _URL_PASSWORD.match(source, first, last)
+        if password and password[2] is not None and _PORT_THEN_QUERY.match(password[0]):
+            password = None  # "cam:554?x=a@b": a port, then a query holding an "@"
         if password:
             parts.append((first, password.end(), f"{password[1] or password[2]}:***@"))
         # the query alone: from the first "?" after the authority to the fragment ("#")
