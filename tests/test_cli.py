@@ -512,12 +512,15 @@ def test_info_describes_the_rig(data_dir: Path, capsys: pytest.CaptureFixture[st
 def test_info_on_paper_refuses_a_bad_value_in_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     """``info --size 1280x720 --hfov 180 --baseline 0.1`` printed the rig's heading on stdout,
     then 'hfov_deg: ...', the Python argument's name, on stderr; the error is now the one line,
-    naming the option."""
-    assert main(["info", "--size", "1280x720", "--hfov", "180", "--baseline", "0.1"]) == 2
+    naming the option (refused by argparse now, with the range --hfov takes)."""
+    with pytest.raises(SystemExit) as exit_:
+        main(["info", "--size", "1280x720", "--hfov", "180", "--baseline", "0.1"])
+    assert exit_.value.code == 2
     out, err = capsys.readouterr()
     assert out == ""
     assert err.strip().splitlines() == [
-        "stereovision: error: --hfov: expected a field of view in (0, 180) degrees, got 180.0"
+        "stereovision info: error: argument --hfov: expected a horizontal field of view from "
+        "0.1 to under 180 degrees, got '180' (see stereovision info --help)"
     ]
     assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", "-1"]) == 2
     out, err = capsys.readouterr()
@@ -2643,12 +2646,20 @@ def test_a_negative_or_unit_suffixed_metre_option_names_what_it_takes(
 def test_a_negative_number_for_a_plain_float_option_says_how_to_give_it(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """`info --hfov -1e1` (no plain negative number to argparse) said "expected one argument"."""
+    """`info --hfov -1e1` (no plain negative number to argparse) said "expected one argument".
+    A negative --hfov is out of its range, said so (no use giving it as --hfov=-1e1); a turn
+    of the view may be negative: how to give it."""
     with pytest.raises(SystemExit):
         main(["info", "--size", "640x480", "--baseline", "0.1", "--hfov", "-1e1"])
     assert capsys.readouterr().err == (
-        "stereovision info: error: argument --hfov: '-1e1' starts with '-' and was taken for an "
-        "option; give it as --hfov=-1e1 (see stereovision info --help)\n"
+        "stereovision info: error: argument --hfov: expected a horizontal field of view from 0.1 "
+        "to under 180 degrees, got '-1e1' (see stereovision info --help)\n"
+    )
+    with pytest.raises(SystemExit):
+        main(["view", "cloud.ply", "--roll", "-1e1"])
+    assert capsys.readouterr().err == (
+        "stereovision view: error: argument --roll: '-1e1' starts with '-' and was taken for an "
+        "option; give it as --roll=-1e1 (see stereovision view --help)\n"
     )
 
 
@@ -2773,11 +2784,37 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
             "stereovision info: error: argument --baseline: expected a number of metres without "
             "a unit (5 for 5 m), got '10cm' (see stereovision info --help)",
         ),
-        # told to write --tolerance=-1px, which is no number either
+        # told to write --tolerance=-1px, which is no number either (then: no word of the unit)
         (
             ["check", "l.png", "r.png", "--tolerance", "-1px"],
-            "stereovision check: error: argument --tolerance: expected a number, got '-1px' (see "
-            "stereovision check --help)",
+            "stereovision check: error: argument --tolerance: expected a number without a unit "
+            "(5 for 5 px), got '-1px' (see stereovision check --help)",
+        ),
+        # capture --square 25mm: "expected a number"; nan: the library's "square_size:"
+        (
+            ["capture", "--left", "l.avi", "--right", "r.avi", "--charuco", "5x7", "--square",
+             "25mm", "--marker", "18", "-o", "out"],
+            "stereovision capture: error: argument --square: expected a side above 0 without a "
+            "unit (25 for 25 mm; --square and --marker in one unit, any), got '25mm' (see "
+            "stereovision capture --help)",
+        ),
+        (
+            ["capture", "--left", "l.avi", "--right", "r.avi", "--charuco", "5x7", "--square",
+             "25", "--marker", "nan", "-o", "out"],
+            "stereovision capture: error: argument --marker: expected a side above 0 (--square "
+            "and --marker in one unit, any), got 'nan' (see stereovision capture --help)",
+        ),
+        # a field of view of 1e-300 degrees was taken: a focal length of 7e305 px said, exit 0
+        (
+            ["info", "--size", "640x480", "--hfov", "1e-300", "--baseline", "0.1"],
+            "stereovision info: error: argument --hfov: expected a horizontal field of view from "
+            "0.1 to under 180 degrees, got '1e-300' (see stereovision info --help)",
+        ),
+        (
+            ["info", "--size", "640x480", "--hfov", "90deg", "--baseline", "0.1"],
+            "stereovision info: error: argument --hfov: expected a horizontal field of view from "
+            "0.1 to under 180 degrees without a unit (5 for 5 degrees), got '90deg' (see "
+            "stereovision info --help)",
         ),
         # "scene root not found" of a file that is there
         (
@@ -2796,6 +2833,7 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
         ),
     ],
     ids=["calibrate-square", "calibrate-unit", "board-square", "info-baseline", "check-tolerance",
+         "capture-square-unit", "capture-marker-nan", "info-hfov-tiny", "info-hfov-unit",
          "bench-file", "batch-grid-ground", "batch-grid-range"],
 )  # fmt: skip
 def test_a_bad_option_value_is_said_in_the_option_s_name(
@@ -2839,6 +2877,64 @@ def test_every_way_of_typing_a_unit_after_a_metre_value_is_told_to_leave_it_out(
     with pytest.raises(argparse.ArgumentTypeError) as err:  # a word is no unit-suffixed number
         positive_metres("far")
     assert str(err.value) == "expected a number of metres above 0, got 'far'"
+
+
+def _number_options() -> list[tuple[str, str]]:
+    """Every (command, option) of the CLI whose value is converted to a number."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return [
+        (name, action.option_strings[-1])
+        for name, parser in sub.choices.items()
+        for action in parser._actions
+        if action.option_strings and action.type not in (None, str) and action.nargs != 0
+    ]
+
+
+@pytest.mark.parametrize(("command", "option"), _number_options())
+def test_every_number_option_tells_a_value_typed_with_a_unit_to_leave_it_out(
+    capsys: pytest.CaptureFixture[str], command: str, option: str
+) -> None:
+    """``capture --square 25mm``, ``--fps 30fps``, ``--max-skew-ms 5ms``: only the metre
+    options and ``board --square`` said where a unit goes; the others "expected a number". Each
+    says it now in one line naming the option, exit 2."""
+    assert len(_number_options()) >= 40  # the sweep holds the CLI's number options
+    with pytest.raises(SystemExit) as exit_:
+        main([command, f"{option}=25mm"])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"error: argument {option}: expected " in err
+    assert "without a unit" in err or "its unit given by --unit (25 --unit mm)" in err
+    assert err.endswith(f", got '25mm' (see stereovision {command} --help)\n")
+
+
+@pytest.mark.parametrize(
+    ("hfov", "taken"),
+    [("0.1", True), ("1", True), ("170", True), ("179.9", True), ("0.09", False),
+     ("180", False), ("nan", False), ("-0", False), ("inf", False)],
+)  # fmt: skip
+def test_info_takes_every_real_lens_s_field_of_view_and_nothing_past_it(
+    capsys: pytest.CaptureFixture[str], hfov: str, taken: bool
+) -> None:
+    """A 1-degree telephoto and a 170-degree wide lens are rigs on paper; 0.09 (focal length
+    running away) and 180 (no pinhole's) are refused in one line with the range."""
+    try:
+        status = main(["info", "--size", "1280x720", "--hfov", hfov, "--baseline", "0.1"])
+    except SystemExit as exit_:
+        status = exit_.code
+    out, err = capsys.readouterr()
+    if taken:
+        assert status == 0 and err == ""
+        assert f"field of view {float(hfov):.1f} x " in out
+    else:
+        assert status == 2 and out == ""
+        assert err == (
+            "stereovision info: error: argument --hfov: expected a horizontal field of view "
+            f"from 0.1 to under 180 degrees, got {hfov!r} (see stereovision info --help)\n"
+        )
 
 
 def test_a_value_starting_with_a_dash_is_told_in_the_options_long_form(

@@ -3082,6 +3082,25 @@ def _pairs(n: int) -> str:
     return f"{n} pair" if n == 1 else f"{n} pairs"
 
 
+def board_side(text: str) -> float:
+    """argparse type of ``capture --square`` and ``--marker``: a finite number above 0, in any
+    unit (the two in the same one: only their ratio finds the board). Refused in the option's
+    name: ``25mm`` was "expected a number" (no word of the unit), ``nan`` the library's
+    ``--charuco: square_size: ...``."""
+    from stereovision.cli import _UNIT_SUFFIXED
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        hint = " without a unit (25 for 25 mm; " if _UNIT_SUFFIXED.match(text) else " ("
+        raise argparse.ArgumentTypeError(
+            f"expected a side above 0{hint}--square and --marker in one unit, any), got {text!r}"
+        )
+    return value
+
+
 def add_cli(subparsers: Any) -> None:
     """Register the ``capture`` subcommand on an ``argparse`` subparsers object."""
     from stereovision.cli import positive_count, positive_rate  # cli builds its parser with these
@@ -3107,8 +3126,8 @@ def add_cli(subparsers: Any) -> None:
         metavar="COLSxROWS",
         help="auto-capture distinct poses of a ChArUco board of COLSxROWS squares",
     )
-    p.add_argument("--square", type=float, help="--charuco: square side")
-    p.add_argument("--marker", type=float, help="--charuco: marker side (same unit)")
+    p.add_argument("--square", type=board_side, help="--charuco: square side")
+    p.add_argument("--marker", type=board_side, help="--charuco: marker side (same unit)")
     p.add_argument(
         "--dictionary", default="auto", help="--charuco: ArUco dictionary (default: found)"
     )

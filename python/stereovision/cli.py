@@ -7,6 +7,7 @@ written atomically after all computation succeeded, so an error never destroys e
 from __future__ import annotations
 
 import argparse
+import ast
 import contextlib
 import json
 import math
@@ -1789,6 +1790,76 @@ _UNIT_SUFFIXED = re.compile(
 )
 
 
+#: The unit of each number option whose value is not metres nor a count, for the hint that
+#: leaves a typed unit out (``--max-skew-ms 5ms``); the metre options say theirs themselves.
+_OPTION_UNITS = {
+    "--fps": "fps",
+    "--read-timeout": "s",
+    "--max-skew-ms": "ms",
+    "--max-disparity": "px",
+    "--tolerance": "px",
+    "--hfov": "degrees",
+    "--roll": "degrees",
+    "--pitch": "degrees",
+    "--yaw": "degrees",
+    "--forward": "m",
+    "--up": "m",
+    "--right": "m",
+    "--dpi": "dpi",
+}
+
+
+def _with_unit_hint(message: str) -> str:
+    """argparse's refusal of an option's value, with the hint the metre options give
+    (``without a unit (5 for 5 m)``) when the value was typed with a unit (``--fps 30fps``,
+    ``--square 25mm``, ``--count 10x``); a message holding its own hint is kept.
+
+    Parameters
+    ----------
+    message : str
+        ``argument --opt: expected ..., got 'VALUE'`` (other messages are returned as given).
+
+    Returns
+    -------
+    str
+        The message, the hint before its ``, got``.
+    """
+    m = re.fullmatch(r"argument (\S+): (expected .*?), got ('.*'|\".*\")", message)
+    if m is None or "unit" in m[2]:
+        return message
+    try:
+        typed = ast.literal_eval(m[3])
+    except (ValueError, SyntaxError):
+        return message
+    if not (isinstance(typed, str) and _UNIT_SUFFIXED.match(typed)):
+        return message
+    unit = _OPTION_UNITS.get(m[1].split("/")[-1])
+    example = f" (5 for 5 {unit})" if unit else ""
+    return f"argument {m[1]}: {m[2]} without a unit{example}, got {m[3]}"
+
+
+#: Narrowest and widest ``info --hfov`` (degrees): a rig on paper's pinhole cameras. A 1200 mm
+#: telephoto on a full-frame sensor sees 1.7 degrees, a superzoom's long end about 0.7; 180 and
+#: over is no pinhole's (a fisheye's 170 is said as the rectified pinhole pair would be). Below
+#: 0.1 the focal length runs away (1e-300: 7e305 px and a depth of 9e302 m said, exit 0).
+HFOV_RANGE_DEG = (0.1, 180.0)
+
+
+def field_of_view(text: str) -> float:
+    """argparse type of ``info --hfov``: degrees from 0.1 up to (not including) 180, refused in
+    the option's name with the range (``1e-300`` was taken and said as absurd figures)."""
+    lo, hi = HFOV_RANGE_DEG
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not lo <= value < hi:  # NaN too
+        raise argparse.ArgumentTypeError(
+            f"expected a horizontal field of view from {lo:g} to under {hi:g} degrees, got {text!r}"
+        )
+    return value
+
+
 def positive_metres(text: str) -> float:
     """argparse type of ``--max-depth``, ``--max-sigma`` and ``--voxel``: a finite
     number of metres above 0, as a plain number.
@@ -1904,6 +1975,7 @@ class _Parser(argparse.ArgumentParser):
         missing = "the following arguments are required: right"
         if message == missing or message.startswith(f"{missing}, "):
             message = self._folder_for_a_pair(message, message[len(missing) + 2 :])
+        message = _with_unit_hint(message)
         sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
         sys.exit(EXIT_ERROR)
 
@@ -2192,7 +2264,13 @@ def build_parser() -> argparse.ArgumentParser:
         "(stereo_calib output, a Q.dat alone), its image size",
     )
     add_calib_unit(d)
-    d.add_argument("--hfov", type=float, metavar="DEG", help="a rig on paper: horizontal FOV")
+    d.add_argument(
+        "--hfov",
+        type=field_of_view,
+        metavar="DEG",
+        help=f"a rig on paper: horizontal FOV, {HFOV_RANGE_DEG[0]:g} to under "
+        f"{HFOV_RANGE_DEG[1]:g} degrees",
+    )
     d.add_argument("--baseline", type=metres, metavar="M", help="a rig on paper: baseline (m)")
     d.add_argument("--left-topic", help="a bag: its left image topic (default: found)")
     d.add_argument("--right-topic", help="a bag: its right image topic (default: found)")
