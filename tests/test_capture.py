@@ -278,6 +278,11 @@ def test_a_camera_whose_grab_hangs_is_given_up(tmp_path: Path) -> None:
     ]  # fmt: skip
     with pytest.raises(ValueError, match=r"read_timeout: expected a positive number of sec"):
         capture(cam, tmp_path / "p2", read_timeout=-1.0)
+    # past threading's longest wait: was taken, then an OverflowError ("timestamp out of range
+    # for platform time_t") out of the wait
+    with pytest.raises(ValueError, match=r"^read_timeout: expected at most 9\.22337e\+09 sec"):
+        capture(cam, tmp_path / "p2", read_timeout=1e10)
+    assert not (tmp_path / "p2").exists()
 
 
 def test_a_grab_given_up_as_hung_keeps_its_capture_until_it_returns(tmp_path: Path) -> None:

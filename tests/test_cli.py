@@ -470,6 +470,12 @@ def test_depth_rectification_on_a_pair_too_small_says_only_that(
         ),
         (["stream", "--read-timeout", "inf"], "argument --read-timeout: expected seconds above 0"),
         (["gui", "--read-timeout", "-1"], "argument --read-timeout: expected seconds above 0"),
+        # taken, then an internal OverflowError out of the wait (and an abort, exit 134)
+        (
+            ["capture", "-o", "x", "--read-timeout", "1e10"],
+            "argument --read-timeout: expected at most 86400 seconds (a day), or 'none' for no "
+            "limit, got '1e10'",
+        ),
     ],
 )
 def test_usage_errors_are_one_line(argv: list[str], says: str) -> None:

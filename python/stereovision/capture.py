@@ -556,6 +556,12 @@ def check_read_timeout(timeout: float | None, name: str = "read_timeout") -> Non
         raise ValueError(
             f"{name}: expected a positive number of seconds (None: no limit), got {timeout!r}"
         )
+    # 1e10 s passed too, and overflowed the wait as inf did (an internal OverflowError)
+    if timeout is not None and timeout > threading.TIMEOUT_MAX:
+        raise ValueError(
+            f"{name}: expected at most {threading.TIMEOUT_MAX:g} seconds (None: no limit), "
+            f"got {timeout!r}"
+        )
 
 
 def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:

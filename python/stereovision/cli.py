@@ -1905,9 +1905,14 @@ def positive_rate(text: str) -> float:
 #: ``--read-timeout``'s spelling of "no limit" (a camera's read waits as long as it takes).
 NO_READ_TIMEOUT = "none"
 
+#: Longest ``--read-timeout`` (seconds): a day, far past any camera's cold start; a longer
+#: wait is meant as no limit, which is ``none`` (1e10 overflowed the wait: an internal error).
+MAX_READ_TIMEOUT_S = 86400.0
+
 
 def read_timeout_seconds(text: str) -> float:
-    """argparse type of ``--read-timeout``: finite seconds above 0, or ``none`` (no limit).
+    """argparse type of ``--read-timeout``: seconds above 0, up to a day
+    (:data:`MAX_READ_TIMEOUT_S`), or ``none`` (no limit).
 
     Refused in the option's name, as ``--fps`` is. ``0`` is refused, not read as "no limit":
     the library refuses it too, and a word of its own cannot be mistaken for a short wait.
@@ -1932,6 +1937,11 @@ def read_timeout_seconds(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(
             f"expected seconds above 0 or {NO_READ_TIMEOUT!r} (no limit), got {text!r}"
+        )
+    if value > MAX_READ_TIMEOUT_S:
+        raise argparse.ArgumentTypeError(
+            f"expected at most {MAX_READ_TIMEOUT_S:g} seconds (a day), or {NO_READ_TIMEOUT!r} "
+            f"for no limit, got {text!r}"
         )
     return value
 
