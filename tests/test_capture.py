@@ -285,6 +285,29 @@ def test_a_camera_whose_grab_hangs_is_given_up(tmp_path: Path) -> None:
     assert not (tmp_path / "p2").exists()
 
 
+def test_a_cli_whose_open_was_given_up_ends_on_its_one_line(tmp_path: Path) -> None:
+    """``capture --read-timeout 1e-300``: the open given up, the error line said, then the
+    open came back out of OpenCV while the interpreter shut down: "terminate called without an
+    active exception" under the line, exit 134 (SIGABRT). The process now ends on its line."""
+    import subprocess
+    import sys
+
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(2)])
+    rpat = _write_sequence(tmp_path / "frames", "right", [_numbered(i) for i in range(2)])
+    argv = ["capture", "--left", lpat, "--right", rpat, "--read-timeout", "1e-300"]
+    proc = subprocess.run(
+        [sys.executable, "-m", "stereovision", *argv, "-o", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert (proc.returncode, proc.stdout) == (2, "")
+    assert proc.stderr == (
+        f"stereovision: error: left source {lpat!r} did not open within 1e-300 s (its open did "
+        "not return: a stalled stream or network share); give it a longer timeout\n"
+    )
+
+
 def test_a_grab_given_up_as_hung_keeps_its_capture_until_it_returns(tmp_path: Path) -> None:
     """A grab given up as hung stays inside OpenCV: ``close()`` released its capture under it
     and a second ``read`` grabbed it again, which crashed the process (SIGSEGV). Now the

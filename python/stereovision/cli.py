@@ -2340,7 +2340,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     itself (an unknown option, a value an option does not take: ``--voxel 0``, ``--square 25mm``),
     ``--help`` and ``--version`` exit as argparse's do, by ``SystemExit`` (2, or 0), before any
     work.
+
+    Run as the process's own command (``argv`` None), it ends the process itself (its output
+    flushed) when a camera's open or grab it gave up is still in OpenCV: one coming back out of
+    it while the interpreter shut down aborted the process, "terminate called without an active
+    exception" under the error line and exit 134, not 2 (``capture --read-timeout 1e-300``, a
+    slow camera given up).
     """
+    status = _main(argv)
+    if argv is None and any(
+        t.name in _NATIVE_THREADS and t.is_alive() for t in threading.enumerate()
+    ):
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):  # a closed pipe: nothing more to say
+                stream.flush()
+        os._exit(status)
+    return status
+
+
+#: The daemon threads that may be left in OpenCV's native code, given up (a hung or slow
+#: camera's open or grab): the process must not shut its interpreter down under them.
+_NATIVE_THREADS = ("stereovision-grab", "stereovision-gui-read", "stereovision-gui-open")
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    """:func:`main`'s work: parse ``argv`` and run its command."""
     try:
         # the commands' modules are imported here (0.2 s): a Ctrl-C right after the command
         # was typed printed a traceback of the import it stopped
