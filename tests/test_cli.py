@@ -567,6 +567,29 @@ def test_view_refuses_a_camera_move_past_its_limit_in_one_line(
     ]
 
 
+@pytest.mark.parametrize("option", ["--roll", "--pitch", "--yaw"])
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "1e400"])
+def test_view_refuses_a_turn_that_is_no_finite_number_in_the_option_s_name(
+    option: str, value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``view --roll nan`` said "camera control roll must be a finite number, got nan": the
+    library's words, no option named (the moves said theirs). Refused by argparse now."""
+    shot = tmp_path / "v.png"
+    with pytest.raises(SystemExit) as exc:
+        main(["view", str(tmp_path / "missing.ply"), f"{option}={value}", "-o", str(shot)])
+    assert exc.value.code == 2 and not shot.exists()
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision view: error: argument {option}: expected a finite number of degrees, "
+        f"got {value!r} (see stereovision view --help)"
+    ]
+
+
+def test_view_turns_take_any_finite_degrees() -> None:
+    from stereovision.render import _camera_turn
+
+    assert [_camera_turn(v) for v in ("-0", "720", "-1e308", " 5")] == [0.0, 720.0, -1e308, 5.0]
+
+
 def test_view_camera_move_takes_its_limit() -> None:
     from stereovision.render import _camera_move
 

@@ -1509,6 +1509,19 @@ def _camera_move(text: str) -> float:
     return value
 
 
+def _camera_turn(text: str) -> float:
+    """argparse type of ``view``'s ``--roll``, ``--pitch`` and ``--yaw``: finite degrees,
+    refused in the option's name (``--roll nan`` was the library's "camera control roll must
+    be a finite number", naming no option)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number of degrees, got {text!r}")
+    return value
+
+
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision view`` on the CLI's sub-parsers."""
     p = subparsers.add_parser(
@@ -1522,7 +1535,7 @@ def add_cli(subparsers: Any) -> None:
         ("pitch", "> 0 looks up"),
         ("yaw", "> 0 turns right"),
     ):
-        p.add_argument(f"--{name}", type=float, default=0.0, help=f"degrees; {sign}")
+        p.add_argument(f"--{name}", type=_camera_turn, default=0.0, help=f"degrees; {sign}")
     for name, axis in (("forward", "+Z"), ("up", "-Y"), ("right", "+X")):
         p.add_argument(
             f"--{name}",
