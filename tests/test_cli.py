@@ -584,6 +584,24 @@ def test_view_refuses_a_turn_that_is_no_finite_number_in_the_option_s_name(
     ]
 
 
+@pytest.mark.parametrize("command", ["capture", "stream", "calibrate"])
+@pytest.mark.parametrize("value", ["nan", "-5", "inf", "1e308"])
+def test_max_skew_ms_is_refused_in_the_option_s_name(
+    command: str, value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--max-skew-ms nan`` (-5, inf) said the library's "max_skew_ms: expected a number >= 0"
+    and 1e308 "internal OverflowError: cannot convert float infinity to integer (please report
+    this)": refused by argparse now, naming the option and its range, before the bag is read."""
+    argv = [command, "--from-bag", str(tmp_path / "rig"), f"--max-skew-ms={value}"]
+    with pytest.raises(SystemExit) as exc:
+        main(argv + (["--no-display"] if command == "stream" else ["-o", str(tmp_path / "o")]))
+    assert exc.value.code == 2 and list(tmp_path.iterdir()) == []
+    assert capsys.readouterr().err == (
+        f"stereovision {command}: error: argument --max-skew-ms: expected milliseconds from 0 "
+        f"to 1e+06, got {value!r} (see stereovision {command} --help)\n"
+    )
+
+
 def test_view_turns_take_any_finite_degrees() -> None:
     from stereovision.render import _camera_turn
 

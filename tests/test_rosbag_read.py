@@ -1252,6 +1252,12 @@ def test_stamps_rates_and_the_skew_limit_itself(cones: Any, tmp_path: Path) -> N
     assert cam.dropped == {"left": 2, "right": 2}
     with pytest.raises(ValueError, match="max_skew_ms: expected a number >= 0"):
         BagCamera(bag, max_skew_ms=-1)
+    # 1e308 ms: its whole nanoseconds overflowed (OverflowError: cannot convert float infinity)
+    with pytest.raises(ValueError, match=r"^max_skew_ms: expected at most 1e\+06, got 1e\+308$"):
+        BagCamera(bag, max_skew_ms=1e308)
+    with BagCamera(bag, max_skew_ms=1e6) as cam:  # the limit itself pairs all three
+        list(cam.frames())
+    assert cam.stamps_ns == [T0, T0 + PERIOD_NS, T0 + 2 * PERIOD_NS]
 
 
 def test_bgra16_transport_suffixes_and_positions(cones: Any, tmp_path: Path) -> None:

@@ -2110,9 +2110,11 @@ def add_bag_args(p: argparse.ArgumentParser, what: str, *, skew: bool = True) ->
     p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
     p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
     if skew:
+        from stereovision.cli import skew_ms  # cli builds its parser with it
+
         p.add_argument(
             "--max-skew-ms",
-            type=float,
+            type=skew_ms,
             help="--from-bag: largest stamp difference of a pair (default: half a frame period)",
         )
 

@@ -1902,6 +1902,23 @@ def positive_rate(text: str) -> float:
     return value
 
 
+def skew_ms(text: str) -> float:
+    """argparse type of ``--max-skew-ms``: milliseconds from 0 to
+    :data:`~stereovision.rosbag.MAX_SKEW_MS`, refused in the option's name (``nan`` and ``-5``
+    were the library's ``max_skew_ms: ...``, ``1e308`` an internal OverflowError)."""
+    from stereovision.rosbag import MAX_SKEW_MS
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value <= MAX_SKEW_MS:  # NaN too
+        raise argparse.ArgumentTypeError(
+            f"expected milliseconds from 0 to {MAX_SKEW_MS:g}, got {text!r}"
+        )
+    return value
+
+
 #: ``--read-timeout``'s spelling of "no limit" (a camera's read waits as long as it takes).
 NO_READ_TIMEOUT = "none"
 

@@ -992,6 +992,11 @@ def find_stereo_topics(
     return top[0]
 
 
+#: Largest ``max_skew_ms`` :class:`BagCamera` takes: 1000 s, far past any pair (two frames
+#: that far apart are no pair); 1e308 overflowed its whole nanoseconds, an OverflowError.
+MAX_SKEW_MS = 1e6
+
+
 class BagCamera(PairSource):
     """A stereo rig recorded in a ROS 1 or ROS 2 bag, read as synchronised pairs.
 
@@ -1011,6 +1016,7 @@ class BagCamera(PairSource):
     max_skew_ms : float, optional
         Largest stamp difference of a pair. Default: half the frame period of the faster topic
         (from the first :data:`PERIOD_SAMPLE` frames' stamps), so a frame pairs at most once.
+        At most :data:`MAX_SKEW_MS`.
     image_size : tuple of int or str, optional
         Resize the frames to ``(width, height)`` (or ``"WxH"``); a size of another shape than the
         recording's is not applied (a resize would stretch the frames), with a warning. Default:
@@ -1068,6 +1074,8 @@ class BagCamera(PairSource):
             raise ValueError("give both the left and the right topic, or neither")
         if max_skew_ms is not None and not (math.isfinite(max_skew_ms) and max_skew_ms >= 0):
             raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
+        if max_skew_ms is not None and max_skew_ms > MAX_SKEW_MS:
+            raise ValueError(f"max_skew_ms: expected at most {MAX_SKEW_MS:g}, got {max_skew_ms!r}")
         self.requested_size = parse_size(image_size, "image_size")
         try:
             reader = _open_reader(self.path)
