@@ -1654,6 +1654,22 @@ class _Terminal:
         return True
 
 
+def test_cli_capture_of_one_pair_says_it_in_the_singular(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``capture --count 1``'s last line said "1 pair saved in ... (count reached); 1 pairs
+    read": the saved count was singular, the read count not."""
+    from stereovision.cli import main
+
+    left = _write_sequence(tmp_path / "seq", "left", [_numbered(0)])
+    right = _write_sequence(tmp_path / "seq", "right", [_numbered(0)])
+    out = tmp_path / "pairs"
+    argv = ["capture", "--left", left, "--right", right, "--count", "1", "-o", str(out)]
+    assert main(argv) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.startswith(f"1 pair saved in {out} (count reached); 1 pair read; delivered ")
+
+
 def test_cli_capture_from_a_recording_shows_its_frames_bar_on_a_terminal(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

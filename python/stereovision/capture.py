@@ -3079,7 +3079,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
     sk = result.skew
     print(
         f"{_pairs(len(result.saved))} saved in {args.output} ({result.ended}); "
-        f"{result.frames_read} pairs read; delivered {cam.describe()}; "
+        f"{_pairs(result.frames_read)} read; delivered {cam.describe()}; "
         f"skew mean {sk['mean_ms']:.2f} ms, max {sk['max_ms']:.2f} ms"
     )
     return 0
