@@ -602,6 +602,26 @@ def test_max_skew_ms_is_refused_in_the_option_s_name(
     )
 
 
+def test_depth_voxel_too_small_for_the_cloud_is_said_as_the_option_and_keeps_the_last_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``depth --calib ... --voxel 1e-300`` said "voxel: 1e-300 is too small for points reaching
+    ...": the library's parameter, no unit. The option now, in metres; the folder's earlier
+    run is kept."""
+    out = tmp_path / "out"
+    argv = ["depth", str(CONES / "left.png"), str(CONES / "right.png"), "--calib"]
+    argv += [str(CONES / "calib.txt"), "--method", "fast", "-o", str(out)]
+    assert main(argv) == 0
+    earlier = {p.name: p.read_bytes() for p in out.iterdir()}
+    capsys.readouterr()
+    assert main([*argv, "--voxel", "1e-300"]) == 2
+    err = capsys.readouterr().err
+    assert re.fullmatch(
+        r"stereovision: error: --voxel: 1e-300 m is too small for points reaching [0-9.]+ m\n", err
+    ), err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == earlier
+
+
 def test_view_turns_take_any_finite_degrees() -> None:
     from stereovision.render import _camera_turn
 

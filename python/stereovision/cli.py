@@ -396,7 +396,15 @@ def depth_outputs(
     # all are there: an error or interrupt in a later writer left the new disparity files
     # beside the earlier run's overview.png, depth.npy and cloud.ply, without a word.
     with staged_outputs(out_dir) as stage:
-        staged = write_depth_outputs(res, stage, voxel, counts=counts)
+        try:
+            staged = write_depth_outputs(res, stage, voxel, counts=counts)
+        except ValueError as exc:  # voxel_downsample's words: its parameter, not the option
+            tiny = re.fullmatch(r"voxel: (\S+) is too small for points reaching (\S+)", str(exc))
+            if tiny is None:
+                raise
+            raise CliError(
+                f"--voxel: {tiny[1]} m is too small for points reaching {tiny[2]} m"
+            ) from None
         staged.update(render_outputs(res, stage))
         staged.update(write_overview(res, stage, name, unit))
         if ground:
