@@ -622,6 +622,31 @@ def test_depth_voxel_too_small_for_the_cloud_is_said_as_the_option_and_keeps_the
     assert {p.name: p.read_bytes() for p in out.iterdir()} == earlier
 
 
+@pytest.mark.parametrize(
+    ("square", "unit", "metres"), [("1e12", "mm", "1e+09"), ("1e-300", "m", "1e-300")]
+)
+def test_calibrate_square_out_of_bounds_is_said_in_the_options(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    square: str,
+    unit: str,
+    metres: str,
+) -> None:
+    """``calibrate --square 1e12 --unit mm`` said "square_size: 1e+12 mm is 1e+09 m", the
+    library's parameter; the options now, nothing written."""
+    boards = data_dir / "chessboard"
+    out = tmp_path / "c.yaml"
+    argv = ["calibrate", "--left", str(boards / "left0*.jpg"), "--right"]
+    argv += [str(boards / "right0*.jpg"), "--square", square, "--unit", unit, "-o", str(out)]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: --square {float(square):g} --unit {unit} is {metres} m; expected "
+        "a board square between 1 nm and 100 m\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_view_turns_take_any_finite_degrees() -> None:
     from stereovision.render import _camera_turn
 

@@ -2720,6 +2720,8 @@ def _cli_words(text: str) -> str:
     text = re.sub(r"\bpattern=\((\d+), (\d+)\)", r"--pattern \1x\2", text)
     text = re.sub(r"\bdistortion='(\w+)'", r"--distortion \1", text)
     text = re.sub(r"\bmax_pairs=(\d+)", r"--max-pairs \1", text)
+    # the square's bounds: "square_size: 1e-300 m is 1e-300 m", the parameter's name
+    text = re.sub(r"^square_size: (\S+) (\w+) is ", r"--square \1 --unit \2 is ", text)
     return re.sub(r"\bunit='(\w+)'", r"--unit \1", text)
 
 
