@@ -1670,6 +1670,24 @@ def test_cli_capture_of_one_pair_says_it_in_the_singular(
     assert last.startswith(f"1 pair saved in {out} (count reached); 1 pair read; delivered ")
 
 
+def test_a_source_that_ends_after_one_frame_says_it_in_the_singular(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A left sequence of one frame beside a right one of two ended the capture "(left
+    source ... ended after 1 frames; the right source still had frames)"."""
+    from stereovision.cli import main
+
+    left = _write_sequence(tmp_path / "seq", "left", [_numbered(0)])
+    right = _write_sequence(tmp_path / "seq", "right", [_numbered(0), _numbered(1)])
+    out = tmp_path / "pairs"
+    assert main(["capture", "--left", left, "--right", right, "-o", str(out)]) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.startswith(
+        f"1 pair saved in {out} (left source {left!r} ended after 1 frame; the right source "
+        "still had frames); 1 pair read; "
+    )
+
+
 def test_cli_capture_from_a_recording_shows_its_frames_bar_on_a_terminal(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -3118,7 +3136,7 @@ def test_an_image_sequence_opens_from_its_first_number_however_late(
         result = capture(cam, tmp_path / "pairs")
     assert len(result.saved) == 1
     assert result.ended.startswith(
-        f"left source {pattern!r} ended after 1 images: {name % (first + 1)} is missing, so the "
+        f"left source {pattern!r} ended after 1 image: {name % (first + 1)} is missing, so the "
         "2 images numbered after it were not read"
     )
 

@@ -1485,7 +1485,7 @@ def test_a_nearer_right_frame_drops_the_one_before_and_the_end_says_so(
     assert [(f.t_left, f.t_right) for f in got] == [(T0 / 1e9, (T0 + ms // 2) / 1e9)]
     assert cam.dropped == {"left": 0, "right": 1}
     assert str(err.value).endswith(
-        "end of the recording after 1 pairs (0 left and 1 right frames without a partner)"
+        "end of the recording after 1 pair (0 left and 1 right frames without a partner)"
     )
     # two lefts, one right: the left passed over is counted on its side
     frames = [(T0, left, T0, right), (T0 + 40 * ms, left, None, right)]

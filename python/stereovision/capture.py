@@ -1665,7 +1665,8 @@ class StereoCamera(PairSource):
 
     def _fail(self, side: str, what: str) -> SourceError:
         return SourceError(
-            f"{side} source {_describe_source(self.sources[side])} {what} after {self.count} pairs",
+            f"{side} source {_describe_source(self.sources[side])} {what} after "
+            f"{_pairs(self.count)}",
             side=side,
             end=False,
             frames=self.count,
@@ -1718,12 +1719,12 @@ class StereoCamera(PairSource):
                 else ("is missing", "renumber them without the gap")
             )
             return (
-                f"{side} source {name} ended after {n} images: {gap[0]} {why}, so the "
+                f"{side} source {name} ended after {_counted(n, 'image')}: {gap[0]} {why}, so the "
                 f"{gap[1]} image{'s' if gap[1] > 1 else ''} numbered after it "
                 f"{'were' if gap[1] > 1 else 'was'} not read ({fix})"
             )
         if total is None:
-            return f"{side} source {name} ended after {n} frames"
+            return f"{side} source {name} ended after {_counted(n, 'frame')}"
         if self._sequence.get(side):
             return (
                 f"{side} source {name} ended after {n} of its {total} images: the next one "
@@ -1743,7 +1744,7 @@ class StereoCamera(PairSource):
         gaps = [g[0] for side in gone if (g := self._gap(side)) is not None]
         devices = [s for s in gone if isinstance(self.sources[s], (int, np.integer))]
         if len(gone) == 2 and not short and not gaps and not devices:
-            message = f"both sources ended after {self.count} frames"
+            message = f"both sources ended after {_counted(self.count, 'frame')}"
         elif len(gone) == 2:
             message = "; ".join(self._end_phrase(side) for side in gone)
         else:
@@ -3087,7 +3088,13 @@ def cmd_capture(args: argparse.Namespace) -> int:
 
 def _pairs(n: int) -> str:
     """``1 pair``, ``2 pairs``: the CLI's counts ("1 pairs saved" read badly)."""
-    return f"{n} pair" if n == 1 else f"{n} pairs"
+    return _counted(n, "pair")
+
+
+def _counted(n: int, thing: str) -> str:
+    """``1 frame``, ``0 frames``, ``2 frames``: a count said with its noun ("ended after 1
+    frames", "after 1 images" read badly)."""
+    return f"{n} {thing}" if n == 1 else f"{n} {thing}s"
 
 
 def board_side(text: str) -> float:

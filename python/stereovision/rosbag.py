@@ -81,7 +81,7 @@ import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
 from stereovision._validate import renamed_keyword, source_warning
-from stereovision.capture import PairSource, SourceError, StereoFrame, resize_frame
+from stereovision.capture import PairSource, SourceError, StereoFrame, _pairs, resize_frame
 
 __all__ = [
     "DEFAULT_FRAME_ID",
@@ -1307,7 +1307,7 @@ class BagCamera(PairSource):
         nxt = self._next_pair()
         if nxt is None:
             raise SourceError(
-                f"bag {self.path}: end of the recording after {self.count} pairs "
+                f"bag {self.path}: end of the recording after {_pairs(self.count)} "
                 f"({self.dropped['left']} left and {self.dropped['right']} right frames without "
                 "a partner)"
             )
