@@ -1094,3 +1094,27 @@ def test_the_triangulated_square_sides_pair_partial_boards_corners_by_their_ids(
     assert rep.square_size_measured == pytest.approx(float(np.median(side)), rel=1e-6)
     assert rep.square_size_std == pytest.approx(float(side.std()), rel=1e-4)
     assert rep.square_size_std < 0.01 * BOARD.square_size
+
+
+def test_a_cut_legacy_board_is_not_read_in_the_other_layout_a_square_off() -> None:
+    """An 11x8 legacy board whose last column is out of view gave both layouts 27 corners and
+    the tie chose the current layout: every id a square off (corners 55 px from where the board
+    puts them). Its board reaches past the edge seen, black squares on the white margin: the
+    legacy layout is found, and the corners are the board's."""
+    true = CharucoBoard("11x8", 0.04, 0.03, "DICT_7X7_100", legacy=True)
+    rv, tv = np.array([0.05, 0.1, 0.0]), np.array([-0.05, -0.06, 0.45])
+    img = render_charuco(true, K1, D1, rv, tv, supersample=SS)
+    wrong = find_charuco_corners(img, replace(true, legacy=False))
+    right = find_charuco_corners(img, true)
+    assert wrong is not None and right is not None and len(wrong[0]) == len(right[0])  # a tie
+    found = CharucoBoard("11x8", 0.04, 0.03).resolve(img)
+    assert found is not None and found.legacy is True
+    got = find_charuco_corners(img, CharucoBoard("11x8", 0.04, 0.03))
+    assert got is not None
+    np.testing.assert_array_equal(got[0], right[0])
+    err = np.linalg.norm(got[1] - _project(true, got[0], rv, tv, K1, D1), axis=1)
+    assert err.max() < 0.5
+    # the board in full view: either layout's count and squares still agree on the legacy one
+    full = render_charuco(true, K1, D1, np.array([0.1, -0.2, 0.0]), np.array([-0.22, -0.15, 0.7]))
+    found = CharucoBoard("11x8", 0.04, 0.03, "DICT_7X7_100").resolve(full)
+    assert found is not None and found.legacy is True

@@ -16,7 +16,8 @@ Conventions (OpenCV's ``cv2.aruco.CharucoBoard``):
 - OpenCV 4.6 changed the layout of boards with an even number of rows (``legacy`` is the old
   one). Boards printed from older generators (and calib.io's, by their docs) may need
   ``legacy=True``; ``legacy=None`` tries both on the first board found and keeps the one that
-  gives more corners.
+  gives more corners (a board cut on one side can give both as many, the wrong one every id a
+  square off: then the one whose black squares the image shows black).
 """
 
 from __future__ import annotations
@@ -356,14 +357,86 @@ class CharucoBoard:
         if board.legacy is None:
             if board.squares[1] % 2 == 1:
                 return replace(board, legacy=False)
-            counts = []
+            counts, misplaced = [], []
             for legacy in (False, True):
-                found = find_charuco_corners(gray, replace(board, legacy=legacy))
+                trial = replace(board, legacy=legacy)
+                found = find_charuco_corners(gray, trial)
                 counts.append(0 if found is None else len(found[0]))
+                misplaced.append(
+                    None if found is None else _white_black_squares(gray, trial, *found)
+                )
             if max(counts) == 0:
                 return None
-            board = replace(board, legacy=counts[1] > counts[0])
+            # A view of part of the board (its last column cut off) fits both layouts with as
+            # many corners, the wrong one with every id a square off (55 px on a 7X7 11x8 board
+            # at 0.45 m): that one's board reaches past the edge seen, its black squares on the
+            # white margin. The corner count decides when that does not tell them apart.
+            a, b = misplaced
+            if a is not None and b is not None and min(a, b) == 0 and max(a, b) >= 2:
+                board = replace(board, legacy=b == 0)
+            else:
+                board = replace(board, legacy=counts[1] > counts[0])
         return board
+
+
+def _white_black_squares(
+    gray: npt.NDArray[np.uint8], board: CharucoBoard, ids: npt.NDArray[np.int64], pts: F64
+) -> int | None:
+    """How many of ``board``'s black squares the image shows white, where the found corners'
+    homography puts them (centres in the image, the whole board), or None when it cannot tell.
+
+    A wrong layout's corners and markers can agree with a view whose board is cut on one side,
+    every id a square off: the board then reaches a square past the edge seen, where its black
+    squares fall on the white margin. The right layout's black squares are black.
+    """
+    obj = board.object_points(ids)[:, :2].astype(np.float64)
+    try:
+        hom, _ = cv2.findHomography(obj, pts.astype(np.float64), 0)
+    except cv2.error:
+        return None
+    if hom is None or not np.isfinite(hom).all():
+        return None
+    s, m = board.square_size, board.marker_size
+    white = set()
+    for quad in board.cv_board().getObjPoints():
+        cx, cy = np.asarray(quad, np.float64).reshape(-1, 3)[:, :2].mean(axis=0)
+        white.add((math.floor(cx / s), math.floor(cy / s)))
+    (x0, y0), (x1, y1) = obj.min(axis=0), obj.max(axis=0)
+    g = (s + m) / 4  # a square's centre to the middle of the white gap around its marker
+    h, w = gray.shape
+
+    def grey(board_pts: list[tuple[float, float]]) -> npt.NDArray[np.float64]:
+        q = cv2.perspectiveTransform(np.array(board_pts, np.float64).reshape(-1, 1, 2), hom)
+        xy = np.round(q.reshape(-1, 2))
+        inside = (xy[:, 0] >= 0) & (xy[:, 0] < w) & (xy[:, 1] >= 0) & (xy[:, 1] < h)
+        out = np.full(len(xy), np.nan)
+        xi = xy[inside].astype(np.int64)
+        out[inside] = gray[xi[:, 1], xi[:, 0]]
+        return out
+
+    # the two tones, from the squares between the corners found
+    gaps, dark = [], []
+    for r in range(board.squares[1]):
+        for c in range(board.squares[0]):
+            cx, cy = (c + 0.5) * s, (r + 0.5) * s
+            if x0 < cx < x1 and y0 < cy < y1:
+                if (c, r) in white:
+                    gaps += [(cx + g, cy), (cx - g, cy), (cx, cy + g), (cx, cy - g)]
+                else:
+                    dark.append((cx, cy))
+    if not gaps or not dark:
+        return None
+    tone_w, tone_b = np.nanmedian(grey(gaps)), np.nanmedian(grey(dark))
+    if not tone_w - tone_b > 20:  # NaN too: no contrast to judge by
+        return None
+    black = [
+        ((c + 0.5) * s, (r + 0.5) * s)
+        for r in range(board.squares[1])
+        for c in range(board.squares[0])
+        if (c, r) not in white
+    ]
+    centres = grey(black)
+    return int(np.count_nonzero(centres > (tone_w + tone_b) / 2))
 
 
 _CV_BOARDS: dict[tuple[Any, ...], Any] = {}
