@@ -924,12 +924,15 @@ def _refusal(*args: object, **kwargs: object) -> str:
 def test_a_view_moved_under_half_a_pixel_has_no_parallax(data_dir: Path) -> None:
     """A mutation audit found the no-parallax floor unasserted beyond an identical pair: a view
     moved 0.3 px (its matches' median movement, under the 0.5 px floor) is the same view; one
-    moved 0.8 px is not refused as such."""
+    moved 0.8 px is not refused as such (but as matches that all fit one homography: a shift
+    of the whole view has no parallax either)."""
     left = load_scene(data_dir / "middlebury2003" / "cones").left
     h, w = left.shape[:2]
     for dx, same in ((0.3, True), (0.8, False)):
         moved = cv2.warpAffine(left, np.float64([[1, 0, -dx], [0, 1, 0]]), (w, h))
-        assert ("no parallax" in _refusal(left, moved)) is same, dx
+        said = _refusal(left, moved)
+        assert ("same view" in said) is same, dx
+        assert ("fit one homography" in said) is not same, dx
 
 
 def test_thirty_matches_and_thirty_that_fit_are_enough(
@@ -1381,3 +1384,23 @@ def test_an_image_an_empty_file_or_a_folder_given_as_the_rectification_says_what
         f"rectification file not found: {tmp_path} is a folder; give its "
         f"{tmp_path / 'rectification.json'}"
     )
+
+
+@pytest.mark.parametrize("turn", [(0.5, 1.5, 0.3), (0.0, 0.0, 3.0)])
+def test_a_camera_turned_in_place_has_no_parallax_and_is_refused(
+    data_dir: Path, turn: tuple[float, float, float]
+) -> None:
+    """The left image turned in place (``K R K^-1``: no baseline, so no parallax) was
+    "rectified": rows 0.03 px, disparities 8-27 px (max_disparity 35) of a scene the views
+    cannot range. 99 % of its matches fit one homography (a real pair's 21-77 %): refused."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    h, w = sc.left.shape[:2]
+    k = np.array([[w, 0, (w - 1) / 2], [0, w, (h - 1) / 2], [0, 0, 1.0]])
+    hom = k @ cv2.Rodrigues(np.radians(turn))[0] @ np.linalg.inv(k)
+    turned = cv2.warpPerspective(sc.left, hom, (w, h), borderMode=cv2.BORDER_REPLICATE)
+    with pytest.raises(ValueError, match=r"(\d+) % of the (\d+) feature matches fit one homo") as e:
+        rectify_uncalibrated(sc.left, turned)
+    assert int(re.findall(r"(\d+) % of", str(e.value))[0]) >= 95
+    assert "no parallax" in str(e.value)
+    # the pair itself, its right camera beside the left one, is rectified as before
+    assert rectify_uncalibrated(sc.left, sc.right).median_dy < 0.1
