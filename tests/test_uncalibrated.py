@@ -1404,3 +1404,22 @@ def test_a_camera_turned_in_place_has_no_parallax_and_is_refused(
     assert "no parallax" in str(e.value)
     # the pair itself, its right camera beside the left one, is rectified as before
     assert rectify_uncalibrated(sc.left, sc.right).median_dy < 0.1
+
+
+def test_rectify_takes_the_packages_images_and_names_others(data_dir: Path) -> None:
+    """The homographies' rectify() handed any array to OpenCV: a float16 image (which the
+    package reads everywhere else) and bool or int64 arrays failed OpenCV's assertion
+    "ifunc != 0 in function 'remap'". float16 is now warped in float32 and returned as float16
+    (as the uint8 warp's values); the others are refused naming the image and the dtype."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    rect = rectify_uncalibrated(sc.left, sc.right)
+    base = rect.rectify(sc.left, sc.right)
+    half = [np.asarray(img, np.float16) / np.float16(255) for img in (sc.left, sc.right)]
+    got = rect.rectify(*half)
+    for g, b in zip(got, base, strict=True):
+        assert g.dtype == np.float16 and g.shape == b.shape
+        assert np.abs(g.astype(np.float32) * 255 - b).max() < 1.5  # uint8 rounding, float16 steps
+    with pytest.raises(ValueError, match="right: unsupported dtype bool"):
+        rect.rectify(sc.left, sc.right > 100)
+    with pytest.raises(ValueError, match="left: unsupported dtype int64"):
+        rect.rectify(sc.left.astype(np.int64), sc.right)

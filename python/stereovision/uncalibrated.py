@@ -43,7 +43,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8, xy_points
+from stereovision._validate import as_gray_uint8, as_image_array, xy_points
 from stereovision.rectification_check import (
     DEFAULT_TOLERANCE_PX,
     MIN_MATCHES,
@@ -350,18 +350,25 @@ class UncalibratedRectification:
         Raises
         ------
         ValueError
-            If an image is not of :attr:`input_size`.
+            If an image is not an image array (as :meth:`Calibration.rectify
+            <stereovision.calibration.Calibration.rectify>`: bool, signed integer or other
+            dtypes, a wrong shape) or not of :attr:`input_size`.
         """
         out = []
         for name, img, hom in (("left", left, self.H1), ("right", right, self.H2)):
-            arr = np.asarray(img)
-            if arr.ndim < 2 or (arr.shape[1], arr.shape[0]) != self.input_size:
-                got = f"{arr.shape[1]}x{arr.shape[0]}" if arr.ndim >= 2 else str(arr.shape)
+            # OpenCV's own assertion ("ifunc != 0 in function 'remap'") of a bool or int64
+            # array, or of a float16 image the package otherwise takes, said nothing of it
+            arr = as_image_array(img, name)
+            if (arr.shape[1], arr.shape[0]) != self.input_size:
                 raise ValueError(
-                    f"{name} image is {got} px; this rectification is for "
-                    f"{self.input_size[0]}x{self.input_size[1]}"
+                    f"{name} image is {arr.shape[1]}x{arr.shape[0]} px; this rectification is "
+                    f"for {self.input_size[0]}x{self.input_size[1]}"
                 )
-            out.append(np.asarray(cv2.warpPerspective(arr, hom, self.size, flags=interpolation)))
+            work = arr
+            if arr.dtype.kind == "f" and arr.dtype.itemsize not in (4, 8):  # float16, long double
+                work = arr.astype(np.float32 if arr.dtype.itemsize == 2 else np.float64)
+            warped = np.asarray(cv2.warpPerspective(work, hom, self.size, flags=interpolation))
+            out.append(warped if warped.dtype == arr.dtype else warped.astype(arr.dtype))
         return out[0], out[1]
 
     def rectify_points(self, points: npt.ArrayLike, side: str = "left") -> F64:
