@@ -1347,6 +1347,30 @@ def test_export_result_refused_writes_nothing(result, tmp_path):
     assert sorted(written) == ["depth.npz", "disparity_16.png"]
 
 
+@pytest.mark.parametrize(
+    ("target", "error", "words"),
+    [
+        ("cloud.pcd", OSError, r"cloud\.pcd: it is a link that loops"),
+        ("/nonexistent_sv/x/cloud.pcd", FileNotFoundError, r"directory /nonexistent_sv/x does not"),
+    ],
+)
+def test_export_result_link_in_the_way_writes_nothing(result, tmp_path, target, error, words):
+    """A link where a later format goes (one that loops, one into a missing folder) was found
+    at that format's turn, after depth.npz and cloud.ply had been replaced: it is now refused
+    before any file is written, as a folder in the way is."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "depth.npz").write_bytes(b"earlier npz")
+    (out / "cloud.ply").write_bytes(b"earlier ply")
+    link = out / "cloud.pcd"
+    link.symlink_to(out / target if target == "cloud.pcd" else target)
+    with pytest.raises(error, match=words):
+        export.export_result(result, out, ("npz", "ply", "pcd"))
+    assert (out / "depth.npz").read_bytes() == b"earlier npz"
+    assert (out / "cloud.ply").read_bytes() == b"earlier ply"
+    assert sorted(p.name for p in out.iterdir()) == ["cloud.pcd", "cloud.ply", "depth.npz"]
+
+
 def test_mesh_ply_colours_float_0_1_and_out_of_range(tmp_path):
     """A uint8 cast made a mesh's 0-1 float colours (pyvista's) black, 0.5 grey became 0, and
     wrapped integers (300 came out 44, -1 255): floats are scaled from 0-1, and colours that do

@@ -44,7 +44,15 @@ from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.depth import DepthResult
-from stereovision.io import _ascii_table, atomic_write, make_folder, read_ply, write_ply
+from stereovision.io import (
+    _ascii_table,
+    _through_links,
+    _writable_destination,
+    atomic_write,
+    make_folder,
+    read_ply,
+    write_ply,
+)
 
 if TYPE_CHECKING:
     import pyvista as pv
@@ -1056,6 +1064,9 @@ def export_result(
         Unknown format, or PLY / PCD / depth PNG asked for a result without calibration.
     IsADirectoryError
         If a folder stands where one of the files goes.
+    OSError
+        If a link stands there that loops or leads into a missing folder
+        (FileNotFoundError).
 
     Notes
     -----
@@ -1090,6 +1101,10 @@ def export_result(
             raise IsADirectoryError(
                 f"cannot write {target}: it is a folder; move it away (nothing was written)"
             )
+        if target.is_symlink():
+            # what atomic_write refuses of a link (one that loops, one into a missing folder)
+            # was found at its format's turn, after depth.npz and cloud.ply were replaced
+            _writable_destination(_through_links(target))
     make_folder(out)
     writers: dict[str, Callable[[Path, DepthResult], Path]] = {
         "ply": write_cloud_ply,
