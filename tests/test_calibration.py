@@ -235,6 +235,21 @@ def test_a_calibration_written_as_json_by_opencv_filestorage_loads(tmp_path: Pat
         Calibration.load(path)
 
 
+def test_a_filestorage_json_opencv_cannot_parse_is_not_called_yaml(tmp_path: Path) -> None:
+    """A cv::FileStorage JSON that OpenCV's parser refuses (a NaN Python's json wrote, which
+    Python reads back) was said to be unparseable "as OpenCV YAML/XML": it is JSON."""
+    path = tmp_path / "rig.json"
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    for key, value in raw_calib()._to_record().items():
+        fs.write(key, value)
+    fs.release()
+    obj = json.loads(path.read_text())
+    obj["K1"]["data"][1] = float("nan")
+    path.write_text(json.dumps(obj, indent=1))
+    with pytest.raises(ValueError, match=r"^cannot parse .*rig\.json as OpenCV JSON: line \d+: "):
+        Calibration.load(path)
+
+
 def test_json_content(tmp_path: Path) -> None:
     rect_calib(doffs=0.0).save(tmp_path / "c.json")
     obj = json.loads((tmp_path / "c.json").read_text())

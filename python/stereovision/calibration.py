@@ -252,9 +252,9 @@ def _node_matrix(node: Any, key: str, source: str, vector: bool = False) -> npt.
 
 
 def _open_filestorage(text: str, source: str) -> Any:
-    """``cv2.FileStorage`` reading ``text`` (OpenCV YAML/XML), opened, or a ValueError naming
-    ``source``. A damaged file makes OpenCV's parser raise cv2.error (or, from the constructor,
-    a SystemError wrapping it): both are the file's fault.
+    """``cv2.FileStorage`` reading ``text`` (OpenCV YAML/XML or JSON), opened, or a ValueError
+    naming ``source``. A damaged file makes OpenCV's parser raise cv2.error (or, from the
+    constructor, a SystemError wrapping it): both are the file's fault.
 
     An XML file without its ``<?xml ...?>`` declaration (hand-edited, or from a tool that
     omits it) is read as XML: OpenCV took it for YAML ("line 1: Invalid or unsupported
@@ -268,12 +268,14 @@ def _open_filestorage(text: str, source: str) -> Any:
         text = declaration + end + lead + rest
     elif body.startswith("<opencv_storage"):
         text = '<?xml version="1.0"?>' + lead + body
+    # cv::FileStorage's JSON comes here too (Calibration._from_json_text): not "YAML/XML"
+    kind = "JSON" if body.startswith("{") else "YAML/XML"
     try:
         fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
     except (cv2.error, SystemError) as exc:
-        raise ValueError(f"cannot parse {source} as OpenCV YAML/XML: {_first_line(exc)}") from None
+        raise ValueError(f"cannot parse {source} as OpenCV {kind}: {_first_line(exc)}") from None
     if not fs.isOpened():
-        raise ValueError(f"cannot parse {source} as OpenCV YAML/XML")
+        raise ValueError(f"cannot parse {source} as OpenCV {kind}")
     return fs
 
 
