@@ -577,6 +577,8 @@ CASES = {
     "write_pfm": lambda: io.write_pfm(OUT + "/d.pfm", f32(SQ)),
     "noise_sigma": lambda: temporal.noise_sigma(u8(SQ)),
     "TemporalFilter": lambda: sv.TemporalFilter()(u8(SQ), u8(SQ)),
+    # last: before its check, OpenCV's blur of it crashed the child (SIGSEGV under 3 GB)
+    "segments_graph": lambda: planes.segments(u8((2, 1_500_000_000)), k=1.0),
 }
 for name, call in CASES.items():
     try:
@@ -652,6 +654,24 @@ def test_an_image_past_32_bit_indices_is_refused_before_any_copy(
         "32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
     assert too_large_outcomes[case] == want
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS is Linux's")
+def test_an_image_past_the_graph_segmentations_limit_is_refused_before_any_copy(
+    too_large_outcomes: dict[str, str],
+) -> None:
+    """segments' graph path (k > 0, min_size > 1, a float image) takes at most 2**31 pixels:
+    a 2 x 1.5e9 image (3e9 pixels, within the other kernels' 32-bit indices) was blurred and
+    copied as float32 keys (a MemoryError for 11.2 GiB) before graph_segments refused it."""
+    assert too_large_outcomes.get("segments_graph") == (
+        "ValueError: image: image of 1500000000x2 pixels is too large: the kernels index pixels "
+        "with 32-bit integers (at most 2147483648 pixels, 2147483647 per side)"
+    )
+    from stereovision._validate import check_index_range
+
+    check_index_range((2, 2**30), "image", max_pixels=2**31)
+    with pytest.raises(ValueError, match=r"^image: image of 1073741825x2 pixels .* 2147483648 "):
+        check_index_range((2, 2**30 + 1), "image", max_pixels=2**31)
 
 
 def test_check_index_range_at_the_kernels_limits() -> None:

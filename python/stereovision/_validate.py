@@ -95,7 +95,9 @@ MAX_PIXELS = 2**32 - 1
 MAX_SIDE = 2**31 - 1
 
 
-def check_index_range(shape: tuple[int, ...], name: str, what: str = "image") -> None:
+def check_index_range(
+    shape: tuple[int, ...], name: str, what: str = "image", *, max_pixels: int = MAX_PIXELS
+) -> None:
     """Refuse an ``(H, W, ...)`` shape past the kernels' 32-bit pixel indices, from the shape alone.
 
     Called before any copy or conversion: a broadcast or memory-mapped image of 70000 x 70000
@@ -110,11 +112,14 @@ def check_index_range(shape: tuple[int, ...], name: str, what: str = "image") ->
         Argument name used in the error message.
     what : str
         What the array is, for the message: ``"image"``, or ``"map"`` for a disparity map.
+    max_pixels : int
+        The kernel's own limit of ``W * H``, for one whose numbers reach fewer pixels than
+        :data:`MAX_PIXELS` (the graph segmentation's ``2**31``).
 
     Raises
     ------
     ValueError
-        If the width or height exceeds :data:`MAX_SIDE` or ``W * H`` exceeds :data:`MAX_PIXELS`.
+        If the width or height exceeds :data:`MAX_SIDE` or ``W * H`` exceeds ``max_pixels``.
 
     Examples
     --------
@@ -124,10 +129,10 @@ def check_index_range(shape: tuple[int, ...], name: str, what: str = "image") ->
     ValueError: left: image of 70000x70000 pixels is too large: ...
     """
     h, w = int(shape[0]), int(shape[1])
-    if w > MAX_SIDE or h > MAX_SIDE or w * h > MAX_PIXELS:
+    if w > MAX_SIDE or h > MAX_SIDE or w * h > max_pixels:
         raise ValueError(
             f"{name}: {what} of {w}x{h} pixels is too large: the kernels index pixels with 32-bit "
-            f"integers (at most {MAX_PIXELS} pixels, {MAX_SIDE} per side)"
+            f"integers (at most {max_pixels} pixels, {MAX_SIDE} per side)"
         )
 
 

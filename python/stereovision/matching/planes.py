@@ -49,6 +49,9 @@ _BLUR = 2.0  # px: Gaussian sigma before the quantisation
 _MAX_BLUR = 64.0
 #: The largest pixel count taken (``min_pixels``, ``min_size``): the kernels' counts.
 _MAX_COUNT = 2**31 - 1
+#: Most pixels :func:`_core.graph_segments` takes (``GRAPH_MAX_PIXELS`` of
+#: rust/core/src/segment.rs: it numbers two edges a pixel in 32 bits).
+_GRAPH_MAX_PIXELS = 2**31
 _STEP = 16  # grey levels (0-255) per quantisation bin
 _MIN_PIXELS = 50  # measured pixels a segment needs for a plane
 _MAX_RESIDUAL = 0.7  # px: largest median absolute residual of an accepted plane
@@ -114,13 +117,23 @@ def segments(
     finite_number(offset, "offset")
     _real(k, "k")
     size = int_in_range(min_size, "min_size", 0, _MAX_COUNT)
-    if blur > 0:
-        im = _blurred(im, blur)
-    fast = im.dtype == np.uint8 and (im.ndim == 2 or im.shape[2] <= 3) and 0 <= offset <= 255
+    # the blur makes any image uint8
+    fast = (
+        (blur > 0 or im.dtype == np.uint8)
+        and (im.ndim == 2 or im.shape[2] <= 3)
+        and 0 <= offset <= 255
+    )
     # The kernel has no min_size: it served a uint8 image with min_size 50 as if it were 1,
     # while the same image as floats had its small regions joined to a neighbour.
     whole = float(step).is_integer() and float(offset).is_integer()
-    if k == 0 and fast and step <= 255 and size <= 1 and whole:
+    quantised = k == 0 and fast and step <= 255 and size <= 1 and whole
+    if not quantised:
+        # the graph's own, lower limit, before the blur and the float32 key: a 2 x 1.5e9 image
+        # was copied (a MemoryError for 11.2 GiB) before graph_segments refused it
+        check_index_range(im.shape, "image", max_pixels=_GRAPH_MAX_PIXELS)
+    if blur > 0:
+        im = _blurred(im, blur)
+    if quantised:
         # Equal regions of a uint8 image: the kernel bins and labels in one pass.
         u8 = im[:, :, None] if im.ndim == 2 else im
         return _core.quantised_regions(np.ascontiguousarray(u8), int(step), int(offset))
