@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 import threading
@@ -2863,3 +2864,45 @@ def test_a_video_file_read_to_its_end_still_ends_its_stream(tmp_path: Path) -> N
     with StereoCamera(str(tmp_path / "l%d.png"), str(tmp_path / "r%d.png")) as cam:
         rep = run_stream(cam, max_disparity=8, check=False)
     assert (rep.frames, rep.ended, rep.error) == (3, "end of stream", None)
+
+
+class _UnpluggedNode(_Unplugged):
+    """A camera opened by its V4L2 node (``/dev/video0``, a ``/dev/v4l/by-id`` link): the
+    path OpenCV gets, with the backend a device reports."""
+
+    def __init__(self, path: Any, *args: Any) -> None:
+        super().__init__(0 if "0" in str(path) else 1)
+
+    def getBackendName(self) -> str:
+        return "V4L2"
+
+
+@PIPELINED
+def test_a_camera_opened_by_its_device_node_that_stops_fails_the_stream(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--left /dev/video0`` is a camera as ``--left 0`` is: unplugged mid-stream, it ended the
+    stream as ``"end of stream"``, exit 0 (only a camera index was taken for a device). So
+    does a ``/dev/v4l/by-id`` link, whose link is gone once the camera is unplugged."""
+    link = tmp_path / "usb-cam-video-index0"
+    link.symlink_to("/dev/video0")  # as udev's by-id link: dangling here, no camera
+    real_exists = os.path.exists
+    nodes = ("/dev/video0", "/dev/video1", str(link))
+    monkeypatch.setattr(os.path, "exists", lambda p: str(p) in nodes or real_exists(p))
+    monkeypatch.setattr(cv2, "VideoCapture", _UnpluggedNode)
+    said = (
+        "left source '{}' stopped delivering frames after 3 (disconnected?); right source "
+        "'/dev/video1' stopped delivering frames after 3 (disconnected?)"
+    )
+    for left in ("/dev/video0", str(link)):
+        with StereoCamera(left, "/dev/video1") as cam:
+            if left == str(link):
+                link.unlink()  # unplugged: udev removes the link
+            rep = run_stream(cam, max_disparity=8, check=False, pipelined=False)
+        assert (rep.frames, rep.ended, rep.error) == (3, "source failed", said.format(left))
+    argv = ["stream", "--left", "/dev/video0", "--right", "/dev/video1", "--no-display"]
+    assert main([*argv, "--no-check", "--json", "--max-disparity", "8"]) == 2
+    out, err = capsys.readouterr()
+    summary = json.loads(out.splitlines()[-1])
+    assert (summary["frames"], summary["ended"]) == (3, "source failed")
+    assert err.splitlines()[-1] == f"stereovision: error: {said.format('/dev/video0')}"

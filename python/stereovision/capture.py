@@ -1545,9 +1545,14 @@ class StereoCamera(PairSource):
         # whatever was copied into or moved out of its folder while it was read
         self._sequence_start: dict[str, int] = {}
         self._media_offset: float | None = None  # left - right media time of the first pair
+        # which sources are camera devices (an index, /dev/video0, a /dev/v4l/by-id link),
+        # known at the open: a by-id link is gone once its camera is unplugged
+        self._device: dict[str, bool] = {}
         try:
             for side, src in self.sources.items():
                 self._caps[side] = self._open(side, src, fps, open_timeout)
+                path = os.fspath(src) if isinstance(src, os.PathLike) else src
+                self._device[side] = _camera_device(path) is not None
         except BaseException:
             self.close()
             raise
@@ -1701,7 +1706,7 @@ class StereoCamera(PairSource):
     def _end_phrase(self, side: str) -> str:
         src, n = self.sources[side], self.count
         name = _describe_source(src)
-        if isinstance(src, (int, np.integer)):
+        if self._device.get(side, False) or isinstance(src, (int, np.integer)):
             return f"{side} source {name} stopped delivering frames after {n} (disconnected?)"
         total = self._short(side)
         gap = self._gap(side)
@@ -1742,7 +1747,7 @@ class StereoCamera(PairSource):
         gone = [side for side in ("left", "right") if not ok[side]]
         short = [t for side in gone if (t := self._short(side)) is not None]
         gaps = [g[0] for side in gone if (g := self._gap(side)) is not None]
-        devices = [s for s in gone if isinstance(self.sources[s], (int, np.integer))]
+        devices = [s for s in gone if self._device.get(s, False)]
         if len(gone) == 2 and not short and not gaps and not devices:
             message = f"both sources ended after {_counted(self.count, 'frame')}"
         elif len(gone) == 2:

@@ -578,12 +578,17 @@ def _pairs(
 
 
 def _device_ended(camera: Any, exc: SourceError) -> bool:
-    """Whether the source(s) whose end ``exc`` reports include a camera device (an index):
+    """Whether the source(s) whose end ``exc`` reports include a camera device (an index, or
+    its node as StereoCamera knew it at the open: ``/dev/video0``, a ``/dev/v4l/by-id`` link):
     a file or sequence ends, a device that stops delivering was lost."""
+    sides = ("left", "right") if exc.side in (None, "both") else (exc.side,)
+    device = getattr(camera, "_device", None)
+    if isinstance(device, dict):
+        # an index alone was taken for a device: /dev/video0 unplugged ended as a file does
+        return any(device.get(side, False) for side in sides)
     sources = getattr(camera, "sources", None)
     if not isinstance(sources, dict):
         return False
-    sides = ("left", "right") if exc.side in (None, "both") else (exc.side,)
     return any(isinstance(sources.get(side), (int, np.integer)) for side in sides)
 
 
