@@ -8,6 +8,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -627,6 +628,20 @@ def test_an_empty_result_or_a_left_image_of_other_channels_is_a_value_error(
     res.depth = None
     res.left_rectified = None if left is None else np.zeros(left, np.uint8)
     with pytest.raises(ValueError, match=match):
+        overview_image(res, "t")
+
+
+@pytest.mark.parametrize(
+    ("dtype", "value"), [(np.uint16, 1000), (np.float32, 0.5), (np.float64, 200.0), (bool, True)]
+)
+def test_a_left_image_that_is_not_uint8_is_a_value_error(dtype: Any, value: Any) -> None:
+    """The left panel is uint8: a hand-made uint16 left image of 1000 was drawn as 232 (wrapped
+    modulo 256), a float one of 0.5 black, without a word; each is a ValueError naming it."""
+    res = _small_result(30, 40)
+    res.left_rectified = np.full((30, 40, 3), value, dtype)
+    with pytest.raises(
+        ValueError, match=rf"^result: expected a uint8 left image, got {np.dtype(dtype)}$"
+    ):
         overview_image(res, "t")
 
 

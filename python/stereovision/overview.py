@@ -277,8 +277,8 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     Parameters
     ----------
     result : DepthResult
-        Its left (rectified) image (grey ``(H, W)`` or ``(H, W, 1)``, BGR or BGRA, drawn as BGR;
-        None: black), disparity, depth (None without calibration) and confidence.
+        Its left (rectified) uint8 image (grey ``(H, W)`` or ``(H, W, 1)``, BGR or BGRA, drawn
+        as BGR; None: black), disparity, depth (None without calibration) and confidence.
     title : str
         The one-line title (scaled down to fit; a character outside ASCII is drawn, and kept
         in :attr:`Overview.title`, as ``?``).
@@ -297,7 +297,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     ------
     ValueError
         An unknown ``unit`` (the message names the allowed ones), a disparity map that is not
-        ``(H, W)`` or has no pixel, or a left image that is not grey, BGR or BGRA.
+        ``(H, W)`` or has no pixel, or a left image that is not grey, BGR or BGRA, or not uint8.
     """
     from stereovision._validate import known_unit
     from stereovision.calibration import UNIT_TO_METRES
@@ -326,6 +326,10 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
                 "result: expected a grey (H, W) or (H, W, 1), BGR or BGRA left image, got shape "
                 f"{left.shape}"
             )
+        if left.dtype != np.uint8:
+            # the panel is uint8: a uint16 image of 1000 was drawn as 232 (wrapped), a float
+            # one of 0.5 black
+            raise ValueError(f"result: expected a uint8 left image, got {left.dtype}")
         if left.ndim == 3 and left.shape[2] == 4:
             left = left[:, :, :3]  # BGRA: drawn without its alpha
         elif left.ndim == 3 and left.shape[2] == 1:
