@@ -4093,3 +4093,65 @@ def test_sequences_that_start_at_other_numbers_are_said_to_pair_in_order(tmp_pat
         with StereoCamera(left, right) as cam:
             fr = cam.read()
     assert (_read_stamp(fr.left), _read_stamp(fr.right)) == (1, 1)
+
+
+class _UnpluggedCamera:
+    """A camera device (``cv2.VideoCapture(index)`` stand-in) that delivers 3 frames, then
+    none if its index is in ``gone``: unplugged."""
+
+    gone: tuple[int, ...] = (0, 1)
+
+    def __init__(self, index: int, *args: Any) -> None:
+        self.index, self.n = index, 0
+        rng = np.random.default_rng(0)
+        left = cv2.GaussianBlur(rng.integers(0, 255, (48, 64, 3), dtype=np.uint8), (7, 7), 2.0)
+        self.frame = left if index == 0 else np.roll(left, -2, axis=1)
+
+    def isOpened(self) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        self.n += 1
+        return self.n <= 3 or self.index not in self.gone
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, self.frame.copy()
+
+    def get(self, prop: int) -> float:
+        return {cv2.CAP_PROP_FRAME_WIDTH: 64.0, cv2.CAP_PROP_FRAME_HEIGHT: 48.0}.get(prop, 0.0)
+
+    def set(self, prop: int, value: float) -> bool:
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+@pytest.mark.parametrize("gone", [(0,), (0, 1)])
+def test_capture_of_a_camera_that_stops_delivering_fails_and_keeps_its_pairs(
+    gone: tuple[int, ...],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A camera has no end: ``capture`` of two unplugged ones said "3 pairs saved (end of
+    stream)", exit 0, as of two videos read to their end (of one, its reason, exit 0 too),
+    where ``stream`` fails (2fda8ab). It fails as ``stream`` does, exit 2, the pairs kept."""
+    from stereovision.cli import main
+
+    monkeypatch.setattr(_UnpluggedCamera, "gone", gone)
+    monkeypatch.setattr(cv2, "VideoCapture", _UnpluggedCamera)
+    out = tmp_path / "pairs"
+    assert main(["capture", "--left", "0", "--right", "1", "-o", str(out)]) == 2
+    said = "left source camera 0 stopped delivering frames after 3 (disconnected?); " + (
+        "the right source still had frames"
+        if gone == (0,)
+        else "right source camera 1 stopped delivering frames after 3 (disconnected?)"
+    )
+    err = capsys.readouterr().err
+    assert err.splitlines()[-1] == (
+        f"stereovision: error: {said}; 3 pairs were saved in {out} and are kept"
+    )
+    assert sorted(p.name for p in out.iterdir()) == [
+        f"{side}_{i:04d}.png" for side in ("left", "right") for i in (1, 2, 3)
+    ]

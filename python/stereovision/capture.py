@@ -2681,7 +2681,9 @@ def capture(
     count : int, optional
         Pairs to save. Without it, capture runs until a source ends (normal for files); when
         one ends before the other, or a video file before the frames its header announces
-        (truncated), :attr:`CaptureResult.ended` says so (the CLI prints it).
+        (truncated), :attr:`CaptureResult.ended` says so (the CLI prints it). A camera device
+        has no end: one that stops delivering (unplugged) raises :class:`SourceError`, its
+        message saying the pairs saved, which are kept.
     chessboard : tuple of int or str, optional
         Pattern (``(9, 6)`` or ``"9x6"``): save only pairs with the board in both images and a
         new pose (:class:`ChessboardCollector`).
@@ -2783,7 +2785,9 @@ def capture(
         except SourceError as exc:
             # an end before any pair is an error, as in `stream` (a bag whose frames found no
             # partner said "0 pairs saved (end of stream)" and exited 0)
-            if count is None and exc.end and camera.count > 0:
+            # a camera device has no end: one that stops delivering (unplugged) was said as
+            # "end of stream", exit 0, as a video's end, where stream fails
+            if count is None and exc.end and camera.count > 0 and not _device_ended(camera, exc):
                 ended = _end_reason(exc, saved, last_index)
                 break
             raise exc.with_message(f"{exc}; {kept_note()}") from exc
@@ -2941,6 +2945,21 @@ def _refuse_own_output(sources: Any, out: PathLike, ext: str, flag: str) -> None
             f"{flag} {out}: the source {looping} would read the pairs saved there as its next "
             "frames, without end; save them in another folder"
         )
+
+
+def _device_ended(camera: Any, exc: SourceError) -> bool:
+    """Whether the source(s) whose end ``exc`` reports include a camera device (an index, or
+    its node as StereoCamera knew it at the open: ``/dev/video0``, a ``/dev/v4l/by-id`` link):
+    a file or sequence ends, a device that stops delivering was lost."""
+    sides = ("left", "right") if exc.side in (None, "both") else (exc.side,)
+    device = getattr(camera, "_device", None)
+    if isinstance(device, dict):
+        # an index alone was taken for a device: /dev/video0 unplugged ended as a file does
+        return any(device.get(side, False) for side in sides)
+    sources = getattr(camera, "sources", None)
+    if not isinstance(sources, dict):
+        return False
+    return any(isinstance(sources.get(side), (int, np.integer)) for side in sides)
 
 
 def _end_reason(exc: SourceError, saved: list[tuple[Path, Path]], last_index: int) -> str:

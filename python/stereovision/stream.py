@@ -47,6 +47,7 @@ from stereovision.capture import (
     StereoCamera,
     StereoFrame,
     _describe_source,
+    _device_ended,
     add_source_args,
     check_read_timeout,
     cli_read_timeout,
@@ -575,21 +576,6 @@ def _pairs(
             filtered=filtered,
         )
         n += 1
-
-
-def _device_ended(camera: Any, exc: SourceError) -> bool:
-    """Whether the source(s) whose end ``exc`` reports include a camera device (an index, or
-    its node as StereoCamera knew it at the open: ``/dev/video0``, a ``/dev/v4l/by-id`` link):
-    a file or sequence ends, a device that stops delivering was lost."""
-    sides = ("left", "right") if exc.side in (None, "both") else (exc.side,)
-    device = getattr(camera, "_device", None)
-    if isinstance(device, dict):
-        # an index alone was taken for a device: /dev/video0 unplugged ended as a file does
-        return any(device.get(side, False) for side in sides)
-    sources = getattr(camera, "sources", None)
-    if not isinstance(sources, dict):
-        return False
-    return any(isinstance(sources.get(side), (int, np.integer)) for side in sides)
 
 
 def _media_period_ns(camera: Any) -> int | None:
