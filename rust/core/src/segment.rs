@@ -331,7 +331,11 @@ fn median(v: &mut [f32]) -> f32 {
 /// the result does not depend on the thread count.
 ///
 /// A table that cannot be allocated is [`OutOfMemory`](crate::CoreError::OutOfMemory)
-/// (unchecked, it aborted the process).
+/// (unchecked, it aborted the process); a map of more than [`MAX_PIXELS`] pixels (or rows
+/// longer than [`MAX_SIDE`]) is [`TooLarge`](crate::CoreError::TooLarge).
+///
+/// [`MAX_PIXELS`]: crate::image::MAX_PIXELS
+/// [`MAX_SIDE`]: crate::image::MAX_SIDE
 ///
 /// # Panics
 /// If `labels.len() != disp.len()` or a label is not below it (labels as the segment functions
@@ -354,6 +358,10 @@ pub fn plane_fill(
     if disp.is_empty() || w == 0 {
         return Ok(PlaneFillStats::default());
     }
+    // Pixels are listed (`order`, the fills) and counted per segment in u32: past u32::MAX
+    // pixels they wrapped. The binding checks the shape before calling; a Rust caller reaches
+    // this alone. `div_ceil`: a last row cut short still counts (w * h >= the length).
+    crate::image::check_index_range(w, disp.len().div_ceil(w))?;
     let n_seg = labels.iter().max().map_or(0, |&m| m as usize + 1);
     assert!(
         n_seg <= labels.len(),
@@ -1258,6 +1266,71 @@ pub(crate) mod tests {
             changed > 50 && filled > 200,
             "{changed} segments, {filled} holes"
         );
+    }
+
+    /// A zero-filled, never-touched private mapping of `len` values that reserves no memory
+    /// (`MAP_NORESERVE`): a slice longer than u32 counts, for a guard that must refuse it before
+    /// reading it. `None` where the system will not map it (strict overcommit).
+    #[cfg(target_os = "linux")]
+    pub(crate) struct Unbacked<T> {
+        ptr: *mut T,
+        len: usize,
+    }
+
+    #[cfg(target_os = "linux")]
+    extern "C" {
+        fn mmap(addr: *mut u8, len: usize, prot: i32, flags: i32, fd: i32, off: i64) -> *mut u8;
+        fn munmap(addr: *mut u8, len: usize) -> i32;
+    }
+
+    #[cfg(target_os = "linux")]
+    impl<T: crate::alloc::ZeroBits> Unbacked<T> {
+        pub(crate) fn new(len: usize) -> Option<Self> {
+            const PROT_RW: i32 = 0x1 | 0x2;
+            const FLAGS: i32 = 0x02 | 0x20 | 0x4000; // MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE
+            let bytes = len.checked_mul(std::mem::size_of::<T>())?;
+            // SAFETY: a fresh anonymous mapping; the result is checked below.
+            let p = unsafe { mmap(std::ptr::null_mut(), bytes, PROT_RW, FLAGS, -1, 0) };
+            (p as isize != -1 && !p.is_null()).then(|| Unbacked { ptr: p.cast(), len })
+        }
+
+        pub(crate) fn slice(&mut self) -> &mut [T] {
+            // SAFETY: `len` page-aligned, zero-filled values (valid by `ZeroBits`), owned here.
+            unsafe { std::slice::from_raw_parts_mut(self.ptr, self.len) }
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    impl<T> Drop for Unbacked<T> {
+        fn drop(&mut self) {
+            // SAFETY: the mapping made by `new`, unmapped once.
+            unsafe { munmap(self.ptr.cast(), self.len * std::mem::size_of::<T>()) };
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn plane_fill_refuses_maps_past_its_32_bit_pixel_numbers() {
+        // It lists pixels and counts them per segment in u32 and had no guard of its own (the
+        // binding checks first): 2^32 pixels of one segment overflowed its count (a panic in a
+        // debug build, a wrapped count in release). Refused from the length, before reading.
+        let n = crate::image::MAX_PIXELS + 1;
+        let (Some(mut d), Some(mut l)) = (Unbacked::<f32>::new(n), Unbacked::<u32>::new(n)) else {
+            eprintln!("skipped: the system maps no 16 GiB without reserving it");
+            return;
+        };
+        let (d, l) = (d.slice(), l.slice());
+        for (w, h) in [(1 << 16, 1 << 16), (3, n.div_ceil(3)), (1, n), (n, 1)] {
+            assert_eq!(
+                plane_fill(d, l, w, 3, 1.0, 0.0, 9.0),
+                Err(crate::CoreError::TooLarge {
+                    width: w,
+                    height: h,
+                    max_pixels: crate::image::MAX_PIXELS,
+                }),
+                "{w}x{h}"
+            );
+        }
     }
 
     #[test]
