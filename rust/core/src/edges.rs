@@ -12,7 +12,7 @@
 use rayon::prelude::*;
 
 use crate::alloc::{try_zeroed, ZeroBits};
-use crate::error::Result;
+use crate::error::{CoreError, Result};
 use crate::fill::fill_row;
 
 /// Thresholds of [`fattened`].
@@ -30,7 +30,11 @@ pub struct FattenParams {
 /// `guide` image of the same size: marked along the rows or along the columns (module docs).
 /// Rows (and columns) run in parallel, each independent of the others. A failed allocation of
 /// an image-sized buffer is [`OutOfMemory`](crate::CoreError::OutOfMemory) (a `vec!` aborted
-/// the process).
+/// the process); a `w x h` past `usize` is
+/// [`InvalidParameter`](crate::CoreError::InvalidParameter) `shape`.
+///
+/// # Panics
+/// If `d` or `guide` does not hold `w * h` values.
 pub fn fattened(
     d: &[f32],
     guide: &[f32],
@@ -38,9 +42,14 @@ pub fn fattened(
     h: usize,
     p: &FattenParams,
 ) -> Result<Vec<bool>> {
-    assert_eq!(d.len(), w * h, "d must hold w * h values");
-    assert_eq!(guide.len(), w * h, "guide must hold w * h values");
-    let mut out = try_zeroed::<bool>(w * h, "the fattened-edge check's marks")?;
+    // Unchecked, the product wrapped: a debug build panicked, a release build took a
+    // 2^32 x 2^32 shape with empty buffers as 0 pixels and returned an empty mask.
+    let n = w
+        .checked_mul(h)
+        .ok_or_else(|| CoreError::param("shape", format!("{w} x {h} pixels overflow usize")))?;
+    assert_eq!(d.len(), n, "d must hold w * h values");
+    assert_eq!(guide.len(), n, "guide must hold w * h values");
+    let mut out = try_zeroed::<bool>(n, "the fattened-edge check's marks")?;
     if w == 0 || h == 0 {
         return Ok(out);
     }
@@ -220,6 +229,27 @@ mod tests {
                 want
             );
         }
+    }
+
+    #[test]
+    fn a_shape_past_usize_is_an_error() {
+        // w * h was unchecked: it panicked ("attempt to multiply with overflow") in a debug
+        // build, and in release 2^32 x 2^32 wrapped to 0 pixels: an empty mask, Ok.
+        for (w, h) in [(usize::MAX, 2), (1 << 32, 1 << 32), (2, usize::MAX / 2 + 1)] {
+            let e = fattened(&[], &[], w, h, &P).unwrap_err();
+            assert_eq!(
+                e,
+                CoreError::param("shape", format!("{w} x {h} pixels overflow usize"))
+            );
+        }
+        assert_eq!(
+            fattened(&[], &[], 1 << 32, 1 << 32, &P)
+                .unwrap_err()
+                .to_string(),
+            "invalid parameter `shape`: 4294967296 x 4294967296 pixels overflow usize"
+        );
+        // At the edge of usize no overflow: an empty shape is an empty mask.
+        assert_eq!(fattened(&[], &[], usize::MAX, 0, &P), Ok(Vec::new()));
     }
 
     #[test]
