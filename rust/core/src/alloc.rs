@@ -319,6 +319,33 @@ pub fn try_concat<T>(parts: Vec<Vec<T>>, what: &'static str) -> Result<Vec<T>> {
     Ok(v)
 }
 
+/// `it.collect::<Result<Vec<T>>>()` of a parallel iterator of known length into a vector
+/// allocated at once, checked: [`CoreError::OutOfMemory`] (a `collect` aborts the process when
+/// it cannot allocate). An item's error is returned instead of the vector (one of them, as
+/// `collect` returns one); the other items are still computed.
+pub fn try_par_collect<T, I>(it: I, what: &'static str) -> Result<Vec<T>>
+where
+    T: Send + Default,
+    I: rayon::iter::IndexedParallelIterator<Item = Result<T>>,
+{
+    use rayon::iter::IndexedParallelIterator;
+    let mut v = Vec::new();
+    try_reserve_len(&mut v, it.len(), what)?;
+    let failed = Mutex::new(None);
+    it.map(|r| {
+        r.unwrap_or_else(|e| {
+            let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+            f.get_or_insert(e);
+            T::default()
+        })
+    })
+    .collect_into_vec(&mut v); // into the reserved room: no reallocation
+    match failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        Some(e) => Err(e),
+        None => Ok(v),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -363,6 +390,22 @@ mod tests {
         assert_eq!(
             try_concat(Vec::<Vec<u8>>::new(), "d").unwrap(),
             Vec::<u8>::new()
+        );
+        use rayon::prelude::*;
+        let items = |n: usize| (0..n).into_par_iter().map(|i| Ok(vec![i; i % 3]));
+        assert!(matches!(
+            try_par_collect(items(1 << 60), "p"),
+            Err(CoreError::OutOfMemory { what: "p", .. })
+        ));
+        let want: Vec<Vec<usize>> = (0..1000).map(|i| vec![i; i % 3]).collect();
+        assert_eq!(try_par_collect(items(1000), "p").unwrap(), want);
+        let failing = (0..1000usize).into_par_iter().map(|i| match i {
+            700 => Err(CoreError::oom(7, "an item")),
+            _ => Ok(vec![i]),
+        });
+        assert_eq!(
+            try_par_collect(failing, "p"),
+            Err(CoreError::oom(7, "an item"))
         );
     }
 

@@ -15,7 +15,9 @@ use rayon::prelude::*;
 
 use super::rtable::{ght_vote_rows, voters, RTable, RowIndex};
 use super::tracking::{wrap_angle, Segment};
-use crate::alloc::{try_collect, try_concat, try_filled, try_grow, try_reserve_len, try_zeroed};
+use crate::alloc::{
+    try_collect, try_concat, try_filled, try_grow, try_par_collect, try_reserve_len, try_zeroed,
+};
 use crate::error::Result;
 use crate::matching::hopfield::{run_dynamics, Csr};
 
@@ -79,14 +81,17 @@ pub fn candidates(
         }
     }
     let tol = (p.seg_theta_tol_deg as f64).to_radians();
-    let right_voters: Vec<Vec<(i32, i32, u32)>> = right
-        .par_iter()
-        .map(|s| voters(&s.pixels, theta_r, w, p.n_bins))
-        .collect::<Result<_>>()?;
-    let per: Vec<Vec<Candidate>> = left
-        .par_iter()
-        .enumerate()
-        .map_init(Vec::<u32>::new, |acc, (ia, a)| -> Result<Vec<Candidate>> {
+    // The lists of lists (one per right, one per left segment) allocated checked too: a
+    // rayon `collect` aborted the process when it could not allocate.
+    let right_voters: Vec<Vec<(i32, i32, u32)>> = try_par_collect(
+        right
+            .par_iter()
+            .map(|s| voters(&s.pixels, theta_r, w, p.n_bins)),
+        "the MCGM matcher's voters per right segment",
+    )?;
+    let per = left.par_iter().enumerate().map_init(
+        Vec::<u32>::new,
+        |acc, (ia, a)| -> Result<Vec<Candidate>> {
             let Some((lo, hi)) = window[ia] else {
                 return Ok(Vec::new());
             };
@@ -158,8 +163,9 @@ pub fn candidates(
             out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.right.cmp(&y.right)));
             out.truncate(p.k_cand);
             Ok(out)
-        })
-        .collect::<Result<_>>()?;
+        },
+    );
+    let per = try_par_collect(per, "the MCGM matcher's candidates per left segment")?;
     try_concat(per, "the MCGM matcher's candidate pairs")
 }
 

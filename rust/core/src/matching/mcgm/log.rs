@@ -10,7 +10,7 @@
 // Row kernels index equally long rows in lockstep; index loops are the form LLVM vectorises.
 #![allow(clippy::needless_range_loop)]
 
-use crate::alloc::try_zeroed;
+use crate::alloc::{try_reserve_len, try_zeroed};
 use crate::error::Result;
 use crate::image::Image;
 use crate::parallel::for_each_row;
@@ -110,15 +110,26 @@ pub fn log_filter(img: &Image, sigma: f32) -> Result<Vec<f32>> {
     // Row passes: hg = I *_x g, ha = I *_x a.
     let mut hg = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
     let mut ha = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
+    // A row's padded copy is allocated checked (`with_capacity` aborted the process); the
+    // first failure is recorded and returned before the column pass.
+    let failed = std::sync::Mutex::new(None);
     crate::parallel::for_each_row2(&mut hg, &mut ha, w, |y, og, oa| {
         let src = &img.data[y * w..(y + 1) * w];
         // The padded row: reflected borders around a copy of the row (no reflect per pixel).
-        let mut p: Vec<f32> = Vec::with_capacity(w + 2 * r);
+        let mut p: Vec<f32> = Vec::new();
+        if let Err(e) = try_reserve_len(&mut p, w + 2 * r, "a LoG row of the MCGM matcher") {
+            let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+            f.get_or_insert(e);
+            return;
+        }
         p.extend((-(r as isize)..0).map(|i| src[reflect(i, w)]));
         p.extend_from_slice(src);
         p.extend((w as isize..(w + r) as isize).map(|i| src[reflect(i, w)]));
         row_pass(&p, &g, &a, og, oa);
     });
+    if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
     // Column pass: L = ha *_y g + hg *_y a.
     let mut out = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
     for_each_row(&mut out, w, |y, o| {

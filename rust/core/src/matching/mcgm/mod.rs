@@ -26,6 +26,7 @@ mod tests;
 
 use rayon::prelude::*;
 
+use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
 use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};
 use crate::simd::simd_fn;
@@ -431,11 +432,14 @@ pub fn channel_curves(
     let zc = zero_crossings(&log, w, h)?;
     let tp = p.track_params(sigma);
     let curves = track(&zc, &tp)?;
-    let rtables = curves
-        .segments
-        .par_iter()
-        .map(|s| build_rtable(s, &zc.theta, w, p.cand.n_bins))
-        .collect::<Result<_>>()?;
+    // One per segment: the list allocated checked (a `collect` aborted the process).
+    let rtables = crate::alloc::try_par_collect(
+        curves
+            .segments
+            .par_iter()
+            .map(|s| build_rtable(s, &zc.theta, w, p.cand.n_bins)),
+        "the MCGM matcher's R-tables per segment",
+    )?;
     Ok(ChannelCurves {
         sigma,
         scale,
@@ -1412,8 +1416,8 @@ fn area_ok(left: &Image, right: &Image, m: &Match, tol: f32) -> bool {
 }
 
 /// Indices of `matches` by the row, then the column, of the rounded left pixel (ties in index
-/// order; non-finite positions last).
-fn raster_order(matches: &[Match]) -> Vec<u32> {
+/// order; non-finite positions last). A failed allocation is [`CoreError::OutOfMemory`].
+fn raster_order(matches: &[Match]) -> Result<Vec<u32>> {
     let key = |m: &Match| -> u64 {
         if !(m.xl.is_finite() && m.yl.is_finite()) {
             return u64::MAX;
@@ -1422,14 +1426,21 @@ fn raster_order(matches: &[Match]) -> Vec<u32> {
         let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
         ((y as u32 ^ 0x8000_0000) as u64) << 32 | (x as u32 ^ 0x8000_0000) as u64
     };
-    let mut keyed: Vec<(u64, u32)> = matches
-        .iter()
-        .enumerate()
-        .map(|(i, m)| (key(m), i as u32))
-        .collect();
+    let mut keyed = try_collect(
+        matches.len(),
+        matches.iter().enumerate().map(|(i, m)| (key(m), i as u32)),
+        FILTER_LISTS,
+    )?;
     keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
+    try_collect(keyed.len(), keyed.iter().map(|&(_, i)| i), FILTER_LISTS)
 }
+
+/// What [`edge_filters`]' per-match lists are called in an
+/// [`OutOfMemory`](CoreError::OutOfMemory).
+const FILTER_LISTS: &str = "the MCGM matcher's edge-filter lists";
+
+/// Most matches [`edge_filters`] takes: it numbers them in u32.
+pub const MAX_FILTER_MATCHES: usize = u32::MAX as usize;
 
 /// Counts of [`edge_filters`]' survivors after each step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -1446,6 +1457,10 @@ pub struct FilterCounts {
 /// `disc_tol` px), then the area check ([`FilterParams::zncc_check`]). `range` is the
 /// searched disparity range (`sides_best`). Returns the kept flags and the counts after the
 /// first two filters.
+///
+/// More than [`MAX_FILTER_MATCHES`] matches is [`CoreError::InvalidParameter`] `matches`; a
+/// failed allocation of a list that grows with the matches or the rows is
+/// [`CoreError::OutOfMemory`] (they were `vec!`s and `collect`s: the process aborted).
 pub fn edge_filters(
     left: &Image,
     right: &Image,
@@ -1458,17 +1473,28 @@ pub fn edge_filters(
     // Positions are compared with `w as i32`, rows and match numbers counted in u32: the
     // binding's mcgm_filter reaches this without mcgm_match's check.
     crate::image::check_index_range(left.width, left.height)?;
+    if matches.len() > MAX_FILTER_MATCHES {
+        return Err(CoreError::param(
+            "matches",
+            format!(
+                "{} matches: at most {MAX_FILTER_MATCHES} (they are numbered in 32 bits)",
+                matches.len()
+            ),
+        ));
+    }
     let (w, h) = left.size();
     // Both per-match checks run in raster order of the left pixel: neighbouring checks read
     // the same image rows (in match order, the windows' rows were mostly cache misses).
-    let order = raster_order(matches);
-    let mut keep = vec![false; matches.len()];
+    let order = raster_order(matches)?;
+    let mut keep = try_filled(matches.len(), false, FILTER_LISTS)?;
     let scale =
         left.data
             .iter()
             .chain(&right.data)
             .fold(0.0f32, |a, &v| if v.abs() > a { v.abs() } else { a });
-    let ok: Vec<bool> = order
+    let mut ok: Vec<bool> = Vec::new();
+    try_reserve_len(&mut ok, order.len(), FILTER_LISTS)?;
+    order
         .par_iter()
         .map_init(
             || SidesScratch {
@@ -1484,7 +1510,7 @@ pub fn edge_filters(
                     && (!f.sides || sides_ok(left, right, m, f, range, scratch))
             },
         )
-        .collect();
+        .collect_into_vec(&mut ok); // into the reserved room: no reallocation
     for (&i, o) in order.iter().zip(ok) {
         keep[i as usize] = o;
     }
@@ -1497,21 +1523,24 @@ pub fn edge_filters(
             let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
             (x >= 0 && y >= 0 && x < w as i32 && y < h as i32).then_some((x, y))
         };
-        let cell: Vec<Option<(i32, i32)>> = matches
-            .iter()
-            .zip(&keep)
-            .map(|(m, &k)| if k { pos(m) } else { None })
-            .collect();
-        let mut start = vec![0u32; h + 1];
+        let cell = try_collect(
+            matches.len(),
+            matches
+                .iter()
+                .zip(&keep)
+                .map(|(m, &k)| if k { pos(m) } else { None }),
+            FILTER_LISTS,
+        )?;
+        let mut start = try_zeroed::<u32>(h + 1, FILTER_LISTS)?;
         for &(_, y) in cell.iter().flatten() {
             start[y as usize + 1] += 1;
         }
         for i in 1..start.len() {
             start[i] += start[i - 1];
         }
-        let mut fill = start.clone();
+        let mut fill = try_collect(start.len(), start.iter().copied(), FILTER_LISTS)?;
         // (column, match index) per row.
-        let mut items = vec![(0i32, 0u32); start[h] as usize];
+        let mut items = try_filled(start[h] as usize, (0i32, 0u32), FILTER_LISTS)?;
         for (i, c) in cell.iter().enumerate() {
             if let Some((x, y)) = *c {
                 items[fill[y as usize] as usize] = (x, i as u32);
@@ -1521,7 +1550,9 @@ pub fn edge_filters(
         for y in 0..h {
             items[start[y] as usize..start[y + 1] as usize].sort_unstable();
         }
-        let drop: Vec<bool> = matches
+        let mut drop: Vec<bool> = Vec::new();
+        try_reserve_len(&mut drop, matches.len(), FILTER_LISTS)?;
+        matches
             .par_iter()
             .enumerate()
             .map(|(i, m)| {
@@ -1548,18 +1579,20 @@ pub fn edge_filters(
                 }
                 false
             })
-            .collect();
+            .collect_into_vec(&mut drop);
         for (k, d) in keep.iter_mut().zip(drop) {
             *k &= !d;
         }
     }
     let n_disc = keep.iter().filter(|&&k| k).count();
     if f.zncc_check {
-        let live: Vec<u32> = order.into_iter().filter(|&i| keep[i as usize]).collect();
-        let ok: Vec<bool> = live
-            .par_iter()
+        let mut live = order; // in place: no allocation
+        live.retain(|&i| keep[i as usize]);
+        let mut ok: Vec<bool> = Vec::new();
+        try_reserve_len(&mut ok, live.len(), FILTER_LISTS)?;
+        live.par_iter()
             .map(|&i| area_ok(left, right, &matches[i as usize], f.zncc_tol))
-            .collect();
+            .collect_into_vec(&mut ok);
         for (&i, o) in live.iter().zip(ok) {
             keep[i as usize] = o;
         }
@@ -1684,8 +1717,8 @@ fn match_channel(
 /// Drops exact repeats of a correspondence (the same `xl, yl, xr, yr` bits), keeping the first:
 /// two curve pixels on one row can carry the same crossing (a vertical-only mark takes its
 /// neighbour's horizontal crossing), and the pair would otherwise be reported, and counted,
-/// twice.
-fn drop_repeats(ms: &mut Vec<Match>) {
+/// twice. A failed allocation of its lists is [`CoreError::OutOfMemory`].
+fn drop_repeats(ms: &mut Vec<Match>) -> Result<()> {
     let key = |m: &Match| {
         (
             m.yl.to_bits(),
@@ -1694,9 +1727,10 @@ fn drop_repeats(ms: &mut Vec<Match>) {
             m.yr.to_bits(),
         )
     };
-    let mut order: Vec<u32> = (0..ms.len() as u32).collect();
+    const WHAT: &str = "the MCGM matcher's repeat check";
+    let mut order = try_collect(ms.len(), 0..ms.len() as u32, WHAT)?;
     order.sort_unstable_by_key(|&i| (key(&ms[i as usize]), i));
-    let mut keep = vec![true; ms.len()];
+    let mut keep = try_filled(ms.len(), true, WHAT)?;
     for pair in order.windows(2) {
         if key(&ms[pair[0] as usize]) == key(&ms[pair[1] as usize]) {
             keep[pair[1] as usize] = false;
@@ -1704,6 +1738,7 @@ fn drop_repeats(ms: &mut Vec<Match>) {
     }
     let mut k = keep.into_iter();
     ms.retain(|_| k.next().unwrap_or(true));
+    Ok(())
 }
 
 /// The MCGM channel end to end (see the module docs).
@@ -1805,7 +1840,7 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
             taken[row + x] = true;
         }
     }
-    drop_repeats(&mut combined);
+    drop_repeats(&mut combined)?;
     let (keep, counts) = edge_filters(
         left,
         right,

@@ -15,7 +15,7 @@ use crate::alloc::{try_collect, try_filled, try_zeroed};
 use crate::error::Result;
 
 /// R-table of one segment in CSR form over `n_bins` orientation bins.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct RTable {
     /// `offsets[b]..offsets[b + 1]` index the entries of bin `b` (`n_bins + 1` values).
     pub offsets: Vec<u32>,

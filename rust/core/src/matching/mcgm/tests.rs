@@ -805,7 +805,7 @@ fn repeated_correspondences_are_dropped_keeping_the_first() {
         m(5.5, 1.5, 4.0),
         m(7.0, 2.0, 5.0),
     ];
-    drop_repeats(&mut ms);
+    drop_repeats(&mut ms).unwrap();
     let scores: Vec<f32> = ms.iter().map(|m| m.score).collect();
     assert_eq!(scores, [1.0, 2.0, 4.0]);
 }
@@ -2839,4 +2839,143 @@ fn segment_lists_too_large_to_allocate_are_an_error() {
         let want = format!("child: error: out of memory: {want}");
         assert!(stdout.contains(&want), "{case}: {want} not in {stdout}");
     }
+}
+
+/// Run by [`match_and_row_lists_too_large_to_allocate_are_an_error`] in a child process, one
+/// case (`SV_MCGM_OOM_CASE`) under an address-space limit a little above what is mapped: a
+/// list that grows with the matches, the right segments or an image row, larger than the room
+/// left while the buffers before it fit.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of match_and_row_lists_too_large_to_allocate_are_an_error"]
+fn match_and_row_lists_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let case = std::env::var("SV_MCGM_OOM_CASE").unwrap();
+    let limit = |extra: usize| {
+        rayon::join(|| (), || ()); // the pool's thread started before the limit
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + extra);
+    };
+    let r = match case.as_str() {
+        // 2^21 matches (48 MiB, built before the limit): their raster-order keys (16 bytes
+        // each, 32 MiB) do not fit in 16 MiB.
+        "edge_filters" => {
+            let m = Match {
+                xl: 1.0,
+                yl: 1.0,
+                xr: 0.0,
+                yr: 1.0,
+                score: 1.0,
+                channel: 0,
+            };
+            let ms = vec![m; 1 << 21];
+            let img = blobs(16, 16, 0.0);
+            let f = McgmParams::default().filters;
+            limit(16 << 20);
+            edge_filters(&img, &img, &ms, &f, (0, 8)).map(|(k, _)| k.len())
+        }
+        // 2^20 right segments with no pixels (56 MiB, before the limit): the row lists fit
+        // in 16 MiB, their list of voters (24 bytes a segment, 24 MiB) does not.
+        "voters_list" => {
+            let seg = Segment {
+                pixels: Vec::new(),
+                centroid: (0.0, 0.0),
+                x_min: 0,
+                x_max: 0,
+                y_min: 0,
+                y_max: 0,
+                mean_theta: 0.0,
+            };
+            let right = vec![seg; 1 << 20];
+            let cp = McgmParams::default().cand;
+            limit(16 << 20);
+            graph::candidates(&[], &[], &right, &[0.0], 1, 1, &[], &cp).map(|c| c.len())
+        }
+        // A 2^22 x 1 image (16 MiB, before the limit): the two row-pass planes (32 MiB) fit
+        // in 40 MiB, a row's padded copy (16 MiB more) does not.
+        "log_row" => {
+            let img = Image {
+                width: 1 << 22,
+                height: 1,
+                data: vec![0.5; 1 << 22],
+            };
+            limit(40 << 20);
+            log_filter(&img, 1.0).map(|l| l.len())
+        }
+        // A 2^22 x 3 LoG (48 MiB, before the limit): the four maps (156 MiB) fit in 164 MiB,
+        // a band's candidate columns (16 MiB more) do not.
+        "zc_row" => {
+            let (w, h) = (1usize << 22, 3);
+            let l: Vec<f32> = (0..w * h)
+                .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+                .collect();
+            limit(164 << 20);
+            zero_crossings(&l, w, h).map(|z| z.mark.len())
+        }
+        other => panic!("no case {other}"),
+    };
+    match r {
+        Ok(n) => println!("child: {case} {n}"),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn match_and_row_lists_too_large_to_allocate_are_an_error() {
+    // edge_filters' per-match lists, the candidate search's list of voters per right segment,
+    // the LoG's padded row and the zero crossings' row scratch were vec!/collect/
+    // with_capacity: a failed allocation aborted the process (SIGABRT).
+    for (case, want) in [
+        (
+            "edge_filters",
+            "the MCGM matcher's edge-filter lists needs 32.00 MiB (33554432 bytes)",
+        ),
+        (
+            "voters_list",
+            "the MCGM matcher's voters per right segment needs 24.00 MiB (25165824 bytes)",
+        ),
+        (
+            "log_row",
+            "a LoG row of the MCGM matcher needs 16.00 MiB (16777248 bytes)",
+        ),
+        (
+            "zc_row",
+            "a zero-crossing row buffer of the MCGM matcher needs 16.00 MiB (16777220 bytes)",
+        ),
+    ] {
+        let stdout = crate::segment::tests::run_oom_child_with(
+            "matching::mcgm::tests::match_and_row_lists_under_a_memory_limit",
+            Some(("SV_MCGM_OOM_CASE", case)),
+        );
+        let want = format!("child: error: out of memory: {want}");
+        assert!(stdout.contains(&want), "{case}: {want} not in {stdout}");
+    }
+}
+
+// SAFETY: five f32 and a u8 (and padding): all-zero bits are a valid match.
+#[cfg(target_os = "linux")]
+unsafe impl crate::alloc::ZeroBits for Match {}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn edge_filters_refuses_more_matches_than_32_bit_numbers_reach() {
+    // It numbers matches in u32 (raster order, the rows' items): past u32::MAX they wrapped
+    // (and the binding's mcgm_filter reaches it directly). Refused from the count before any
+    // list is built; the matches are a never-touched mapping (96 GiB, reserving nothing).
+    let n = MAX_FILTER_MATCHES + 1;
+    let Some(mut ms) = crate::segment::tests::Unbacked::<Match>::new(n) else {
+        eprintln!("skipped: the system maps no 96 GiB without reserving it");
+        return;
+    };
+    let img = blobs(16, 16, 0.0);
+    let f = McgmParams::default().filters;
+    assert_eq!(
+        edge_filters(&img, &img, ms.slice(), &f, (0, 8)).map(|_| ()),
+        Err(CoreError::param(
+            "matches",
+            "4294967296 matches: at most 4294967295 (they are numbered in 32 bits)"
+        ))
+    );
 }

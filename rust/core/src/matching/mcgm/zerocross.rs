@@ -12,6 +12,8 @@ use crate::simd::simd_fn;
 
 /// Names the crossing planes in an out-of-memory error.
 const WHAT: &str = "a zero-crossing plane of the MCGM matcher";
+/// What a band's candidate columns are called in an [`OutOfMemory`](crate::CoreError::OutOfMemory).
+const ROW_SCRATCH: &str = "a zero-crossing row buffer of the MCGM matcher";
 
 /// Mark bit: the pixel holds a crossing found by the horizontal scan (along x).
 pub const ZC_H: u8 = 1;
@@ -66,6 +68,9 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
     let mut theta = try_zeroed::<f32>(n, WHAT)?;
     // (Images narrower or lower than 3 pixels have no interior: nothing is marked.)
     if w >= 3 && h >= 3 {
+        // A band's row scratch (4 bytes a column) allocated checked: a `vec!` aborted the
+        // process. The first failure is recorded and the maps are then not returned.
+        let failed = std::sync::Mutex::new(None);
         let band = w * ROWS_PER_TASK;
         mark.par_chunks_mut(band)
             .zip(xsub.par_chunks_mut(band))
@@ -76,7 +81,14 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
             )
             .enumerate()
             .for_each(|(b, ((mk, xs), (st, th)))| {
-                let mut cand: Vec<u32> = vec![0; w + 1];
+                let mut cand = match try_zeroed::<u32>(w + 1, ROW_SCRATCH) {
+                    Ok(c) => c,
+                    Err(e) => {
+                        let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+                        f.get_or_insert(e);
+                        return;
+                    }
+                };
                 let rows = mk
                     .chunks_mut(w)
                     .zip(xs.chunks_mut(w))
@@ -88,6 +100,9 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
                     }
                 }
             });
+        if let Some(e) = failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+            return Err(e);
+        }
     }
     Ok(ZeroCrossings {
         width: w,
