@@ -533,4 +533,36 @@ mod tests {
             ok(crate::segment::quantised_regions(&[], w, h, 1, 8, 0).map(|_| ()));
         }
     }
+
+    #[test]
+    fn public_sub_stages_refuse_images_past_32_bit_indices() {
+        // Public stages a Rust caller reaches alone (the binding checks the shape before
+        // select_points): they held columns, rows or pixel numbers in u32 unchecked. On the
+        // old code select_points and high_threshold returned Ok on these empty maps (or
+        // panicked: `tile * w` overflowed), zero_crossings overflowed `w * h` or tried to
+        // allocate the maps (16 GiB and more). Now TooLarge first, from the shape alone.
+        use crate::matching::{hopfield, mcgm};
+        for (w, h) in TOO_LARGE {
+            let too_large = Err(CoreError::TooLarge {
+                width: w,
+                height: h,
+                max_pixels: MAX_PIXELS,
+            });
+            let ip = hopfield::HopfieldParams::default().interest;
+            let r = hopfield::interest::select_points(&[], w, h, &ip);
+            assert_eq!(r.map(|_| ()), too_large, "select_points {w}x{h}");
+            let zc = mcgm::zerocross::ZeroCrossings {
+                width: w,
+                height: h,
+                mark: Vec::new(),
+                xsub: Vec::new(),
+                strength: Vec::new(),
+                theta: Vec::new(),
+            };
+            let r = mcgm::tracking::high_threshold(&zc, 0.5);
+            assert_eq!(r.map(|_| ()), too_large, "high_threshold {w}x{h}");
+            let r = mcgm::zerocross::zero_crossings(&[], w, h);
+            assert_eq!(r.map(|_| ()), too_large, "zero_crossings {w}x{h}");
+        }
+    }
 }

@@ -236,13 +236,17 @@ fn seg_max(seg: &[f32]) -> f32 {
 }
 
 /// Selection step of [`interest_points`] on a precomputed map (row bands in parallel, raster
-/// order). A failed allocation of the list is [`crate::CoreError::OutOfMemory`].
+/// order). A failed allocation of the list is [`crate::CoreError::OutOfMemory`]; a map past
+/// [`crate::image::check_index_range`] is [`crate::CoreError::TooLarge`].
 pub fn select_points(
     m: &[f32],
     w: usize,
     h: usize,
     p: &InterestParams,
 ) -> Result<Vec<InterestPoint>> {
+    // Points hold their column and row in u32: past the limit they wrapped (the binding
+    // checks the shape first; a Rust caller reaches this alone).
+    crate::image::check_index_range(w, h)?;
     if w == 0 {
         return Ok(Vec::new());
     }

@@ -52,9 +52,11 @@ pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
 
 /// Builds the R-table of `seg` (`theta`: normal directions of the image, `w`: its width). A
 /// failed allocation of its tables (24 bytes a pixel at the peak) is
-/// [`crate::CoreError::OutOfMemory`].
+/// [`crate::CoreError::OutOfMemory`]; an image past [`check_positions`]' limit is
+/// [`crate::CoreError::TooLarge`].
 pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Result<RTable> {
     const WHAT: &str = "an R-table of the MCGM matcher";
+    check_positions(theta, w)?;
     let mut counts = try_zeroed::<u32>(n_bins + 1, WHAT)?;
     let bins = try_collect(
         seg.pixels.len(),
@@ -87,6 +89,14 @@ pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Re
     })
 }
 
+/// Refuses an image (`theta`, `w` wide) whose pixel positions would not fit the i32 columns and
+/// rows of an R-table or a voter ([`crate::image::check_index_range`]): they wrapped silently
+/// (a pixel on row 2^31 of a 1-wide image became row -2^31). Once per call, not per pixel:
+/// every pixel indexes `theta`, so its row is below `ceil(len / w)`.
+fn check_positions(theta: &[f32], w: usize) -> Result<()> {
+    crate::image::check_index_range(w, theta.len().div_ceil(w.max(1)))
+}
+
 /// GHT comparison result: normalised peak and the vote-weighted translation `t = p - q`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ght {
@@ -100,13 +110,15 @@ pub struct Ght {
 /// A segment's pixels as voters of [`ght_vote`]: integer position and orientation bin of each
 /// (computed once per segment instead of once per comparison). `theta`: the image's normal
 /// directions, `w` its width. A failed allocation (12 bytes a pixel) is
-/// [`crate::CoreError::OutOfMemory`].
+/// [`crate::CoreError::OutOfMemory`]; an image past [`check_positions`]' limit is
+/// [`crate::CoreError::TooLarge`].
 pub fn voters(
     pixels: &[u32],
     theta: &[f32],
     w: usize,
     n_bins: usize,
 ) -> Result<Vec<(i32, i32, u32)>> {
+    check_positions(theta, w)?;
     let it = pixels.iter().map(|&q| {
         let (x, y) = ((q as usize % w) as i32, (q as usize / w) as i32);
         (x, y, theta_bin(theta[q as usize], n_bins) as u32)

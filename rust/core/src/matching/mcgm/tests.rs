@@ -2979,3 +2979,39 @@ fn edge_filters_refuses_more_matches_than_32_bit_numbers_reach() {
         ))
     );
 }
+
+#[cfg(target_os = "linux")]
+#[test]
+fn rtables_and_voters_refuse_positions_past_i32() {
+    // Both turn a pixel number into an i32 column and row with no check (public: a Rust
+    // caller reaches them alone): on the old code pixel 2^31 of a 1-wide image came back on
+    // row -2^31, Ok. `theta` is a never-touched mapping (8 GiB, reserving nothing).
+    let n = (1usize << 31) + 1;
+    let Some(mut theta) = crate::segment::tests::Unbacked::<f32>::new(n) else {
+        eprintln!("skipped: the system maps no 8 GiB without reserving it");
+        return;
+    };
+    let theta = theta.slice();
+    let seg = Segment {
+        pixels: vec![1 << 31],
+        centroid: (0.0, 0.0),
+        x_min: 0,
+        x_max: 0,
+        y_min: 0,
+        y_max: 0,
+        mean_theta: 0.0,
+    };
+    for (w, h) in [(1, n), (n, 1)] {
+        let too_large = Err(CoreError::TooLarge {
+            width: w,
+            height: h,
+            max_pixels: crate::image::MAX_PIXELS,
+        });
+        assert_eq!(voters(&seg.pixels, theta, w, 36).map(|_| ()), too_large);
+        assert_eq!(build_rtable(&seg, theta, w, 36).map(|_| ()), too_large);
+    }
+    // Within the limit (MAX_SIDE rows): the last pixel on row 2^31 - 2.
+    let last = [(1u32 << 31) - 2];
+    let v = voters(&last, &theta[..crate::image::MAX_SIDE], 1, 36).unwrap();
+    assert_eq!(v, [(0, i32::MAX - 1, 0)]);
+}

@@ -79,8 +79,11 @@ pub fn wrap_angle(d: f64) -> f64 {
 
 /// Seed threshold: the `q` quantile ("lower": sorted value at `floor(q (n - 1))`) of the
 /// strengths of marked pixels; 0 when nothing is marked. A failed allocation of the list of
-/// marked pixels (4 bytes each) is [`crate::CoreError::OutOfMemory`].
+/// marked pixels (4 bytes each) is [`crate::CoreError::OutOfMemory`]; an image past
+/// [`crate::image::check_index_range`] is [`crate::CoreError::TooLarge`] (as in [`track`]).
 pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> Result<f32> {
+    // The marked pixels are listed in u32: refused first, not wrapped.
+    crate::image::check_index_range(zc.width, zc.height)?;
     let n = zc.marked().count();
     let marked = try_collect(n, zc.marked().map(|i| i as u32), WHAT)?;
     marked_quantile(&marked, &zc.strength, q)

@@ -60,7 +60,11 @@ impl ZeroCrossings {
 /// Rows in parallel bands: every value of row `y` is a function of the LoG rows `y - 1..=y + 1`
 /// alone (the vertical scan's marks on row `y` come from the pairs `(y - 1, y)` and `(y, y + 1)`),
 /// so the maps are the same whatever the split.
+///
+/// An image past [`crate::image::check_index_range`] is [`crate::CoreError::TooLarge`].
 pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
+    // Candidate columns are u32 (and `w * h` was unchecked): refused first, not wrapped.
+    crate::image::check_index_range(w, h)?;
     let n = w * h;
     let mut mark = try_zeroed::<u8>(n, WHAT)?;
     let mut xsub = try_filled(n, f32::NAN, WHAT)?;
