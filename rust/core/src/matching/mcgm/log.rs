@@ -100,10 +100,23 @@ simd_fn! {
     }
 }
 
+/// Largest `sigma` of [`log_filter`] (px): the largest nominal channel the matcher takes.
+pub const MAX_SIGMA: f32 = 64.0;
+
 /// `L = I (*) K_sigma` (float32, same size as the image).
 ///
-/// A failed allocation of its planes is [`crate::CoreError::OutOfMemory`].
+/// A failed allocation of its planes is [`crate::CoreError::OutOfMemory`]; a `sigma` that is
+/// not in `(0, MAX_SIGMA]` is [`crate::CoreError::InvalidParameter`].
 pub fn log_filter(img: &Image, sigma: f32) -> Result<Vec<f32>> {
+    // The binding and the matcher bound sigma before calling; a Rust caller reaches this
+    // alone: an infinite sigma emptied the kernels (an index panic), 0 or NaN made them NaN
+    // (a NaN map, Ok), a huge one sized them (and the padded rows) past memory (an abort).
+    if !(sigma > 0.0 && sigma <= MAX_SIGMA) {
+        return Err(crate::CoreError::param(
+            "sigma",
+            format!("must lie in (0, {MAX_SIGMA}] px, got {sigma}"),
+        ));
+    }
     let (w, h) = img.size();
     let (g, a) = log_kernels(sigma);
     let r = g.len() / 2;

@@ -3015,3 +3015,25 @@ fn rtables_and_voters_refuse_positions_past_i32() {
     let v = voters(&last, &theta[..crate::image::MAX_SIDE], 1, 36).unwrap();
     assert_eq!(v, [(0, i32::MAX - 1, 0)]);
 }
+
+#[test]
+fn log_filter_refuses_a_sigma_outside_its_range() {
+    // Unchecked for a Rust caller: inf emptied the kernels and panicked indexing them, 0 and
+    // NaN gave a NaN map (Ok), a negative sigma ran on a 3-tap kernel, 1e9 sized the kernels
+    // past memory (an abort).
+    let img = blobs(20, 10, 0.0);
+    for sigma in [f32::INFINITY, 0.0, -1.0, f32::NAN, 1e9, 64.001] {
+        assert_eq!(
+            log_filter(&img, sigma),
+            Err(CoreError::param(
+                "sigma",
+                format!("must lie in (0, 64] px, got {sigma}")
+            )),
+            "{sigma}"
+        );
+    }
+    // The ends of the range still filter (a half-resolution channel goes below 0.3).
+    for sigma in [0.1, 64.0] {
+        assert_eq!(log_filter(&img, sigma).unwrap().len(), 200);
+    }
+}
