@@ -1432,7 +1432,8 @@ fn raster_order(matches: &[Match]) -> Result<Vec<u32>> {
         FILTER_LISTS,
     )?;
     keyed.sort_unstable();
-    try_collect(keyed.len(), keyed.iter().map(|&(_, i)| i), FILTER_LISTS)
+    // In place (the keys' buffer reused, not a second allocation).
+    Ok(keyed.into_iter().map(|(_, i)| i).collect())
 }
 
 /// What [`edge_filters`]' per-match lists are called in an
@@ -1486,7 +1487,7 @@ pub fn edge_filters(
     // Both per-match checks run in raster order of the left pixel: neighbouring checks read
     // the same image rows (in match order, the windows' rows were mostly cache misses).
     let order = raster_order(matches)?;
-    let mut keep = try_filled(matches.len(), false, FILTER_LISTS)?;
+    let mut keep = try_zeroed::<bool>(matches.len(), FILTER_LISTS)?;
     let scale =
         left.data
             .iter()
