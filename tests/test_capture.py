@@ -3940,6 +3940,15 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
         ("rtsp://u:1234?x@cam/0", "rtsp://u:***@cam/0"),
         ("rtsp://cam:554#a@b", "rtsp://cam:***@b"),
         ("rtsp://u:12?w@cam:554?x=a@b", "rtsp://u:***@b"),
+        # an IPv6 host's port, then a query holding an "@", is a query as a name's is: the
+        # ":" inside the brackets was taken for a user's, "rtsp://[:***@b" said
+        ("rtsp://[::1]:554?x=a@b", "rtsp://[::1]:554?x=a@b"),
+        (
+            "rtsp://[fe80::1%eth0]:554?mail=a@b&token=t",
+            "rtsp://[fe80::1%eth0]:554?mail=a@b&token=***",
+        ),
+        ("rtsp://[::1]?x=a@b", "rtsp://[::1]?x=a@b"),
+        ("rtsp://u:p?w@[::1]:554/0", "rtsp://u:***@[::1]:554/0"),
         # one URL is the whole source, spaces and all (a leading space too)
         ("http://cam/my video.avi?token=x", "http://cam/my video.avi?token=***"),
         (" http://cam/a b?token=x", " http://cam/a b?token=***"),

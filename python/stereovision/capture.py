@@ -405,7 +405,11 @@ _URL_PASSWORD = re.compile(
 #: part but is a host's port and then a query: ``rtsp://cam:554?x=a@b`` (nothing but digits
 #: before the "?", a key=value after it). A password such as ``1234?k=v`` is said in full
 #: (the one shape this reading leaks); ``u:a?key=b@``, ``u:1234?x@``, ``cam:554#a@`` stay hidden.
-_PORT_THEN_QUERY = re.compile(_SCHEME + r"[^/?#@:]*:\d{1,5}\?[^=@]*=")
+#: An IPv6 host (``[::1]``, its port optional) is read the same way: the ":" inside its brackets
+#: was taken for a user's, and ``rtsp://[::1]:554?x=a@b`` said ``rtsp://[:***@b``.
+_PORT_THEN_QUERY = re.compile(
+    _SCHEME + r"(?:[^/?#@:]*:\d{1,5}|\[[0-9A-Fa-f:.]*(?:%[^\]/?#@]*)?\](?::\d{1,5})?)\?[^=@]*="
+)
 #: A URL inside other text (a GStreamer pipeline's ``location=rtsp://...``): its scheme at
 #: the start or after a space, "=" or a quote; it ends at a space or a quote.
 _URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
@@ -459,7 +463,8 @@ def mask_url_secrets(source: str) -> str:
     password typed with a raw ``?`` or ``#`` (``admin:pa?ss@cam``) reads like the start of a
     query, and a leak is worse than too much hidden. One shape of that is read as a query: a
     host, a port (1 to 5 digits), ``?`` and a ``key=`` before the ``@`` (``cam:554?x=a@b``
-    is said as given); ``cam:554#a@b`` and ``u:1234?x@cam`` stay hidden.
+    is said as given; an IPv6 host's port may be left out: ``[::1]?x=a@b``); ``cam:554#a@b``
+    and ``u:1234?x@cam`` stay hidden.
 
     Examples
     --------
