@@ -5893,3 +5893,42 @@ def test_a_streams_password_is_not_said_when_it_does_not_open(monkeypatch, caplo
         VideoPair("http://admin:s3cret@cam/f_%03d.jpg", "rtsp://cam/1")
     assert str(err.value) == "cannot open camera 'http://admin:***@cam/f_%03d.jpg' (left)"
     assert "s3cret" not in caplog.text and "tok77" not in caplog.text
+
+
+def test_gui_main_as_the_command_ends_past_an_open_it_gave_up(monkeypatch, capsys):
+    """``python -m stereovision.gui --read-timeout 1e-300``: the open given up, its line said,
+    then the open came back out of OpenCV while the interpreter shut down: "terminate called
+    without an active exception" and exit 134 (1 of 5 runs), as ``stereovision capture`` did
+    before the CLI's ``main`` ended the process itself. ``gui.main`` now does as the CLI's."""
+    import os
+    import threading
+
+    import stereovision.gui as gui
+
+    class Ended(Exception):
+        pass
+
+    def exit_(status: int) -> None:
+        raise Ended(status)
+
+    release = threading.Event()
+
+    def given_up(_args: argparse.Namespace) -> Any:
+        # the open left in native code, as _open_within leaves it after its timeout
+        threading.Thread(target=release.wait, name="stereovision-gui-open", daemon=True).start()
+        raise ValueError("left source 'x' did not open within 1e-300 s")
+
+    monkeypatch.setattr(gui, "build_app", given_up)
+    monkeypatch.setattr(os, "_exit", exit_)
+    monkeypatch.setattr(sys, "argv", ["stereovision gui", "--no-browser"])
+    try:
+        with pytest.raises(Ended) as ended:
+            gui.main()
+        assert ended.value.args == (2,)
+        assert capsys.readouterr().err == (
+            "stereovision: error: left source 'x' did not open within 1e-300 s\n"
+        )
+        # given its argv (an in-process caller), it returns: the caller's process is its own
+        assert gui.main(["--no-browser"]) == 2
+    finally:
+        release.set()

@@ -2373,14 +2373,29 @@ def main(argv: Sequence[str] | None = None) -> int:
     slow camera given up).
     """
     status = _main(argv)
-    if argv is None and any(
-        t.name in _NATIVE_THREADS and t.is_alive() for t in threading.enumerate()
-    ):
+    if argv is None:
+        end_past_native_threads(status)
+    return status
+
+
+def end_past_native_threads(status: int) -> None:
+    """End the process with ``status`` (its output flushed) when a thread given up in OpenCV's
+    native code (:data:`_NATIVE_THREADS`) is still alive; return otherwise.
+
+    For a command's ``main`` run as the process's own command (``stereovision``, ``python -m
+    stereovision``, ``python -m stereovision.gui``): such a thread coming back out of OpenCV
+    while the interpreter shut down aborted the process (exit 134, not ``status``).
+
+    Parameters
+    ----------
+    status : int
+        The exit status the command returned.
+    """
+    if any(t.name in _NATIVE_THREADS and t.is_alive() for t in threading.enumerate()):
         for stream in (sys.stdout, sys.stderr):
             with contextlib.suppress(Exception):  # a closed pipe: nothing more to say
                 stream.flush()
         os._exit(status)
-    return status
 
 
 #: The daemon threads that may be left in OpenCV's native code, given up (a hung or slow

@@ -269,7 +269,23 @@ def add_cli(subparsers: Any) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m stereovision.gui``: as ``stereovision gui`` (errors: one line, exit 2)."""
+    """``python -m stereovision.gui``: as ``stereovision gui`` (errors: one line, exit 2).
+
+    Run as the process's own command (``argv`` None), it ends the process itself, as the CLI's
+    ``main`` does, when a camera's open or read it gave up is still in OpenCV
+    (``--read-timeout 1e-300``): that thread coming back out while the interpreter shut down
+    aborted the process, "terminate called without an active exception" and exit 134, not 2.
+    """
+    status = _main(argv)
+    if argv is None:
+        from stereovision.cli import end_past_native_threads
+
+        end_past_native_threads(status)
+    return status
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    """:func:`main`'s work: parse ``argv`` and run the GUI."""
     p = argparse.ArgumentParser(prog="stereovision gui", description=__doc__.splitlines()[0])
     add_arguments(p)
     args = p.parse_args(argv)
