@@ -2906,3 +2906,39 @@ def test_a_camera_opened_by_its_device_node_that_stops_fails_the_stream(
     summary = json.loads(out.splitlines()[-1])
     assert (summary["frames"], summary["ended"]) == (3, "source failed")
     assert err.splitlines()[-1] == f"stereovision: error: {said.format('/dev/video0')}"
+
+
+@PIPELINED
+def test_a_count_of_one_pair_is_said_in_the_singular(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A one-pair stream's summary said "1 pairs in 0.09 s", and its --bag line "1 of the 1
+    pairs processed" ("1 frames", "none of the 1 pairs"), where capture says "1 pair"."""
+    from types import SimpleNamespace
+
+    from stereovision.stream import _bag_line
+
+    scene = data_dir / "middlebury2003" / "cones"
+    for side in ("left", "right"):
+        img = cv2.imread(str(scene / f"{side}.png"))
+        cv2.imwrite(str(tmp_path / f"{side}_000.png"), img[100:164, 100:196])
+    argv = ["stream", "--left", str(tmp_path / "left_%03d.png"), "--no-display", "--no-check"]
+    argv += ["--right", str(tmp_path / "right_%03d.png"), "--max-disparity", "16"]
+    assert main(argv) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.startswith("1 pair in ") and " s (end of stream): " in last
+
+    def bag(frames: int, messages: int) -> SimpleNamespace:
+        return SimpleNamespace(path="b", frames=frames, messages=messages)
+
+    assert (
+        _bag_line(bag(1, 7), 1) == "ROS 2 bag written to b (1 of the 1 pair processed, 7 messages)"
+    )
+    assert (
+        _bag_line(bag(2, 14), 2)
+        == "ROS 2 bag written to b (2 of the 2 pairs processed, 14 messages)"
+    )
+    assert _bag_line(bag(1, 7), 0) == "ROS 2 bag written to b (1 frame, 7 messages)"
+    assert _bag_line(bag(0, 0), 1).startswith(
+        "no ROS 2 bag written to b: none of the 1 pair processed; "
+    )

@@ -46,6 +46,7 @@ from stereovision.capture import (
     SourceError,
     StereoCamera,
     StereoFrame,
+    _counted,
     _describe_source,
     _device_ended,
     add_source_args,
@@ -1481,7 +1482,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             else "no pair processed"
         )
         print(
-            f"{report.frames} pairs in {report.seconds:.2f} s ({report.ended}): "
+            f"{_counted(report.frames, 'pair')} in {report.seconds:.2f} s ({report.ended}): "
             f"{report.fps:.1f} fps; {timings}; max_disparity {report.max_disparity}",
             file=out,
         )
@@ -1539,8 +1540,16 @@ def _bag_line(bag: Any, pairs: int) -> str:
     if not bag.messages:  # the folder was removed (it said "written to DIR (0 messages)")
         if not pairs:
             return f"no ROS 2 bag written to {bag.path}: no frame in it"
-        return f"no ROS 2 bag written to {bag.path}: none of the {pairs} pairs processed; " + lost
-    held = f"{frames} of the {pairs} pairs processed" if frames <= pairs else f"{frames} frames"
+        return (
+            f"no ROS 2 bag written to {bag.path}: none of the {_counted(pairs, 'pair')} "
+            "processed; " + lost
+        )
+    # "1 pairs", "1 frames" read badly (as capture's counts, said in the singular since fd8a1f4)
+    held = (
+        f"{frames} of the {_counted(pairs, 'pair')} processed"
+        if frames <= pairs
+        else _counted(frames, "frame")
+    )
     line = f"ROS 2 bag written to {bag.path} ({held}, {bag.messages} messages)"
     return line + "; " + lost if frames < pairs else line
 
