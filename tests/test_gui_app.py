@@ -5932,3 +5932,19 @@ def test_gui_main_as_the_command_ends_past_an_open_it_gave_up(monkeypatch, capsy
         assert gui.main(["--no-browser"]) == 2
     finally:
         release.set()
+
+
+def test_gui_main_refuses_a_value_in_one_line_with_the_unit_hint(capsys):
+    """``python -m stereovision.gui --read-timeout 10s`` printed argparse's usage block and its
+    line without the hint 4f409a7 gave every number option of ``stereovision gui`` (and of the
+    other commands): its parser is the CLI's now, one line as ``stereovision gui`` says it."""
+    import stereovision.gui as gui
+
+    with pytest.raises(SystemExit) as raised:
+        gui.main(["--read-timeout", "10s"])
+    assert raised.value.code == 2
+    assert capsys.readouterr() == (
+        "",
+        "stereovision gui: error: argument --read-timeout: expected seconds above 0 or 'none' "
+        "(no limit) without a unit (5 for 5 s), got '10s' (see stereovision gui --help)\n",
+    )

@@ -286,7 +286,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     """:func:`main`'s work: parse ``argv`` and run the GUI."""
-    p = argparse.ArgumentParser(prog="stereovision gui", description=__doc__.splitlines()[0])
+    # the CLI's parser: a refused value in one line, with the unit hint (``--read-timeout
+    # 10s``), where argparse's own printed its usage block and no hint
+    from stereovision.cli import _Parser
+
+    p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
     add_arguments(p)
     args = p.parse_args(argv)
     try:
