@@ -402,14 +402,15 @@ _URL_PASSWORD = re.compile(
     r"(" + _SCHEME + r"[^/?#:]*):[^/?#]*@|(" + _SCHEME + r"[^/?#@:]*):[^/]*@"
 )
 #: What :data:`_URL_PASSWORD`'s fallback (a raw "?" or "#" in a password) took for a user
-#: part but is a host's port and then a query: ``rtsp://cam:554?x=a@b`` (nothing but digits
-#: before the "?", a key=value after it). A password such as ``1234?k=v`` is said in full
-#: (the one shape this reading leaks); ``u:a?key=b@``, ``u:1234?x@``, ``cam:554#a@`` stay hidden.
-#: An IPv6 host (``[::1]``, its port optional) is read the same way: the ":" inside its brackets
-#: was taken for a user's, and ``rtsp://[::1]:554?x=a@b`` said ``rtsp://[:***@b``.
-_PORT_THEN_QUERY = re.compile(
-    _SCHEME + r"(?:[^/?#@:]*:\d{1,5}|\[[0-9A-Fa-f:.]*(?:%[^\]/?#@]*)?\](?::\d{1,5})?)\?[^=@]*="
-)
+#: part but is an IPv6 host (``[::1]``, its port optional) and then a query: the ":" inside its
+#: brackets was taken for a user's, and ``rtsp://[::1]:554?x=a@b`` said ``rtsp://[:***@b``. A
+#: user part holds no "[" (RFC 3986), so nothing is leaked by reading it so.
+_PORT_THEN_QUERY = re.compile(_SCHEME + r"\[[0-9A-Fa-f:.]*(?:%[^\]/?#@]*)?\](?::\d{1,5})?\?[^=@]*=")
+#: The same shape with a host name (``rtsp://cam:554?x=a@b``) reads as ``user:password@`` too
+#: (``rtsp://admin:1234?pw=x@cam/0``, a password with a raw "?"): it stays hidden, a leak being
+#: worse than too much hidden, and the secret parameters after its "@" are masked all the same
+#: (``cam:554?mail=a@b&token=t`` said its token when they were looked for after a "?" only).
+_NAMED_PORT_THEN_QUERY = re.compile(_SCHEME + r"[^/?#@:]*:\d{1,5}\?[^=@]*=")
 #: A URL inside other text (a GStreamer pipeline's ``location=rtsp://...``): its scheme at
 #: the start or after a space, "=" or a quote; it ends at a space or a quote.
 _URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
@@ -461,10 +462,10 @@ def mask_url_secrets(source: str) -> str:
     ``#``) and ends at its last ``@`` (``me@mail.com:pw@cam`` hides ``pw``). Where that holds no
     ``@``, a ``user:password@`` running on to the first ``/`` is hidden all the same: a
     password typed with a raw ``?`` or ``#`` (``admin:pa?ss@cam``) reads like the start of a
-    query, and a leak is worse than too much hidden. One shape of that is read as a query: a
-    host, a port (1 to 5 digits), ``?`` and a ``key=`` before the ``@`` (``cam:554?x=a@b``
-    is said as given; an IPv6 host's port may be left out: ``[::1]?x=a@b``); ``cam:554#a@b``
-    and ``u:1234?x@cam`` stay hidden.
+    query, and a leak is worse than too much hidden. So is ``cam:554?x=a@b`` (a port then a
+    query holding an ``@``, or the password ``1234?x=a``): said ``cam:***@b``, with the secret
+    parameters after it masked too. An IPv6 host (``[::1]:554?x=a@b``, ``[::1]?x=a@b``) holds
+    no user part and is said as given.
 
     Examples
     --------
@@ -496,11 +497,17 @@ def _url_secrets(source: str) -> list[tuple[int, int, str]]:
     for first, last in spans:
         password = _URL_PASSWORD.match(source, first, last)
         if password and password[2] is not None and _PORT_THEN_QUERY.match(password[0]):
-            password = None  # "cam:554?x=a@b": a port, then a query holding an "@"
+            password = None  # "[::1]:554?x=a@b": an IPv6 port, then a query holding an "@"
+        ambiguous = bool(
+            password and password[2] is not None and _NAMED_PORT_THEN_QUERY.match(password[0])
+        )
         if password:
             parts.append((first, password.end(), f"{password[1] or password[2]}:***@"))
-        # the query alone: from the first "?" after the authority to the fragment ("#")
+        # the query alone: from the first "?" after the authority to the fragment ("#"); after
+        # a hidden "cam:554?x=a@" (a query, maybe) from its "@" on, "?" or not
         start = source.find("?", password.end() if password else first, last)
+        if ambiguous and password:
+            start = password.end() - 1
         if start >= 0:
             end = source.find("#", start, last)
             query = _URL_SECRET_PARAM.finditer(source, start, end if end >= 0 else last)
