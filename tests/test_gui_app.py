@@ -5450,6 +5450,35 @@ def test_a_failed_click_during_a_computation_leaves_its_progress(tmp_path):
     assert (app.state.busy, app.state.status) == (False, "error")
 
 
+def test_the_max_disparity_in_use_typed_again_clears_its_refusal():
+    """A bad max disparity ("abc") corrected back to the value in use computed nothing (the
+    same range) and said nothing: the refusal "got 'abc'" and the toolbar's "error" stayed
+    under a field holding a good value. The refusal goes; another error on the page stays."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-max-disp-typed-again", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = spawned.append
+    app._load_scene(bundled_data_dir() / "cones")
+    app.apply_max_disparity(text="64")
+    assert app.chosen_max_disparity == 64 and len(spawned) == 1
+    spawned.pop().close()
+    for typed_again in ("64", " 64 "):
+        app.apply_max_disparity(text="abc")
+        assert app.state.error.endswith("got 'abc'") and app.state.status == "error"
+        app.apply_max_disparity(text=typed_again)
+        assert (app.state.error, app.state.status) == ("", "ready"), typed_again
+        assert app.chosen_max_disparity == 64 and spawned == []  # nothing to compute
+    app.apply_max_disparity(text="abc")
+    app.apply_max_disparity(text="auto")  # a change: computed, its refusal gone as before
+    assert app.state.error == "" and app.chosen_max_disparity is None and len(spawned) == 1
+    spawned.pop().close()
+    app.apply_max_disparity(text="0")
+    app._fail(OSError("cannot open camera 5 (left)"))  # said since: not the field's
+    app.apply_max_disparity(text="auto")
+    assert app.state.error == "cannot open camera 5 (left)" and spawned == []
+
+
 def test_an_emptied_slider_is_said_on_the_page(tmp_path):
     """A slider's value the page sent as null (an emptied field) is said as an error; the
     view stays (a TypeError escaped the controller)."""

@@ -1417,6 +1417,9 @@ class StereoApp:
         #: The page's max-disparity field, applied (None: automatic, the scene's range or one
         #: estimated from the images).
         self.chosen_max_disparity: int | None = None
+        #: The page's words refusing the max-disparity field's last value (None: it was taken):
+        #: cleared when the value in use is typed again.
+        self._max_disp_refused: str | None = None
         self.view: ViewData | None = None
         #: The point-cloud file on show ("Open") and its caption: it stays in the 3-D view
         #: whichever way the surface / points toggle is set, until the next computed pair.
@@ -2632,9 +2635,17 @@ class StereoApp:
             chosen = parse_max_disparity(self.state.max_disp, int(min(width, 2**31)))
         except ValueError as exc:
             self._fail(exc)
+            self._max_disp_refused = self.state.error
             return
         if chosen == self.chosen_max_disparity:
+            # the range in use typed again after a refused value: nothing to compute, but the
+            # refusal ("got 'abc'") stayed on the page, and "error" in the toolbar, under a
+            # field that now holds a good value (another error on the page stays)
+            if self._max_disp_refused and self.state.error == self._max_disp_refused:
+                self._done()
+            self._max_disp_refused = None
             return
+        self._max_disp_refused = None
         self.chosen_max_disparity = chosen
         self._done()
         if self.pair is not None:
