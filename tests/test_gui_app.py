@@ -1948,6 +1948,51 @@ def test_a_toggle_after_a_followed_drag_keeps_the_view_and_its_pivot(tmp_path):
     assert app._mouse_camera() is None  # still the sliders' pose: Save says no mouse view
 
 
+def _page_sets(app: Any, **values: Any) -> None:
+    """``values`` set as the page sends them: one update of the server's state, flushed, the
+    change listeners run in that flush (a handler's own changes are flushed after it)."""
+    with app.state:
+        app.state.update(values)
+
+
+def test_the_unit_toggle_clicked_on_the_page_keeps_the_view_the_mouse_left(tmp_path):
+    """On the served page the unit toggle lost the view the mouse left (kept by
+    test_the_unit_toggle_and_the_view_mode_keep_the_view_the_mouse_left, which calls the
+    handler with the state's listeners off): the translation sliders it converts were flushed
+    after its handler had kept the view, and their listener put the view on the sliders' pose
+    (a drag past their range undone, render.png no longer the view shown). The view stays; a
+    slider moved next still moves it."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-unit-click-keeps-mouse", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.ready()  # the listeners run at each flush, as on the server
+    _page_sets(app, right=0.123, forward=1.0)
+    cam = app.plotter.camera
+    assert cam.position == pytest.approx((0.123, 0.0, 1.0), abs=1e-9)
+    cam.Azimuth(-130.0)  # a drag past the yaw slider's 90 degrees
+    cam.OrthogonalizeViewUp()
+    app.plotter.iren.interactor.InvokeEvent("EndInteractionEvent")
+    dragged = render.CameraState.of(cam)
+    assert app.state.yaw == 90.0 and app._mouse_camera() is not None
+    metres = {n: app.state[n] for n in ("forward", "up", "right")}
+    _page_sets(app, unit="ft")
+    for name, value in metres.items():  # converted (inside the feet sliders' 16.4 ft)
+        feet = min(max(round(value / 0.3048, 3), -16.4), 16.4)
+        assert app.state[name] == pytest.approx(feet), name
+    assert render.CameraState.of(cam).same_view(dragged)
+    assert app._mouse_camera() is not None  # still not the sliders' pose: Save says so
+    app._on_unit("m")  # called outside a flush: its changes flushed at its block's end
+    assert render.CameraState.of(cam).same_view(dragged)
+    _page_sets(app, pitch=3.0)  # a slider moved: from the sliders' (clamped) pose
+    moved = render.controls_from_pose(render.pose_from_camera(cam))
+    assert moved.yaw == pytest.approx(90.0) and moved.pitch == pytest.approx(3.0)
+    for name, value in metres.items():
+        assert getattr(moved, name) == pytest.approx(value, abs=2e-3), name  # the rounding
+
+
 def test_save_of_the_pair_ignores_a_drag_of_an_opened_cloud_file(tmp_path):
     """With a point-cloud file shown in the 3-D view, a drag moves the view of that file (another
     scene, framed without the pair's intrinsics), yet Save rendered the pair from that camera

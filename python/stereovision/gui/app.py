@@ -1486,6 +1486,9 @@ class StereoApp:
         self._slider_camera: Any = None
         #: True while the sliders are set from the view the mouse left (no slider move).
         self._following_mouse = False
+        #: The six sliders' values as the unit toggle converted them (:meth:`_on_unit`), until
+        #: the sliders' listener has seen them: it is no slider move (None: no conversion).
+        self._unit_converted: dict[str, Any] | None = None
         if self.plotter.iren is not None:  # the page's mouse events drive it (mode="server")
             self.plotter.iren.interactor.AddObserver("EndInteractionEvent", self._on_mouse_end)
         from stereovision.gui import bundled_data_dir
@@ -3172,6 +3175,12 @@ class StereoApp:
             self._remote_view.update()
 
     def _on_controls(self, **_: Any) -> None:
+        converted, self._unit_converted = self._unit_converted, None
+        if converted is not None and all(self.state[n] == v for n, v in converted.items()):
+            # the unit toggle's conversion (it keeps the view itself): applied here, after the
+            # toggle's handler on the server, it put the view on the sliders' pose again, and a
+            # view the mouse left was lost
+            return
         if not self._following_mouse:
             self._apply_camera()
 
@@ -3238,6 +3247,9 @@ class StereoApp:
                 # (their thumb stuck at the end); the view is kept below
                 value = round(float(st[name]) * factor, 3)
                 st[name] = min(max(value, -limit), limit)
+            # the sliders' listener sees these values when they are flushed: at this block's
+            # end, or (the page's click, itself flushed) after this handler has kept the view
+            self._unit_converted = {n: st[n] for n in _CONTROL_NAMES}
             st.floor_caption = floor_caption(unit)
             if self.view is not None and self._page_before is None:
                 st.depth_caption, st.stats = self.view.texts(unit)
