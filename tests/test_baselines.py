@@ -155,6 +155,32 @@ def test_references_equal_raw_opencv_over_16() -> None:
     np.testing.assert_array_equal(opencv_bm(left, right, 20), expected)  # 20 -> D16 = 32
 
 
+def test_bm_refuses_a_range_that_leaves_its_block_no_room() -> None:
+    """StereoBM with a range near the image's width computed it anyway: on the cones (450 px)
+    at 448 px, disparities up to 2041 px, most pixels "valid", and not the same from one run to
+    the next. Such a range is refused, naming the widest that fits (:func:`bm_widest_range`);
+    that one gives disparities inside it, the same each run."""
+    from stereovision.baselines import BM_BLOCK_SIZE, bm_widest_range
+
+    left, right = _shifted_pair(7)  # 160 px wide
+    widest = bm_widest_range(160)
+    assert widest == 144 and widest + BM_BLOCK_SIZE - 1 <= 160 < widest + 16 + BM_BLOCK_SIZE - 1
+    with pytest.raises(ValueError) as err:
+        opencv_bm(left, right, widest + 1)
+    assert str(err.value) == (
+        "StereoBM's 15 px block and a 160 px disparity range (a multiple of 16) need images at "
+        "least 174 px wide, got 160; give a max_disparity of at most 144"
+    )
+    runs = [opencv_bm(left, right, widest) for _ in range(3)]
+    for d in runs[1:]:
+        np.testing.assert_array_equal(d, runs[0])
+    assert not (runs[0] >= widest).any()  # NaN compares False
+    narrow = np.zeros((20, 29), np.uint8)
+    with pytest.raises(ValueError, match=r"at least 30 px wide, got 29$"):  # no range fits
+        opencv_bm(narrow, narrow, 1)
+    assert opencv_bm(left[:, :30], right[:, :30], 16).shape == (60, 30)
+
+
 def test_references_reject_mismatched_pair() -> None:
     with pytest.raises(ValueError, match=r"left \(10, 20\) and right \(10, 21\)"):
         opencv_sgbm(np.zeros((10, 20), np.uint8), np.zeros((10, 21), np.uint8), 16)

@@ -656,6 +656,27 @@ def test_the_max_disparity_field_is_searched_as_typed():
     assert "warning: max disparity 320\xa0px at width 320 searched as 319\xa0px" in app.state.stats
 
 
+def test_opencv_bm_searches_no_range_its_block_has_no_room_for():
+    """opencv-bm with a max disparity near the width (440 on the 450 px cones, searched as 448)
+    showed StereoBM's garbage: disparities up to 2041 px, density 49-75 % (another each run),
+    a median depth of 0.1 m. Its range is kept where the 15 px block fits (432 px), said in
+    the statistics; opencv-sgbm keeps the range below the width, as before."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view
+    from stereovision.io import load_scene
+
+    scene = load_scene(bundled_data_dir() / "cones")
+    view = compute_view(scene.left, scene.right, scene.calib, "opencv-bm", max_disparity=440)
+    assert view.result.max_disparity == 432
+    assert not (view.result.disparity >= 432).any()  # NaN compares False
+    assert view.stats.endswith(
+        "warning: max disparity 448\xa0px at width 450 searched as 432\xa0px (opencv-bm's "
+        "15\xa0px block must fit beside it)"
+    )
+    sgbm = compute_view(scene.left, scene.right, scene.calib, "opencv-sgbm", max_disparity=440)
+    assert sgbm.result.max_disparity == 448
+
+
 def test_a_max_disparity_scaled_to_a_whole_pixel_is_not_rounded_up_past_it():
     """159 px at width 424 is 120 px at width 320 exactly; scaled in floats it was
     120.00000000000001 px, searched as 121 px (and said as '121 px searched as 128 px' by

@@ -40,6 +40,7 @@ from stereovision._validate import (
 __all__ = [
     "BM_BLOCK_SIZE",
     "SGBM_BLOCK_SIZE",
+    "bm_widest_range",
     "opencv_bm",
     "opencv_sgbm",
     "ros_stereo_image_proc",
@@ -90,6 +91,19 @@ def round_up16(n: float) -> int:
     if not math.isfinite(x) or x < 0:
         raise ValueError(f"disparity range must be finite and >= 0, got {n!r}")
     return max(16, 16 * math.ceil(x / 16.0))
+
+
+def bm_widest_range(width: int) -> int:
+    """The widest disparity range :func:`opencv_bm` searches in an image ``width`` px wide: the
+    largest multiple of 16 that leaves its :data:`BM_BLOCK_SIZE` px block inside the image
+    (``range + BM_BLOCK_SIZE - 1 <= width``; 0 when none does).
+
+    Examples
+    --------
+    >>> bm_widest_range(450), bm_widest_range(30), bm_widest_range(29)
+    (432, 16, 0)
+    """
+    return max(0, (int(width) - BM_BLOCK_SIZE + 1) // 16 * 16)
 
 
 def _check_pair_shapes(left: np.ndarray, right: np.ndarray, colour: bool = False) -> None:
@@ -146,11 +160,24 @@ def opencv_bm(left: object, right: object, max_disparity: float) -> npt.NDArray[
     Raises
     ------
     ValueError
-        On invalid images, mismatched sizes or a negative/non-finite ``max_disparity``.
+        On invalid images, mismatched sizes or a negative/non-finite ``max_disparity``, or a
+        range (rounded up to a multiple of 16) that leaves no room for the block in the image's
+        width (:func:`bm_widest_range`).
     """
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra)
     num = round_up16(max_disparity)
+    width = la.shape[1]
+    if num > bm_widest_range(width):
+        # StereoBM computed such a range anyway: disparities past it and past the width
+        # (2041 px on a 450 px pair at 448 px), most pixels "valid", a run's density not the
+        # next's (cones at 448 px: 49 %, 75 %, 62 %)
+        widest = bm_widest_range(width)
+        fits = f"; give a max_disparity of at most {widest}" if widest >= 16 else ""
+        raise ValueError(
+            f"StereoBM's {BM_BLOCK_SIZE} px block and a {num} px disparity range (a multiple "
+            f"of 16) need images at least {num + BM_BLOCK_SIZE - 1} px wide, got {width}{fits}"
+        )
     matcher = cv2.StereoBM.create(numDisparities=num, blockSize=BM_BLOCK_SIZE)
     raw = matcher.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right"))
     return _from_opencv(raw)

@@ -853,7 +853,7 @@ def compute_view(
     ValueError
         Unknown method, calibration for another image size, bad images.
     """
-    from stereovision.baselines import round_up16
+    from stereovision.baselines import BM_BLOCK_SIZE, bm_widest_range, round_up16
     from stereovision.cli import colorize
     from stereovision.depth import METHODS, depth_map, estimate_max_disparity
     from stereovision.render import Intrinsics, surface_mesh
@@ -882,14 +882,17 @@ def compute_view(
         notes.append(f"max disparity {d_max} px searched as {round_up16(d_max)} px " + _BY_16)
         d_max = round_up16(d_max)
     widest = (w_s - 1) // 16 * 16 if opencv else w_s - 1  # the range must stay below the width
-    if d_max is not None and d_max > widest and w_s > 16:
+    why = "the range must stay below the width"
+    if method == "opencv-bm":
+        # and leave BM's block inside it: a wider range gave disparities past the width (2041 px
+        # at 448 px on the 450 px cones), most pixels "valid" and depths of 0.1 m
+        widest = bm_widest_range(w_s)
+        why = f"{method}'s {BM_BLOCK_SIZE} px block must fit beside it"
+    if d_max is not None and d_max > widest and widest >= (16 if opencv else 1) and w_s > 16:
         # a range that fits the pair at its size, scaled down and rounded up, can reach the
         # smaller width (440 px at full size searched 320 px at width 320: refused); a pair
-        # 16 px wide or less is depth_map's to refuse
-        notes.append(
-            f"max disparity {d_max} px at width {w_s} searched as {widest} px "
-            "(the range must stay below the width)"
-        )
+        # 16 px wide or less is depth_map's to refuse, one too narrow for BM's block opencv_bm's
+        notes.append(f"max disparity {d_max} px at width {w_s} searched as {widest} px ({why})")
         d_max = widest
     t0 = time.perf_counter()
     report(5, f"{method}: matching {left_s.shape[1]}x{left_s.shape[0]}")
