@@ -3481,6 +3481,53 @@ def test_a_camera_still_opening_is_refused_by_its_dev_video_path_too(monkeypatch
     asyncio.run(clicks())
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="V4L2 device paths")
+def test_a_camera_typed_by_its_device_node_or_by_id_link_opens(tmp_path, monkeypatch):
+    """A camera typed in the page's field as ``/dev/video2`` or by its ``/dev/v4l/by-id/...``
+    link (how a rig keeps left and right apart across reboots) was refused as "path outside
+    the allowed folders" (unless /dev was a --data folder), where its index "2" opens. It
+    opens as that node; other paths outside the allowed folders are still refused."""
+    import asyncio
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    opened: list[tuple[Any, Any]] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            opened.append((left, right))
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    links = tmp_path / "by-id"  # not an allowed folder
+    links.mkdir()
+    (links / "usb-Rig_Left-video-index0").symlink_to("/dev/video7")
+    app = _scene_app("test-dev-video-typed", [bundled_data_dir()])
+    opens = _collect_opens(app)
+
+    async def open_typed(left: str, right: str) -> None:
+        app.state.cam_left, app.state.cam_right = left, right
+        app.open_cameras()
+        if opens:
+            await opens.pop()
+
+    asyncio.run(open_typed(str(links / "usb-Rig_Left-video-index0"), "/dev/video8"))
+    assert app.state.error == "" and opened == [("/dev/video7", "/dev/video8")]
+    assert app.state.source_label == "cameras usb-Rig_Left-video-index0 / video8"
+    outside = tmp_path / "video9"  # named like a node, not one
+    outside.touch()
+    asyncio.run(open_typed(str(outside), "/dev/video8"))
+    assert app.state.error.startswith("path outside the allowed folders: ")
+    assert len(opened) == 1
+
+
 def test_a_late_camera_open_does_not_replace_a_newer_choice_nor_hide_its_error(monkeypatch):
     """The page's Open runs in a thread and is waited for: cameras 0/1 still opening (slow, not
     yet given up) when cameras 2/3 were opened and used replaced them once they came, the

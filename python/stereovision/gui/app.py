@@ -1838,9 +1838,25 @@ class StereoApp:
         return self.source_calib
 
     def _camera_source(self, text: str) -> int | str:
+        """The camera field's ``text`` as the Open opens it: a device index, a V4L2 device node
+        (``/dev/video2``, or a ``/dev/v4l/by-id/...`` link: the node it leads to), else a file
+        or pattern of the allowed folders.
+
+        A device typed by its node was refused as "path outside the allowed folders" (unless
+        ``--data /dev``): the same camera as its index, which opens, and by-id links are how
+        a rig keeps its left and right cameras apart across reboots.
+
+        Raises
+        ------
+        ValueError, FileNotFoundError
+            As :func:`parse_source` and :meth:`AllowedFolders.resolve` raise them.
+        """
         src = parse_source(text)
         if not isinstance(src, str):
             return src
+        node = _camera_device(src) if sys.platform.startswith("linux") else None
+        if node is not None:
+            return node  # /dev/videoN: camera N, as _pending_key knows it
         # Files only from the allowed folders; an image-sequence pattern by its folder.
         p = Path(src)
         if "%" in p.name:
