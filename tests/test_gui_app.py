@@ -6005,8 +6005,14 @@ def test_a_streams_password_is_not_said_when_it_does_not_open(monkeypatch, caplo
     app = _scene_app("test-stream-password-typed", [bundled_data_dir()])
     app.state.cam_left, app.state.cam_right = url, "rtsp://cam/1"
     _open_cameras(app)
-    assert app.state.error == "no such file: rtsp://admin:***@cam/0?token=***"
+    assert app.state.error == (
+        "rtsp://admin:***@cam/0?token=***: a stream's URL is given to gui --left/--right at "
+        "start-up, not typed here (the page opens cameras, and files in the --data folders)"
+    )
     assert app.state.error in caplog.text  # logged, as said
+    app.state.cam_left = "http://cam:8080/video"  # any stream: not opened from the page
+    _open_cameras(app)
+    assert app.state.error.startswith("http://cam:8080/video: a stream's URL is given to gui ")
     # given as gui --left: shown in the page's field without it
     app = _scene_app(
         "test-stream-password-given", [bundled_data_dir()], source_names=(url, "rtsp://cam/1")

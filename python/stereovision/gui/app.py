@@ -1849,7 +1849,8 @@ class StereoApp:
         Raises
         ------
         ValueError, FileNotFoundError
-            As :func:`parse_source` and :meth:`AllowedFolders.resolve` raise them.
+            As :func:`parse_source` and :meth:`AllowedFolders.resolve` raise them; a stream's
+            URL (``rtsp://...``: streams are given to ``gui --left/--right``).
         """
         src = parse_source(text)
         if not isinstance(src, str):
@@ -1857,6 +1858,13 @@ class StereoApp:
         node = _camera_device(src) if sys.platform.startswith("linux") else None
         if node is not None:
             return node  # /dev/videoN: camera N, as _pending_key knows it
+        if re.match(r"[A-Za-z][A-Za-z0-9+.-]*://", src):
+            # the page opens no address typed in it (the server would connect wherever it was
+            # told): said as "no such file: rtsp://...", which told nothing of what to do
+            raise ValueError(
+                f"{mask_url_secrets(src)}: a stream's URL is given to gui --left/--right at "
+                "start-up, not typed here (the page opens cameras, and files in the --data folders)"
+            )
         # Files only from the allowed folders; an image-sequence pattern by its folder.
         p = Path(src)
         if "%" in p.name:
