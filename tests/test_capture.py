@@ -2057,6 +2057,35 @@ def test_a_negative_index_message_names_the_file_as_typed() -> None:
         StereoCamera("-0", 0)
 
 
+def test_a_camera_index_opencv_cannot_take_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An index past a C int (`--left 99999999999999999999`, a typo; the GUI's camera field)
+    reached cv2.VideoCapture, whose overload resolution failed: "left source camera 99999999999
+    999999999 did not open: OpenCV failed (in function 'VideoCapture'", cut there. It is refused
+    as a negative one is; the largest index OpenCV takes is still an index."""
+    from stereovision.cli import main
+
+    says = (
+        "camera index {0} is too large: cameras are numbered from 0 to 2147483647 "
+        "(./{1} for a file)"
+    )
+    for text in ("99999999999999999999", " 2147483648 ", 2**31, np.int64(2**40)):
+        n = int(text)
+        with pytest.raises(ValueError, match=f"^{re.escape(says.format(n, str(text).strip()))}$"):
+            parse_source(text)
+    from stereovision.capture import MAX_CAMERA_INDEX
+
+    assert parse_source(str(MAX_CAMERA_INDEX)) == MAX_CAMERA_INDEX == 2**31 - 1
+    argv = ["capture", "--left", "99999999999999999999", "--right", "0", "-o", str(tmp_path / "x")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert (
+        err == f"stereovision: error: {says.format(99999999999999999999, 99999999999999999999)}\n"
+    )
+    assert not (tmp_path / "x").exists()
+
+
 def test_every_with_a_board_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """`--chessboard 9x6 --every 10` ignored --every (the board's poses choose the pairs) and
     said nothing; it is refused in one line, nothing opened or saved."""

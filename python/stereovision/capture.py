@@ -219,6 +219,18 @@ def _negative_index(n: int, text: str | None = None) -> str:
     )
 
 
+#: Largest device index OpenCV takes (a C int): a larger one failed in cv2.VideoCapture's
+#: overload resolution, said as "did not open: OpenCV failed (in function 'VideoCapture'".
+MAX_CAMERA_INDEX = 2**31 - 1
+
+
+def _too_large_index(n: int, text: str | None = None) -> str:
+    return (
+        f"camera index {n} is too large: cameras are numbered from 0 to {MAX_CAMERA_INDEX} "
+        f"(./{n if text is None else text} for a file)"
+    )
+
+
 def parse_source(text: str | int) -> int | str:
     """A device index for an all-digit string (``"0"`` -> ``0``), else the text (file/pattern).
 
@@ -237,6 +249,7 @@ def parse_source(text: str | int) -> int | str:
     ValueError
         A negative index (``-1`` or ``"-1"``): OpenCV's -1 is "any camera", no side of a rig,
         and crashes the process where no camera is present; as text it was taken for a file.
+        One above :data:`MAX_CAMERA_INDEX`, which OpenCV cannot take.
     """
     # a bool is no camera (True opened camera 1); NumPy's integers are (AttributeError: strip)
     if isinstance(text, (bool, np.bool_)):
@@ -244,12 +257,18 @@ def parse_source(text: str | int) -> int | str:
     if isinstance(text, (int, np.integer)):
         if text < 0:
             raise ValueError(_negative_index(int(text)))
+        if text > MAX_CAMERA_INDEX:
+            raise ValueError(_too_large_index(int(text)))
         return int(text)
     # "-0" is no negative index: a path, as it was (its message said "camera index 0 is negative")
     if re.fullmatch(r"-\d+", text.strip(), re.ASCII) and int(text) < 0:
         raise ValueError(_negative_index(int(text), text.strip()))
     # isdecimal, not isdigit: "²" is a digit that int() refuses ("invalid literal for int()")
-    return int(text) if text.strip().isdecimal() else text
+    if not text.strip().isdecimal():
+        return text
+    if int(text) > MAX_CAMERA_INDEX:
+        raise ValueError(_too_large_index(int(text), text.strip()))
+    return int(text)
 
 
 #: Largest frame side accepted for ``--size`` (16K video is 15360 px wide).
