@@ -316,3 +316,36 @@ def test_eval_scene_uses_only_a_rectified_calibration(
     fake = SimpleNamespace(**{**vars(scene), "calib": SimpleNamespace(rectified=False)})
     row = _eval_scene(fake, "fast", with_opencv=False)
     assert seen == [None] and "depth" not in row and row["ours"]["n_gt"] == 164541
+
+
+def test_eval_of_a_scene_narrower_than_bms_range_plus_its_block(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A 70 px crop of cones (range 64): StereoBM's 15 px block needs 78 px, so 4f17fb0's
+    refusal in opencv_bm refused the whole scene (exit 2); the BM reference now runs on the
+    widest range that fits (48) and the scene is evaluated, as opencv_bm(…, 48) gives it."""
+    import cv2
+
+    from stereovision import baselines
+    from stereovision.evaluate import dense_metrics
+    from stereovision.io import load_scene, read_pfm, write_pfm
+
+    src = data_dir / "middlebury2003" / "cones"
+    scene_dir = tmp_path / "narrow"
+    scene_dir.mkdir()
+    for side in ("left", "right"):
+        cv2.imwrite(
+            str(scene_dir / f"{side}.png"), cv2.imread(str(src / f"{side}.png"))[:, 300:370]
+        )
+    write_pfm(
+        scene_dir / "gt_disp.pfm", np.ascontiguousarray(read_pfm(src / "gt_disp.pfm")[:, 300:370])
+    )
+    proc = _eval(str(scene_dir), "--json")
+    assert proc.returncode == 0, proc.stderr
+    (row,) = _rows(proc.stdout)
+    scene = load_scene(scene_dir)
+    assert row["max_disparity"] == scene.max_disparity == 64
+    assert baselines.bm_reference_range(64, 70) == 48
+    bm = dense_metrics(baselines.opencv_bm(scene.left, scene.right, 48), scene.gt).as_dict()
+    assert row["bm"]["bad_2.0"] == pytest.approx(bm["bad_2.0"])
+    assert row["bm"]["density"] == pytest.approx(bm["density"])

@@ -40,6 +40,7 @@ from stereovision._validate import (
 __all__ = [
     "BM_BLOCK_SIZE",
     "SGBM_BLOCK_SIZE",
+    "bm_reference_range",
     "bm_widest_range",
     "opencv_bm",
     "opencv_sgbm",
@@ -104,6 +105,22 @@ def bm_widest_range(width: int) -> int:
     (432, 16, 0)
     """
     return max(0, (int(width) - BM_BLOCK_SIZE + 1) // 16 * 16)
+
+
+def bm_reference_range(max_disparity: float, width: int) -> float:
+    """``max_disparity`` for :func:`opencv_bm` as a reference beside another matcher (``eval``,
+    ``bench``): as given, or :func:`bm_widest_range` where its block has no room for it (a
+    scene narrower than its range + 14 px), so that the reference runs on its widest range
+    rather than refusing the whole scene; as given when no range fits (under 30 px), for
+    :func:`opencv_bm` to refuse.
+
+    Examples
+    --------
+    >>> bm_reference_range(64, 450), bm_reference_range(64, 70), bm_reference_range(64, 20)
+    (64, 48, 64)
+    """
+    widest = bm_widest_range(width)
+    return widest if round_up16(max_disparity) > widest >= 16 else max_disparity
 
 
 def _check_pair_shapes(left: np.ndarray, right: np.ndarray, colour: bool = False) -> None:

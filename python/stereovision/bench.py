@@ -202,7 +202,9 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     # gabor's Matches are its dense run's confident pixels: timed once, as a dense method
     sparse_only = [m for m in SPARSE_METHODS if m not in ("gabor",)]
     cases += [(sparse_name(m), "sparse", keep(sparse_name(m), sparse(m))) for m in sparse_only]
-    bm = lambda: baselines.opencv_bm(left, right, md)  # noqa: E731
+    # the widest range StereoBM's block has room for, on a scene narrower than md + 14 px
+    bm_md = baselines.bm_reference_range(md, np.asarray(left).shape[1])
+    bm = lambda: baselines.opencv_bm(left, right, bm_md)  # noqa: E731
     sgbm = lambda: baselines.opencv_sgbm(left, right, md)  # noqa: E731
     cases += [("StereoBM", "opencv", keep("StereoBM", bm))]
     cases += [(REFERENCE, "opencv", keep(REFERENCE, sgbm))]

@@ -1505,6 +1505,9 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
             times[name].append(1000 * (time.perf_counter() - t))
         outputs.setdefault(name, out)  # the first round's output is the one evaluated
 
+    # StereoBM's block needs its range + 14 px of width: on a narrower scene the reference runs
+    # on the widest range that fits (it refused, and the whole scene with it)
+    bm_md = baselines.bm_reference_range(md, np.asarray(scene.left).shape[1])
     warm = runs == 1
     for _ in range(runs if warm else runs + 1):
         timed(
@@ -1519,7 +1522,7 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
             ),
         )
         if with_opencv:
-            timed("bm", lambda: baselines.opencv_bm(scene.left, scene.right, md))
+            timed("bm", lambda: baselines.opencv_bm(scene.left, scene.right, bm_md))
             timed("sgbm", lambda: baselines.opencv_sgbm(scene.left, scene.right, md))
         warm = True
     res = outputs["ours"]
