@@ -1495,23 +1495,22 @@ pub fn edge_filters(
             .fold(0.0f32, |a, &v| if v.abs() > a { v.abs() } else { a });
     let mut ok: Vec<bool> = Vec::new();
     try_reserve_len(&mut ok, order.len(), FILTER_LISTS)?;
-    order
-        .par_iter()
-        .map_init(
-            || SidesScratch {
-                scale,
-                ..SidesScratch::default()
-            },
-            |scratch, &i| {
-                let m = &matches[i as usize];
-                m.xl.is_finite()
-                    && m.xr.is_finite()
-                    && m.yl.is_finite()
-                    && m.yr.is_finite()
-                    && (!f.sides || sides_ok(left, right, m, f, range, scratch))
-            },
-        )
-        .collect_into_vec(&mut ok); // into the reserved room: no reallocation
+    // Into the reserved room (no reallocation) by `par_extend`, the path `collect` took:
+    // `collect_into_vec` compiled this hot loop into 4 % more instructions (callgrind).
+    ok.par_extend(order.par_iter().map_init(
+        || SidesScratch {
+            scale,
+            ..SidesScratch::default()
+        },
+        |scratch, &i| {
+            let m = &matches[i as usize];
+            m.xl.is_finite()
+                && m.xr.is_finite()
+                && m.yl.is_finite()
+                && m.yr.is_finite()
+                && (!f.sides || sides_ok(left, right, m, f, range, scratch))
+        },
+    ));
     for (&i, o) in order.iter().zip(ok) {
         keep[i as usize] = o;
     }
@@ -1553,34 +1552,30 @@ pub fn edge_filters(
         }
         let mut drop: Vec<bool> = Vec::new();
         try_reserve_len(&mut drop, matches.len(), FILTER_LISTS)?;
-        matches
-            .par_iter()
-            .enumerate()
-            .map(|(i, m)| {
-                if !keep[i] {
-                    return false;
-                }
-                let Some((x, y)) = cell[i] else {
-                    return true;
-                };
-                let d = m.xl - m.xr;
-                let (x0, x1) = (x - f.disc_dx, x + f.disc_dx);
-                for yy in (y - f.disc_dy).max(0)..=(y + f.disc_dy).min(h as i32 - 1) {
-                    let row = &items[start[yy as usize] as usize..start[yy as usize + 1] as usize];
-                    let from = row.partition_point(|&(c, _)| c < x0);
-                    for &(c, j) in &row[from..] {
-                        if c > x1 {
-                            break;
-                        }
-                        let o = &matches[j as usize];
-                        if j as usize != i && ((o.xl - o.xr) - d).abs() > f.disc_tol {
-                            return true;
-                        }
+        drop.par_extend(matches.par_iter().enumerate().map(|(i, m)| {
+            if !keep[i] {
+                return false;
+            }
+            let Some((x, y)) = cell[i] else {
+                return true;
+            };
+            let d = m.xl - m.xr;
+            let (x0, x1) = (x - f.disc_dx, x + f.disc_dx);
+            for yy in (y - f.disc_dy).max(0)..=(y + f.disc_dy).min(h as i32 - 1) {
+                let row = &items[start[yy as usize] as usize..start[yy as usize + 1] as usize];
+                let from = row.partition_point(|&(c, _)| c < x0);
+                for &(c, j) in &row[from..] {
+                    if c > x1 {
+                        break;
+                    }
+                    let o = &matches[j as usize];
+                    if j as usize != i && ((o.xl - o.xr) - d).abs() > f.disc_tol {
+                        return true;
                     }
                 }
-                false
-            })
-            .collect_into_vec(&mut drop);
+            }
+            false
+        }));
         for (k, d) in keep.iter_mut().zip(drop) {
             *k &= !d;
         }
@@ -1591,9 +1586,10 @@ pub fn edge_filters(
         live.retain(|&i| keep[i as usize]);
         let mut ok: Vec<bool> = Vec::new();
         try_reserve_len(&mut ok, live.len(), FILTER_LISTS)?;
-        live.par_iter()
-            .map(|&i| area_ok(left, right, &matches[i as usize], f.zncc_tol))
-            .collect_into_vec(&mut ok);
+        ok.par_extend(
+            live.par_iter()
+                .map(|&i| area_ok(left, right, &matches[i as usize], f.zncc_tol)),
+        );
         for (&i, o) in live.iter().zip(ok) {
             keep[i as usize] = o;
         }
