@@ -1432,8 +1432,9 @@ fn raster_order(matches: &[Match]) -> Result<Vec<u32>> {
         FILTER_LISTS,
     )?;
     keyed.sort_unstable();
-    // In place (the keys' buffer reused, not a second allocation).
-    Ok(keyed.into_iter().map(|(_, i)| i).collect())
+    // A second list, allocated checked: a `collect` from `keyed.into_iter()` is not done in
+    // place ((u64, u32) and u32 differ in alignment), it allocated unchecked (an abort).
+    try_collect(keyed.len(), keyed.iter().map(|&(_, i)| i), FILTER_LISTS)
 }
 
 /// What [`edge_filters`]' per-match lists are called in an

@@ -2875,6 +2875,25 @@ fn match_and_row_lists_under_a_memory_limit() {
             limit(16 << 20);
             edge_filters(&img, &img, &ms, &f, (0, 8)).map(|(k, _)| k.len())
         }
+        // The same matches under 36 MiB: their raster-order keys (32 MiB) fit, the index
+        // list taken from them (4 bytes a match, 8 MiB) does not. 252451a took it by a
+        // `collect` it called in place: (u64, u32) to u32 changes the alignment, so it was a
+        // new allocation, unchecked (SIGABRT).
+        "edge_filters_order" => {
+            let m = Match {
+                xl: 1.0,
+                yl: 1.0,
+                xr: 0.0,
+                yr: 1.0,
+                score: 1.0,
+                channel: 0,
+            };
+            let ms = vec![m; 1 << 21];
+            let img = blobs(16, 16, 0.0);
+            let f = McgmParams::default().filters;
+            limit(36 << 20);
+            edge_filters(&img, &img, &ms, &f, (0, 8)).map(|(k, _)| k.len())
+        }
         // 2^20 right segments with no pixels (56 MiB, before the limit): the row lists fit
         // in 16 MiB, their list of voters (24 bytes a segment, 24 MiB) does not.
         "voters_list" => {
@@ -2931,6 +2950,10 @@ fn match_and_row_lists_too_large_to_allocate_are_an_error() {
         (
             "edge_filters",
             "the MCGM matcher's edge-filter lists needs 32.00 MiB (33554432 bytes)",
+        ),
+        (
+            "edge_filters_order",
+            "the MCGM matcher's edge-filter lists needs 8.00 MiB (8388608 bytes)",
         ),
         (
             "voters_list",
