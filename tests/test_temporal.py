@@ -874,6 +874,7 @@ def test_black_frames_before_a_still_scene_are_no_estimate_of_its_noise(data_dir
     ("red", "gains", "fit"),
     [
         (400.0, (1.0, 1.0, 1.0, 0.96), 0.96),  # clipped in the mean (and the frame)
+        (280.0, (1.0, 1.0, 1.0, 0.8), 0.8),  # clipped in the mean only (224 in the frame)
         (220.0, (1.0, 1.0, 1.0, 1.3), 1.3),  # clipped in the brighter frame only
     ],
 )
