@@ -678,7 +678,15 @@ def test_check_index_range_at_the_kernels_limits() -> None:
     """The same limits as ``image::check_index_range`` in Rust, on the shape alone."""
     from stereovision._validate import MAX_PIXELS, MAX_SIDE, check_index_range, u8_pair
 
-    for shape in [(1, 1), (MAX_PIXELS // 3, 3), (2, MAX_SIDE), (65537, 65535), (1, MAX_SIDE, 3)]:
+    fit = [
+        (1, 1),
+        (MAX_PIXELS // 3, 3),
+        (2, MAX_SIDE),
+        (MAX_SIDE, 2),
+        (65537, 65535),
+        (1, MAX_SIDE, 3),
+    ]
+    for shape in fit:
         check_index_range(shape, "left")
     for shape in [(65536, 65536), (1, MAX_SIDE + 1), (MAX_SIDE + 1, 1), (2, MAX_PIXELS // 2 + 1)]:
         with pytest.raises(ValueError, match=rf"^left: image of {shape[1]}x{shape[0]} pixels"):
