@@ -1394,3 +1394,28 @@ def test_mesh_ply_colours_float_0_1_and_out_of_range(tmp_path):
         with pytest.raises(ValueError, match=match):
             export.write_mesh_ply(tmp_path / "bad.ply", mesh)
     assert not (tmp_path / "bad.ply").exists()
+
+
+def test_mutation_audit_5_mesh_colours_and_export_pre_checks(result, tmp_path):
+    """What the mutation audit of today's export changes found untested: a mesh RGB that is not
+    (N, 3/4), negative integer colours alone, the point count of a point with two bad channels,
+    pcd as the one metric format of a result without calibration, and an object that is no
+    DepthResult: each refused before anything is written (nor a folder made)."""
+    pts = np.array([[0, 0, 1], [1, 0, 1], [0, 1, 1]], np.float32)
+    mesh = _fake_mesh(pts, [3, 0, 1, 2])
+    for bad, match in (
+        (np.zeros((3, 2), np.uint8), r"expected \(N, 3\) colours, got shape \(3, 2\)"),
+        (np.array([[0, 0, 0], [0, -1, 0], [1, 2, 3]]), "colours 0-255, got values -1 to 3$"),
+        (np.array([[2.0, 2.0, 0], [0, 0, 0], [0, 0, 0]]), "float colours are 0-1, got 1 point"),
+    ):
+        mesh.point_data["RGB"] = bad
+        with pytest.raises(ValueError, match=match):
+            export.write_mesh_ply(tmp_path / "bad.ply", mesh)
+    assert not (tmp_path / "bad.ply").exists()
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
+    with pytest.raises(ValueError, match=r"formats \['pcd'\] need one"):
+        export.export_result(bare, tmp_path / "pcd", ("npz", "pcd"))
+    assert not (tmp_path / "pcd").exists()
+    with pytest.raises(TypeError, match=r"^result: expected a stereovision\.DepthResult, got str$"):
+        export.export_result("depth.npz", tmp_path / "str", ("npz",))  # type: ignore[arg-type]
+    assert not (tmp_path / "str").exists()
