@@ -2383,3 +2383,33 @@ def test_a_mispairing_refusal_names_no_rejected_pair_among_the_numbers_that_diff
             [*left, tmp_path / "left20.png"], [*right, tmp_path / "right21.png"], square_size=1.0
         )
     assert "; the file numbers differ in left06.jpg / right05.jpg. Check" in str(err.value)
+
+
+def test_mutation_audit_5_a_repeat_is_both_images_and_is_said_in_number(
+    cached_corners: None, chessboard: tuple[Calibration, CalibrationReport]
+) -> None:
+    """What the mutation audit of today's repeat and vertical-rig changes found untested: a pair
+    sharing only its left (or right) image with an earlier one is no repeat; one repeat is said
+    in the singular and more than WORST_PAIRS_SHOWN are cut short; a side-by-side rig gets no
+    turn hint and a report without its calibration says |dy|."""
+    from dataclasses import replace
+
+    left, right = _chessboard_paths()
+    names = ["a", "b", "c", "d", "e", "f"]
+    with (
+        warnings.catch_warnings(),
+        pytest.raises(ValueError, match=r"mis-paired .* the file numbers differ in e, f\."),
+    ):
+        warnings.filterwarnings("error", message=".*repeat")  # a repeat said fails the test
+        warnings.filterwarnings("ignore", message="the left and right file numbers differ")
+        calibrate(
+            [*left[:4], left[0], left[5]], [*right[:4], right[5], right[0]], square_size=1.0,
+            names=names,
+        )  # fmt: skip
+    with pytest.warns(UserWarning, match=r"^e repeats an earlier pair \(the same board corners"):
+        calibrate([*left[:4], left[2]], [*right[:4], right[2]], square_size=1.0, names=names[:5])
+    with pytest.warns(UserWarning, match=r"^e, f, g and 1 more repeat an earlier pair \(the same"):
+        calibrate(left[:4] * 2, right[:4] * 2, square_size=1.0, names=[*"abcdefgh"])
+    cal, side_by_side = chessboard
+    assert calmod._upright_hint(cal) == ""
+    assert calmod._epipolar_label(replace(side_by_side, _calibration=None)) == "|dy|"
