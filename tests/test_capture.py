@@ -3983,6 +3983,11 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
         ),
         ("rtsp://[::1]?x=a@b", "rtsp://[::1]?x=a@b"),
         ("rtsp://u:p?w@[::1]:554/0", "rtsp://u:***@[::1]:554/0"),
+        # no port but 1 to 5 digits before the "?" (6 digits, none), and a "#" is no query:
+        # passwords still
+        ("rtsp://u:123456?k=v@cam/0", "rtsp://u:***@cam/0"),
+        ("rtsp://u:?k=v@cam/0", "rtsp://u:***@cam/0"),
+        ("rtsp://cam:554#k=v@b", "rtsp://cam:***@b"),
         # one URL is the whole source, spaces and all (a leading space too)
         ("http://cam/my video.avi?token=x", "http://cam/my video.avi?token=***"),
         (" http://cam/a b?token=x", " http://cam/a b?token=***"),
