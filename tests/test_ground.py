@@ -1626,3 +1626,42 @@ def test_cli_depth_ground_says_why_no_floor_was_tried(
     assert _no_floor_line(disp, calib) == (
         "ground plane: none found (no near-level plane holds 3 % of the pixels)"
     )
+
+
+def test_mutation_audit_5_no_floor_line_counts_pixels_as_the_fit_does() -> None:
+    """_no_floor_line counts a pixel as fit_ground_plane does, finite with disparity + doffs
+    > 0 (in front of the camera): a disparity of 0 is at infinity, not counted (doffs 0), and
+    with Middlebury's doffs (15 px) a disparity of -10 is 5 px in front, counted. The mutation
+    audit found both the '>= 0' and the doffs-less count unasserted."""
+    from stereovision.ground import MIN_PIXELS, _no_floor_line
+
+    def rig(doffs: float) -> Calibration:
+        return Calibration(
+            K1=[[F, 0, 239.5], [0, F, 179.5], [0, 0, 1]], D1=RIG.D1,
+            K2=[[F, 0, 239.5 + doffs], [0, F, 179.5], [0, 0, 1]], D2=RIG.D2,
+            R=RIG.R, T=RIG.T, image_size=SIZE, rectified=True,
+        )  # fmt: skip
+
+    disp = np.full((SIZE[1], SIZE[0]), np.nan)
+    disp.flat[:MIN_PIXELS] = 0.0
+    assert _no_floor_line(disp, rig(0.0)) == (
+        f"ground plane: none found (0 pixels have a disparity; a fit needs {MIN_PIXELS})"
+    )
+    assert fit_ground_plane(disp, rig(0.0)) is None
+    disp.flat[:MIN_PIXELS] = -10.0
+    assert _no_floor_line(disp, rig(15.0)) == (
+        "ground plane: none found (no near-level plane holds 3 % of the pixels)"
+    )
+    assert _no_floor_line(disp, rig(0.0)).startswith("ground plane: none found (0 pixels")
+
+
+def test_mutation_audit_5_scan_dict_scalars_are_mapped_not_rounded() -> None:
+    """as_dict maps range_min as the other scalars (a float32 went to json.dumps as a
+    TypeError) and keeps their digits: only the ranges are rounded to 0.1 mm."""
+    from stereovision.ground import LaserScan
+
+    ranges = np.float32([1.234567, 2.0])
+    scan = LaserScan(-0.5, 0.5, 0.123456789, np.float32(0.25), 20.0, ranges)
+    d = json.loads(json.dumps(scan.as_dict()))
+    assert d["range_min"] == 0.25 and d["angle_increment"] == 0.123456789
+    assert d["ranges"] == [1.2346, 2.0]
