@@ -2942,3 +2942,28 @@ def test_a_count_of_one_pair_is_said_in_the_singular(
     assert _bag_line(bag(0, 0), 1).startswith(
         "no ROS 2 bag written to b: none of the 1 pair processed; "
     )
+
+
+@pytest.mark.parametrize(
+    ("sources", "side", "lost"),
+    [
+        ({"left": "a.mp4", "right": 1}, "left", False),  # the file ended, not the camera
+        ({"left": "a.mp4", "right": 1}, "right", True),
+        ({"left": "a.mp4", "right": 1}, None, True),  # both ended: one was a camera
+        ({"left": np.int64(0), "right": "b.mp4"}, "both", True),
+        ({"left": "a.mp4", "right": "b.mp4"}, "both", False),
+    ],
+)
+def test_mutation_audit_5_a_device_ended_of_a_camera_and_a_file(
+    sources: dict[str, object], side: str | None, lost: bool
+) -> None:
+    """_device_ended looks at the side(s) that ended only: of a file beside a camera, the file's
+    end is an end, the camera's a loss; both ended, one camera is a loss. The mutation audit
+    found the side choice unasserted (every test had two cameras or two files)."""
+    from types import SimpleNamespace
+
+    from stereovision.capture import SourceError
+    from stereovision.stream import _device_ended
+
+    camera = SimpleNamespace(sources=sources)
+    assert _device_ended(camera, SourceError("ended", side=side, frames=3)) is lost
