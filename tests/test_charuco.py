@@ -1118,3 +1118,26 @@ def test_a_cut_legacy_board_is_not_read_in_the_other_layout_a_square_off() -> No
     full = render_charuco(true, K1, D1, np.array([0.1, -0.2, 0.0]), np.array([-0.22, -0.15, 0.7]))
     found = CharucoBoard("11x8", 0.04, 0.03, "DICT_7X7_100").resolve(full)
     assert found is not None and found.legacy is True
+
+
+def test_mutation_audit_5_white_black_squares_of_the_cut_legacy_board() -> None:
+    """_white_black_squares of the cut legacy board above: none of the right layout's black
+    squares is white, several of the wrong one's are (past the edge seen); an image without
+    contrast where the corners were found tells nothing (None). The mutation audit found the
+    count's threshold and the contrast check unasserted."""
+    from stereovision.charuco import _white_black_squares
+
+    true = CharucoBoard("11x8", 0.04, 0.03, "DICT_7X7_100", legacy=True)
+    rv, tv = np.array([0.05, 0.1, 0.0]), np.array([-0.05, -0.06, 0.45])
+    img = render_charuco(true, K1, D1, rv, tv, supersample=SS)
+    gray = img if img.ndim == 2 else cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    # a camera's noise: the black squares' centres are not all the darkest tone
+    noise = np.random.default_rng(5).normal(0.0, 6.0, gray.shape)
+    gray = np.clip(gray + noise, 0, 255).astype(np.uint8)
+    wrong_board = replace(true, legacy=False)
+    right, wrong = find_charuco_corners(img, true), find_charuco_corners(img, wrong_board)
+    assert right is not None and wrong is not None
+    assert _white_black_squares(gray, true, *right) == 0
+    misplaced = _white_black_squares(gray, wrong_board, *wrong)
+    assert misplaced is not None and misplaced >= 2
+    assert _white_black_squares(np.full_like(gray, 128), true, *right) is None
