@@ -3093,3 +3093,17 @@ def test_mutation_audit_5_number_options_at_their_limits() -> None:
     ):
         with pytest.raises(argparse.ArgumentTypeError, match=re.escape(f"got {text!r}")):
             parse(text)
+
+
+def test_mutation_audit_5_the_unit_hint_names_each_options_unit_and_none_for_a_count() -> None:
+    """_with_unit_hint's example is the option's own unit (--dpi's dpi) and a count (--count)
+    gets none: the sweep asserted only "without a unit", so a wrong unit or a "(5 for 5 None)"
+    passed it."""
+    from stereovision.cli import _with_unit_hint
+
+    assert _with_unit_hint("argument --dpi: expected a number, got '300dpi'") == (
+        "argument --dpi: expected a number without a unit (5 for 5 dpi), got '300dpi'"
+    )
+    assert _with_unit_hint("argument --count: expected an integer, got '10x'") == (
+        "argument --count: expected an integer without a unit, got '10x'"
+    )
