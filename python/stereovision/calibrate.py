@@ -1305,16 +1305,7 @@ def _check_pairing(
     pair_err = np.sqrt(np.mean(sol.per_view**2, axis=1))
     worst = np.argsort(-pair_err)[:WORST_PAIRS_SHOWN]
     listed = ", ".join(f"{names[k]} ({pair_err[k]:.1f} px)" for k in worst)
-    numbers = (
-        f"; the file numbers differ in {', '.join(differ[:WORST_PAIRS_SHOWN])}"
-        + (
-            f" and {len(differ) - WORST_PAIRS_SHOWN} more"
-            if len(differ) > WORST_PAIRS_SHOWN
-            else ""
-        )
-        if differ
-        else ""
-    )
+    numbers = f"; the file numbers differ in {_first_shown(differ)}" if differ else ""
     raise ValueError(
         f"stereo RMS {sol.rms:.1f} px, while each camera alone fits its boards to "
         f"{sol.rms_left:.2f} / {sol.rms_right:.2f} px: the pairs do not show one rig; are they "
@@ -1326,6 +1317,13 @@ def _check_pairing(
             else f"Check those pairs, or drop the outliers with {DROP_OUTLIERS_API}"
         )
     )
+
+
+def _first_shown(names: Sequence[str]) -> str:
+    """The first :data:`WORST_PAIRS_SHOWN` of ``names``, and how many more there are."""
+    shown = ", ".join(names[:WORST_PAIRS_SHOWN])
+    extra = len(names) - WORST_PAIRS_SHOWN
+    return f"{shown} and {extra} more" if extra > 0 else shown
 
 
 # ------------------------------------------------------------------------------------- public
@@ -1562,15 +1560,10 @@ def calibrate(
     pair_names = _pair_names(left_names, right_names, names)
     differ = _numbers_differ(left_names, right_names, pair_names)
     if differ:
-        shown = ", ".join(differ[:WORST_PAIRS_SHOWN])
-        more = (
-            f" and {len(differ) - WORST_PAIRS_SHOWN} more"
-            if len(differ) > WORST_PAIRS_SHOWN
-            else ""
-        )
+        shown = _first_shown(differ)
         _warn(
             notes,
-            f"the left and right file numbers differ in {shown}{more}: the pairs are taken in "
+            f"the left and right file numbers differ in {shown}: the pairs are taken in "
             "order, so a missing or extra file shifts the pairing",
             UserWarning,
         )
@@ -1609,15 +1602,10 @@ def calibrate(
         else:
             used.append(i)
     if repeats:
-        shown = ", ".join(repeats[:WORST_PAIRS_SHOWN])
-        more = (
-            f" and {len(repeats) - WORST_PAIRS_SHOWN} more"
-            if len(repeats) > WORST_PAIRS_SHOWN
-            else ""
-        )
+        shown = _first_shown(repeats)
         _warn(
             notes,
-            f"{shown}{more} repeat{'s' if len(repeats) == 1 else ''} an earlier pair (the same "
+            f"{shown} repeat{'s' if len(repeats) == 1 else ''} an earlier pair (the same "
             "board corners in both images): each view is used once",
             UserWarning,
         )
