@@ -4143,6 +4143,39 @@ def test_sequences_that_start_at_other_numbers_are_said_to_pair_in_order(tmp_pat
     assert (_read_stamp(fr.left), _read_stamp(fr.right)) == (1, 1)
 
 
+def test_a_warning_made_an_error_at_the_open_closes_what_was_opened(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Under ``python -W error`` the open's warnings raise: the sequences' start mismatch was
+    warned after the open's clean-up, so both captures stayed open (the object never came
+    back to be closed); a pixel format not delivered left the capture that said it open."""
+    for i in range(3):
+        if i:
+            cv2.imwrite(str(tmp_path / f"left_{i:04d}.png"), _numbered(i))
+        cv2.imwrite(str(tmp_path / f"right_{i:04d}.png"), _numbered(i))
+    opened: list[Any] = []
+    real = capmod._open_path
+
+    def recording(path: str, first: Any) -> Any:
+        opened.append(real(path, first))
+        return opened[-1]
+
+    monkeypatch.setattr(capmod, "_open_path", recording)
+    left, right = str(tmp_path / "left_%04d.png"), str(tmp_path / "right_%04d.png")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match=r"^the left sequence starts at left_0001\.png"):
+            StereoCamera(left, right)
+    assert len(opened) == 2 and not any(c.isOpened() for c in opened)
+    # The format's warning: both captures released (the right one said it).
+    caps = [_FormatCap("L", [], ("MJPG",)), _FormatCap("R", [], ("YUYV",))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match=r"right source .* delivers 'YUYV', not 'MJPG'"):
+            StereoCamera(*caps, fourcc="MJPG")
+    assert [c.released for c in caps] == [1, 1]
+
+
 class _UnpluggedCamera:
     """A camera device (``cv2.VideoCapture(index)`` stand-in) that delivers 3 frames, then
     none if its index is in ``gone``: unplugged."""

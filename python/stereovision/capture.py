@@ -1579,31 +1579,34 @@ class StereoCamera(PairSource):
         # which sources are camera devices (an index, /dev/video0, a /dev/v4l/by-id link),
         # known at the open: a by-id link is gone once its camera is unplugged
         self._device: dict[str, bool] = {}
+        # The warnings below are inside too: one made an error (python -W error) left both
+        # captures open, the object never returned to be closed.
         try:
             for side, src in self.sources.items():
                 self._caps[side] = self._open(side, src, fps, open_timeout)
                 path = os.fspath(src) if isinstance(src, os.PathLike) else src
                 self._device[side] = _camera_device(path) is not None
+            starts = self._sequence_start
+            if len(starts) == 2 and starts["left"] != starts["right"]:
+                # pairs are read in order, not by number: left_0001.png deleted (blurred)
+                # paired every left image with the right one before its own, without a word
+                # until the end
+                first = {
+                    side: os.path.basename(_sequence_name(os.fspath(src), starts[side]))
+                    for side, src in self.sources.items()
+                    if isinstance(src, (str, os.PathLike))  # a sequence is a path
+                }
+                warnings.warn(
+                    f"the left sequence starts at {first['left']}, the right one at "
+                    f"{first['right']}: images are paired in order ({first['left']} with "
+                    f"{first['right']}), not by their numbers; if the numbers name the pairs, "
+                    "remove the images without a partner (or renumber)",
+                    UserWarning,
+                    stacklevel=3,  # __init__, renamed_keyword's wrapper, the caller
+                )
         except BaseException:
             self.close()
             raise
-        starts = self._sequence_start
-        if len(starts) == 2 and starts["left"] != starts["right"]:
-            # pairs are read in order, not by number: left_0001.png deleted (blurred) paired
-            # every left image with the right one before its own, without a word until the end
-            first = {
-                side: os.path.basename(_sequence_name(os.fspath(src), starts[side]))
-                for side, src in self.sources.items()
-                if isinstance(src, (str, os.PathLike))  # a sequence is a path
-            }
-            warnings.warn(
-                f"the left sequence starts at {first['left']}, the right one at "
-                f"{first['right']}: images are paired in order ({first['left']} with "
-                f"{first['right']}), not by their numbers; if the numbers name the pairs, "
-                "remove the images without a partner (or renumber)",
-                UserWarning,
-                stacklevel=3,  # __init__, renamed_keyword's wrapper, the caller
-            )
 
     def _open(self, side: str, src: Source, fps: float | None, timeout: float | None) -> Any:
         configure = functools.partial(self._configure, side, fps)
@@ -1660,12 +1663,17 @@ class StereoCamera(PairSource):
             raise SourceError(f"cannot open {side} source {what}")
         got = self.delivered_fourcc[side]
         if self.requested_fourcc is not None and got != self.requested_fourcc:
-            warnings.warn(
-                f"{side} source {_describe_source(src)} delivers "
-                f"{repr(got) if got else 'no reported format'}, not {self.requested_fourcc!r}",
-                UserWarning,
-                stacklevel=4,  # _open, __init__, renamed_keyword's wrapper, the caller
-            )
+            try:
+                warnings.warn(
+                    f"{side} source {_describe_source(src)} delivers "
+                    f"{repr(got) if got else 'no reported format'}, not "
+                    f"{self.requested_fourcc!r}",
+                    UserWarning,
+                    stacklevel=4,  # _open, __init__, renamed_keyword's wrapper, the caller
+                )
+            except BaseException:  # made an error: this capture is not in _caps to close
+                cap.release()
+                raise
         return cap
 
     def _configure(
