@@ -6032,12 +6032,13 @@ def test_a_streams_password_is_not_said_when_it_does_not_open(monkeypatch, caplo
         open_stereo_source(url, "rtsp://cam/1")
     assert str(err.value) == "cannot open left source 'rtsp://admin:***@cam/0?token=***'"
     assert opened == [url]  # opened as given
-    # OpenCV's own pair (no capture module) takes no URL: refused without its password
+    # OpenCV's own pair (no capture module): a URL is opened, not looked for as a file ("left
+    # camera source not found: ..."), and refused without its password
+    monkeypatch.setattr("stereovision.gui.sources._open_capture", down)
     with pytest.raises(OSError) as err:
         VideoPair(url, "rtsp://cam/1")
-    assert str(err.value) == "left camera source not found: rtsp://admin:***@cam/0?token=***"
-    monkeypatch.setattr("stereovision.gui.sources._open_capture", down)
-    with pytest.raises(OSError) as err:  # a pattern is not looked for: opened, and refused
+    assert str(err.value) == "cannot open camera 'rtsp://admin:***@cam/0?token=***' (left)"
+    with pytest.raises(OSError) as err:  # one with a pattern's "%" too
         VideoPair("http://admin:s3cret@cam/f_%03d.jpg", "rtsp://cam/1")
     assert str(err.value) == "cannot open camera 'http://admin:***@cam/f_%03d.jpg' (left)"
     assert "s3cret" not in caplog.text and "tok77" not in caplog.text

@@ -1191,3 +1191,24 @@ def test_video_pair_says_a_stream_that_gives_no_frame_without_its_password(
     with pytest.raises(OSError, match=r"^camera 'rtsp://admin:\*\*\*@cam/0' gave no frame$"):
         pair.read()
     pair.close()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="V4L2 device nodes are Linux's")
+def test_video_pair_takes_a_stream_or_device_node_for_no_file(fake_cap: type[FakeCap]) -> None:
+    """Any text source was a file: a stream's URL without a "%" was refused as "left camera
+    source not found: rtsp://cam/0", and a camera given by its device node was not asked the
+    size, its missing frame taken for a file's end (rewound, not said)."""
+    pair = VideoPair("rtsp://cam/0", "/dev/video7", size=(640, 480))
+    stream, dev = fake_cap.made
+    assert (stream.src, dev.src) == ("rtsp://cam/0", "/dev/video7")
+    assert stream.props == {}  # a stream is asked no size
+    assert dev.props == {cv2.CAP_PROP_FRAME_WIDTH: 640, cv2.CAP_PROP_FRAME_HEIGHT: 480}
+    assert [tuple(int(x[0, 0, 0]) for x in pair.read()) for _ in range(2)] == [(10, 10), (20, 20)]
+    # Neither is rewound when it gives no frame: said, as a camera by its index is.
+    with pytest.raises(OSError, match=r"^camera 'rtsp://cam/0' gave no frame$"):
+        pair.read()
+    assert cv2.CAP_PROP_POS_FRAMES not in stream.props | dev.props
+    pair.close()
+    # A local path that does not exist is still refused as a file.
+    with pytest.raises(FileNotFoundError, match=r"^left camera source not found: nope\.avi$"):
+        VideoPair("nope.avi", "/dev/video7")

@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
+    _camera_device,
     _open_path,
     _open_within,
     _sequence_first,
@@ -363,10 +364,11 @@ class VideoPair:
     Parameters
     ----------
     left, right : int or str
-        Device index, video file, or image-sequence pattern (``"img_%03d.png"``), opened as
-        ``stereovision capture`` opens it (a sequence may start at any number).
+        Device index or node (``/dev/video0``), stream URL, video file, or image-sequence
+        pattern (``"img_%03d.png"``), opened as ``stereovision capture`` opens it (a sequence
+        may start at any number).
     size : (int, int), optional
-        Requested ``(width, height)`` for devices.
+        Requested ``(width, height)`` for devices (by index or node).
     open_timeout : float or None
         Seconds each open, with the size asked of a device, may take (None: no limit), as
         :class:`~stereovision.capture.StereoCamera`'s.
@@ -396,14 +398,18 @@ class VideoPair:
         try:
             for side, src in (("left", left), ("right", right)):
                 src = parse_source(src)
-                is_file = isinstance(src, str)
+                # Text is a file only when it is no URL nor camera device node: a stream
+                # (rtsp://cam/0) was refused as "camera source not found", a /dev/video2 was
+                # not asked the size and its missing frame was taken for a file's end.
+                device = not isinstance(src, str) or _camera_device(src) is not None
+                is_file = isinstance(src, str) and not device and "://" not in src
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
                     raise FileNotFoundError(
                         f"{side} camera source not found: {mask_url_secrets(str(src))}"
                     )
                 # bounded, the size asked with it: a wedged device hung its open, or a set,
                 # forever (OpenCV's log of the open stays quiet: the error below says what failed)
-                configure = None if size is None or is_file else partial(_ask_size, size)
+                configure = None if size is None or not device else partial(_ask_size, size)
                 first = _sequence_first(src) if isinstance(src, str) else None
                 cap = _open_within(
                     partial(_open_capture, src, first), open_timeout, side, src, configure
