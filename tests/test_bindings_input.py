@@ -379,6 +379,12 @@ try:
                 _core.gabor_remove_speckles(d, 10, 1.0)
         except ValueError as e:
             print("ValueError:", e)
+    elif case in ("log_too_large", "log_bad_sigma"):
+        img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
+        try:
+            _core.mcgm_log(img, 2.0 if case == "log_too_large" else 0.0)
+        except ValueError as e:
+            print("ValueError:", e)
     elif case == "available":
         print("available", sgm._available_bytes())
         raise MemoryError("none")
@@ -452,6 +458,27 @@ def test_in_place_kernels_refuse_2_to_the_32_pixels_before_copying(case: str) ->
         "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
     assert want in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        (
+            "log_too_large",
+            "image of 65536x65536 pixels is too large: the kernels index pixels with 32-bit "
+            "integers (at most 4294967295 pixels, 2147483647 per side)",
+        ),
+        ("log_bad_sigma", "sigma must lie in [0.3, 64] px, got 0"),
+    ],
+)
+def test_mcgm_log_refuses_before_copying_the_image(case: str, message: str) -> None:
+    """``mcgm_log`` copied a non-contiguous (broadcast) image before checking anything: a
+    65536 x 65536 one was a 16 GiB MemoryError under ``ulimit -v``, not the size's ValueError
+    the matcher gives, and a bad sigma was said only after that copy."""
+    out = _under_address_limit(case, 3_000_000 * 1024)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    assert f"ValueError: {message}" in out.stdout, out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

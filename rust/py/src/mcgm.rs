@@ -139,12 +139,16 @@ pub fn mcgm_log<'py>(
     sigma: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
-    let im = image_from_numpy(&img, "image")?;
+    // Both checks come before the copy below: a huge shape-only (broadcast) image was copied
+    // (a MemoryError, or gigabytes taken) before a bad sigma or its size was refused.
     if !(sigma.is_finite() && (0.3..=64.0).contains(&sigma)) {
         return Err(PyValueError::new_err(format!(
             "sigma must lie in [0.3, 64] px, got {sigma}"
         )));
     }
+    let (rows, cols) = img.as_array().dim();
+    stereovision_core::image::check_index_range(cols, rows).map_err(crate::errors::to_pyerr)?;
+    let im = image_from_numpy(&img, "image")?;
     let (w, h) = im.size();
     let data = crate::workers::detach(py, || guard("mcgm_log", || log_filter(&im, sigma)))?;
     image_to_numpy(
