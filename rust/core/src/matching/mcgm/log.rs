@@ -25,7 +25,18 @@ pub fn radius_for(sigma: f32) -> usize {
 }
 
 /// The two 1-D kernels `(g, a)` (taps `-r..=r`), `a` zero-mean on its support.
-pub fn log_kernels(sigma: f32) -> (Vec<f32>, Vec<f32>) {
+///
+/// A `sigma` that is not in `(0, MAX_SIGMA]` is [`crate::CoreError::InvalidParameter`].
+pub fn log_kernels(sigma: f32) -> Result<(Vec<f32>, Vec<f32>)> {
+    // Public: a Rust caller reaches it alone. 0 or NaN made the kernels NaN, inf made them
+    // empty (callers indexing the centre tap panicked), a huge sigma sized them past memory
+    // (an abort): refused here, and so for log_filter too.
+    if !(sigma > 0.0 && sigma <= MAX_SIGMA) {
+        return Err(crate::CoreError::param(
+            "sigma",
+            format!("must lie in (0, {MAX_SIGMA}] px, got {sigma}"),
+        ));
+    }
     let r = radius_for(sigma) as isize;
     let s2 = (sigma as f64) * (sigma as f64);
     let g: Vec<f64> = (-r..=r)
@@ -40,10 +51,10 @@ pub fn log_kernels(sigma: f32) -> (Vec<f32>, Vec<f32>) {
     for (av, gv) in a.iter_mut().zip(&g) {
         *av -= gv * sa / sg;
     }
-    (
+    Ok((
         g.iter().map(|&v| v as f32).collect(),
         a.iter().map(|&v| v as f32).collect(),
-    )
+    ))
 }
 
 /// Reflect-101 index of `i` in `0..n` (folds repeatedly for kernels wider than the image).
@@ -109,16 +120,9 @@ pub const MAX_SIGMA: f32 = 64.0;
 /// not in `(0, MAX_SIGMA]` is [`crate::CoreError::InvalidParameter`].
 pub fn log_filter(img: &Image, sigma: f32) -> Result<Vec<f32>> {
     // The binding and the matcher bound sigma before calling; a Rust caller reaches this
-    // alone: an infinite sigma emptied the kernels (an index panic), 0 or NaN made them NaN
-    // (a NaN map, Ok), a huge one sized them (and the padded rows) past memory (an abort).
-    if !(sigma > 0.0 && sigma <= MAX_SIGMA) {
-        return Err(crate::CoreError::param(
-            "sigma",
-            format!("must lie in (0, {MAX_SIGMA}] px, got {sigma}"),
-        ));
-    }
+    // alone: log_kernels refuses a sigma outside (0, MAX_SIGMA] before anything is sized.
+    let (g, a) = log_kernels(sigma)?;
     let (w, h) = img.size();
-    let (g, a) = log_kernels(sigma);
     let r = g.len() / 2;
     // Row passes: hg = I *_x g, ha = I *_x a.
     let mut hg = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;

@@ -48,7 +48,7 @@ fn blobs(w: usize, h: usize, shift: f32) -> Image {
 #[test]
 fn log_kernel_sums_to_zero_and_flat_images_give_nothing() {
     for sigma in [1.0f32, 2.0, 4.0] {
-        let (g, a) = log_kernels(sigma);
+        let (g, a) = log_kernels(sigma).unwrap();
         let (sg, sa): (f64, f64) = (
             g.iter().map(|&v| v as f64).sum(),
             a.iter().map(|&v| v as f64).sum(),
@@ -882,7 +882,7 @@ fn log_kernels_and_reflect_have_the_specified_values() {
     // g(t) = exp(-t^2 / 2 sigma^2); a = (t^2 / sigma^2 - 1) g / (2 pi sigma^2), made zero-mean
     // by subtracting g sum(a) / sum(g).
     let sigma = 1.5f64;
-    let (g, a) = log_kernels(sigma as f32);
+    let (g, a) = log_kernels(sigma as f32).unwrap();
     let r = 6isize;
     assert_eq!(g.len(), 13);
     let gw: Vec<f64> = (-r..=r)
@@ -928,7 +928,7 @@ fn log_filter_equals_the_direct_2d_convolution() {
     for &(w, h, sigma) in &[(13usize, 7usize, 1.0f32), (5, 9, 2.0), (9, 4, 0.7)] {
         let mut rnd = unit_rng(w as u64 * 31 + h as u64);
         let img = Image::new(w, h, (0..w * h).map(|_| rnd()).collect()).unwrap();
-        let (g, a) = log_kernels(sigma);
+        let (g, a) = log_kernels(sigma).unwrap();
         let r = (g.len() / 2) as isize;
         let got = log_filter(&img, sigma).unwrap();
         for y in 0..h {
@@ -2346,7 +2346,7 @@ fn association_weights_too_large_to_allocate_are_an_error() {
 fn log_filter_per_pixel_reflect(img: &Image, sigma: f32) -> Vec<f32> {
     use super::log::reflect;
     let (w, h) = img.size();
-    let (g, a) = log_kernels(sigma);
+    let (g, a) = log_kernels(sigma).unwrap();
     let r = g.len() / 2;
     let (mut hg, mut ha) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
     for y in 0..h {
@@ -3059,4 +3059,23 @@ fn log_filter_refuses_a_sigma_outside_its_range() {
     for sigma in [0.1, 64.0] {
         assert_eq!(log_filter(&img, sigma).unwrap().len(), 200);
     }
+}
+
+#[test]
+fn log_kernels_refuse_a_sigma_outside_their_range() {
+    // Public, unchecked for a Rust caller: 0 and NaN gave NaN kernels, inf empty ones (a
+    // caller indexing the centre tap panicked), 1e9 sized them past memory (an abort).
+    for sigma in [f32::INFINITY, 0.0, -1.0, f32::NAN, 1e9, 64.001] {
+        assert_eq!(
+            log_kernels(sigma),
+            Err(CoreError::param(
+                "sigma",
+                format!("must lie in (0, 64] px, got {sigma}")
+            )),
+            "{sigma}"
+        );
+    }
+    // The ends of the range: radius ceil(4 sigma), at least 1.
+    assert_eq!(log_kernels(0.1).unwrap().0.len(), 3);
+    assert_eq!(log_kernels(64.0).unwrap().1.len(), 513);
 }
