@@ -56,7 +56,7 @@ pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
 /// [`crate::CoreError::TooLarge`].
 pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Result<RTable> {
     const WHAT: &str = "an R-table of the MCGM matcher";
-    check_positions(theta, w)?;
+    check_positions(theta, w, seg.pixels.len(), n_bins)?;
     let mut counts = try_zeroed::<u32>(n_bins + 1, WHAT)?;
     let bins = try_collect(
         seg.pixels.len(),
@@ -92,8 +92,22 @@ pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Re
 /// Refuses an image (`theta`, `w` wide) whose pixel positions would not fit the i32 columns and
 /// rows of an R-table or a voter ([`crate::image::check_index_range`]): they wrapped silently
 /// (a pixel on row 2^31 of a 1-wide image became row -2^31). Once per call, not per pixel:
-/// every pixel indexes `theta`, so its row is below `ceil(len / w)`.
-fn check_positions(theta: &[f32], w: usize) -> Result<()> {
+/// every pixel indexes `theta`, so its row is below `ceil(len / w)`. `n_pixels` pixels need a
+/// width and a bin count of at least 1 (`% w`, `% n_bins`: a division by zero panicked); with
+/// no pixel the result is empty, as [`super::zerocross::zero_crossings`]' for a 0-wide image.
+fn check_positions(theta: &[f32], w: usize, n_pixels: usize, n_bins: usize) -> Result<()> {
+    if n_pixels > 0 && w == 0 {
+        return Err(crate::CoreError::param(
+            "w",
+            format!("must be at least 1 for {n_pixels} pixels, got 0"),
+        ));
+    }
+    if n_pixels > 0 && n_bins == 0 {
+        return Err(crate::CoreError::param(
+            "n_bins",
+            format!("must be at least 1 for {n_pixels} pixels, got 0"),
+        ));
+    }
     crate::image::check_index_range(w, theta.len().div_ceil(w.max(1)))
 }
 
@@ -118,7 +132,7 @@ pub fn voters(
     w: usize,
     n_bins: usize,
 ) -> Result<Vec<(i32, i32, u32)>> {
-    check_positions(theta, w)?;
+    check_positions(theta, w, pixels.len(), n_bins)?;
     let it = pixels.iter().map(|&q| {
         let (x, y) = ((q as usize % w) as i32, (q as usize / w) as i32);
         (x, y, theta_bin(theta[q as usize], n_bins) as u32)

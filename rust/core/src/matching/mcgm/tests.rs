@@ -3079,3 +3079,44 @@ fn log_kernels_refuse_a_sigma_outside_their_range() {
     assert_eq!(log_kernels(0.1).unwrap().0.len(), 3);
     assert_eq!(log_kernels(64.0).unwrap().1.len(), 513);
 }
+
+#[test]
+fn rtables_and_voters_of_a_zero_width_or_zero_bins_are_errors_or_empty() {
+    // `% w` and `% n_bins` divided by zero (a panic) for a segment with pixels.
+    let seg = Segment {
+        pixels: vec![0, 2],
+        centroid: (1.0, 0.0),
+        x_min: 0,
+        x_max: 2,
+        y_min: 0,
+        y_max: 0,
+        mean_theta: 0.0,
+    };
+    let theta = [0.0f32, 1.0, 2.0];
+    let zero_w = Err(CoreError::param(
+        "w",
+        "must be at least 1 for 2 pixels, got 0",
+    ));
+    assert_eq!(voters(&seg.pixels, &theta, 0, 36).map(|_| ()), zero_w);
+    assert_eq!(build_rtable(&seg, &theta, 0, 36).map(|_| ()), zero_w);
+    let zero_bins = Err(CoreError::param(
+        "n_bins",
+        "must be at least 1 for 2 pixels, got 0",
+    ));
+    assert_eq!(voters(&seg.pixels, &theta, 3, 0).map(|_| ()), zero_bins);
+    assert_eq!(build_rtable(&seg, &theta, 3, 0).map(|_| ()), zero_bins);
+    // No pixel (a 0-wide image has none): empty results, as before.
+    let empty = Segment {
+        pixels: vec![],
+        ..seg.clone()
+    };
+    assert_eq!(voters(&[], &[], 0, 0).unwrap(), []);
+    let rt = build_rtable(&empty, &[], 0, 4).unwrap();
+    assert_eq!((rt.offsets, rt.vecs.len(), rt.px.len()), (vec![0; 5], 0, 0));
+    assert_eq!(build_rtable(&empty, &[], 0, 0).unwrap().offsets, [0]);
+    // Width 1 and a single bin still work: pixel 2 is (0, 2), all in bin 0.
+    assert_eq!(
+        voters(&seg.pixels, &theta, 1, 1).unwrap(),
+        [(0, 0, 0), (0, 2, 0)]
+    );
+}
