@@ -1882,6 +1882,9 @@ mod tests {
         // A weak peak (curvature -0.002) is still a peak; a flat top is not.
         assert_eq!(parabola_offset(0.0, 0.001, 0.0), Some(0.0));
         assert_eq!(parabola_offset(0.5, 0.5, 0.5), None);
+        // The documented threshold: curvature -8e-7 (>= -1e-6) is no peak, -1.2e-6 is one.
+        assert_eq!(parabola_offset(0.0, 4e-7, 0.0), None);
+        assert_eq!(parabola_offset(0.0, 6e-7, 0.0), Some(0.0));
         // The offset is the vertex's: peak 0.25 to the right, and clamped to one shift.
         assert_eq!(parabola_offset(0.0, 1.0, 0.5), Some(0.5 * -0.5 / -1.5));
         assert_eq!(parabola_offset(0.0, 0.5, 0.999), Some(1.0));

@@ -1164,6 +1164,28 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn collinear_points_are_no_plane_even_with_rounding_in_their_centre() {
+        // Five measured pixels on the line x = 3 y + 1 (one label, not connected: plane_fill
+        // takes any labels) span no plane. Their centre (8.2, 2.4) is inexact, so the normal
+        // matrix's determinant is a rounding residue, not exactly 0: only the relative
+        // threshold refuses it (with `<= 0` the solve filled the hole off the line).
+        let (w, h) = (17, 6);
+        let line = [(1, 0), (4, 1), (7, 2), (13, 4), (16, 5)];
+        let mut d = vec![5.0f32; w * h];
+        let mut labels = vec![1u32; w * h];
+        for &(x, y) in &line {
+            labels[y * w + x] = 0;
+            d[y * w + x] = 2.0 + 0.1 * y as f32;
+        }
+        let hole = 5 * w; // (0, 5), off the line
+        labels[hole] = 0;
+        d[hole] = f32::NAN;
+        let s = plane_fill(&mut d, &labels, w, 3, 1.0, f32::NEG_INFINITY, f32::INFINITY).unwrap();
+        assert_eq!(s, PlaneFillStats::default());
+        assert!(d[hole].is_nan(), "{}", d[hole]);
+    }
+
+    #[test]
     fn fill_planes_odd_step_offsets_by_half_rounded_down() {
         // Grey 1 | 2 at step 3: offset 0 bins them 0 0 (one region, a step no plane fits),
         // offset 1 (3 / 2) bins them 0 1 (two flat regions); offset 2 would bin them 1 1.
