@@ -1806,3 +1806,28 @@ def test_render_view_takes_a_numpy_size():
     as_array = render.render_view(cloud, size=np.array([160, 120]))
     assert as_array.shape == (120, 160, 3)
     assert np.array_equal(as_array, render.render_view(cloud, size=(160, 120)))
+
+
+@pytest.mark.parametrize(
+    "size, said",
+    [
+        ((0, 0), "got (0, 0)"),  # VTK's default 300 x 300
+        ((0, 50), "got (0, 50)"),  # the screen's size
+        ((-5, 10), "got (-5, 10)"),  # a 21849 x 300 picture of shader errors
+        ((np.int64(64), np.int64(0)), "got (64, 0)"),
+        ((64.0, 48), "got (64.0, 48)"),  # VTK's own TypeError
+        ((True, True), "got (True, True)"),  # a 1 x 1 picture
+        ((64,), "got (64,)"),  # an IndexError
+        ((70_000, 70_000), "70000x70000 pixels is too large"),
+    ],
+)
+def test_render_view_refuses_a_size_it_would_not_render(size, said):
+    """A size of no pixels, negative, fractional or of another length came back as some other
+    size (300 x 300, 1920 x 1080, 21849 x 300) or as VTK's errors: refused, naming ``size``,
+    before any window is made; with intrinsics, whose scale it sets, too."""
+    cloud = render.point_cloud(np.array([[0.0, 0.0, 2.0], [0.1, 0.1, 2.0]]))
+    intr = render.Intrinsics(f=400.0, cx=199.5, cy=149.5, width=400, height=300)
+    for intrinsics in (None, intr):
+        with pytest.raises(ValueError, match=r"^size: .*" + re.escape(said)):
+            render.render_view(cloud, intrinsics=intrinsics, size=size)
+    assert render.render_view(cloud, size=(64, 48)).shape == (48, 64, 3)

@@ -970,6 +970,29 @@ def median_depth(geometry: pv.PolyData) -> float:
     return float(np.median(z)) if z.size else _DEFAULT_FOCAL_DISTANCE
 
 
+def _render_size(size: Any) -> tuple[int, int]:
+    """``render_view``'s ``size`` as ``(width, height)`` ints, checked: VTK took (0, 0) for its
+    default 300 x 300, (0, 50) for the screen's 1920 x 1080, and (-5, 10) for a 21849 x 300
+    picture of shader errors, all without a word."""
+    from stereovision._validate import check_index_range
+
+    try:
+        items = list(size)
+    except TypeError:
+        items = []
+    whole = len(items) == 2 and all(
+        isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)) for v in items
+    )
+    if not whole or min(int(v) for v in items) < 1:
+        # NumPy numbers as plain ones: "(0, 0)", not "(np.int64(0), np.int64(0))"
+        shown = tuple(v.item() if isinstance(v, np.generic) else v for v in items)
+        shown = shown if len(items) == 2 else size
+        raise ValueError(f"size: expected (width, height) in whole pixels >= 1, got {shown!r}")
+    width, height = (int(v) for v in items)
+    check_index_range((height, width), "size", "render")
+    return width, height
+
+
 def render_view(
     geometry: pv.PolyData,
     controls: CameraControls | None = None,
@@ -1006,11 +1029,14 @@ def render_view(
     Raises
     ------
     ValueError
-        Both ``controls`` and ``camera`` given.
+        Both ``controls`` and ``camera`` given, or a ``size`` that is not two whole numbers of
+        pixels >= 1 (within the writer's 32-bit pixel indices).
     """
     if camera is not None and controls is not None:
         raise ValueError("render_view: give controls or camera, not both")
     controls = controls or CameraControls()
+    if size is not None:
+        size = _render_size(size)
     if intrinsics is not None:
         if size is not None:
             intrinsics = intrinsics.scaled(size[0] / intrinsics.width)
