@@ -1831,3 +1831,22 @@ def test_render_view_refuses_a_size_it_would_not_render(size, said):
         with pytest.raises(ValueError, match=r"^size: .*" + re.escape(said)):
             render.render_view(cloud, intrinsics=intrinsics, size=size)
     assert render.render_view(cloud, size=(64, 48)).shape == (48, 64, 3)
+
+
+@pytest.mark.parametrize(
+    "kwargs, said",
+    [
+        ({"step": True}, r"^step must be a positive integer, got True"),  # taken as 1
+        ({"max_jump": "0.1"}, r"^max_jump must be positive, got '0.1'"),  # a TypeError
+        ({"max_jump": None}, r"^max_jump must be positive, got None"),
+        ({"max_jump": True}, r"^max_jump must be positive, got True"),
+    ],
+)
+def test_surface_mesh_refuses_a_step_or_jump_that_is_no_number(result, kwargs, said):
+    """A bool for ``step`` was a stride of 1 and a text or None for ``max_jump`` raised
+    ``'>' not supported``, naming neither: refused in their names. A NumPy number and an
+    infinite jump (no limit) are taken."""
+    with pytest.raises(ValueError, match=said):
+        render.surface_mesh(result, **kwargs)
+    every = render.surface_mesh(result, step=np.int64(1), max_jump=np.float32(math.inf))
+    assert every.n_cells == _oracle_triangle_count(result.depth, math.inf)

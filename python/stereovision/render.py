@@ -741,10 +741,19 @@ def surface_mesh(
     """
     pv = _pv()
     _check_result(result)
-    if not isinstance(step, (int, np.integer)) or step < 1:
+    from stereovision._validate import _real_scalar
+
+    # a bool was taken as a stride of 1, and a text or None for max_jump raised a TypeError
+    # naming neither ('>' not supported)
+    if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1:
         raise ValueError(f"step must be a positive integer, got {step!r}")
-    if not max_jump > 0:
-        raise ValueError(f"max_jump must be positive, got {max_jump}")
+    try:
+        jump = math.nan if isinstance(max_jump, bool) else _real_scalar(max_jump)
+    except TypeError:
+        jump = math.nan
+    if not jump > 0:  # inf is no limit: every triangle between depths is kept
+        raise ValueError(f"max_jump must be positive, got {max_jump!r}")
+    max_jump = jump
     h, w = result.disparity.shape[:2]
     xs, ys = result.pixels[:, 0], result.pixels[:, 1]
     on_grid = (xs % step == 0) & (ys % step == 0)
