@@ -1850,3 +1850,53 @@ def test_surface_mesh_refuses_a_step_or_jump_that_is_no_number(result, kwargs, s
         render.surface_mesh(result, **kwargs)
     every = render.surface_mesh(result, step=np.int64(1), max_jump=np.float32(math.inf))
     assert every.n_cells == _oracle_triangle_count(result.depth, math.inf)
+
+
+def _wide_cloud() -> tuple[np.ndarray, np.ndarray]:
+    """A wall 5 m ahead seen by a KITTI-wide camera (81 degrees across, 29 down): grey, with a
+    red column at its left edge and a blue one at its right."""
+    xs, ys = np.meshgrid(np.linspace(-4.2, 4.2, 241), np.linspace(-1.3, 1.3, 41))
+    pts = np.stack([xs.ravel(), ys.ravel(), np.full(xs.size, 5.0)], axis=1)
+    colors = np.full((len(pts), 3), 128, np.uint8)
+    colors[pts[:, 0] < -4.1] = (255, 0, 0)
+    colors[pts[:, 0] > 4.1] = (0, 0, 255)
+    return pts, colors
+
+
+def test_view_of_a_wide_cloud_shows_all_of_it(tmp_path, monkeypatch):
+    """A bare cloud was seen through a fixed 60-degree view (75 across at 800x600): a wide
+    camera's cloud lost its sides (6 % of ``depth``'s KITTI cloud). The view widens to fit it,
+    in the screenshot and in the window; a cloud that fits keeps the 60 degrees."""
+    from stereovision.io import write_ply
+
+    pts, colors = _wide_cloud()
+    write_ply(tmp_path / "wide.ply", pts, colors)
+    args = _view_args(tmp_path / "wide.ply", tmp_path / "shot.png")
+    assert args.func(args) == 0
+    rgb = cv2.imread(str(tmp_path / "shot.png"))[..., ::-1].astype(int)
+    red = (rgb[..., 0] > 150) & (rgb[..., 1] < 60) & (rgb[..., 2] < 60)
+    blue = (rgb[..., 2] > 150) & (rgb[..., 0] < 60) & (rgb[..., 1] < 60)
+    assert red.sum() > 50 and blue.sum() > 50, (red.sum(), blue.sum())
+    assert np.nonzero(red)[1].max() < 400 < np.nonzero(blue)[1].min()  # red left, blue right
+    intr = render.cloud_view_intrinsics(pts)
+    assert render.points_in_view(pts, CameraControls(), (800, 600), intr) == len(pts)
+    assert 60.0 < math.degrees(2 * math.atan(300 / intr.f)) < render.MAX_FIT_FOV_DEG
+    # a cloud inside 60 degrees, or none in front, keeps them
+    default_f = 300 / math.tan(math.radians(render.DEFAULT_FOV_DEG / 2))
+    for kept in (pts * [0.5, 0.5, 1.0], pts * [1.0, 1.0, -1.0]):
+        assert render.cloud_view_intrinsics(kept).f == pytest.approx(default_f, rel=1e-12)
+    # as wide as MAX_FIT_FOV_DEG at most: a point almost beside the camera cannot fit
+    beside = np.vstack([pts, [[10.0, 0.0, 1e-6]]])
+    widest = math.degrees(2 * math.atan(300 / render.cloud_view_intrinsics(beside).f))
+    assert widest == pytest.approx(render.MAX_FIT_FOV_DEG)
+    # the window (1024 x 768, 4:3 as the screenshot) opens with the same angle
+    monkeypatch.setattr(render, "_has_display", lambda: True)
+    make = render.make_plotter
+    monkeypatch.setattr(render, "make_plotter", lambda size, off_screen=True: make(size))
+    seen: dict[str, float] = {}
+    monkeypatch.setattr(
+        pv.Plotter, "show", lambda plotter, *a, **k: seen.update(angle=plotter.camera.view_angle)
+    )
+    args = _view_args(tmp_path / "wide.ply", None)
+    assert args.func(args) == 0
+    assert seen["angle"] == pytest.approx(math.degrees(2 * math.atan(300 / intr.f)))
