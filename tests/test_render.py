@@ -1900,3 +1900,22 @@ def test_view_of_a_wide_cloud_shows_all_of_it(tmp_path, monkeypatch):
     args = _view_args(tmp_path / "wide.ply", None)
     assert args.func(args) == 0
     assert seen["angle"] == pytest.approx(math.degrees(2 * math.atan(300 / intr.f)))
+
+
+def test_a_cloud_millimetres_away_is_not_clipped_whole():
+    """The near plane was at least 1 cm: a cloud 4-6 mm ahead (a stereo microscope's) rendered
+    an empty picture, with every point in view and no warning. The floor is now 0.1 % of the far
+    distance for a scene within 10 m; farther scenes keep the 1 cm."""
+    rng = np.random.default_rng(7)
+    pts = rng.uniform([-1e-3, -1e-3, 4e-3], [1e-3, 1e-3, 6e-3], (3000, 3))
+    white = np.full((len(pts), 3), 255, np.uint8)
+    near, far = render.robust_clipping_range(pts, [0, 0, 0])
+    dist = np.linalg.norm(pts, axis=1)
+    assert near == pytest.approx(render.NEAR_FACTOR * np.percentile(dist, 0.5))
+    assert near < 4e-3 < 6e-3 < far
+    img = render.render_view(render.point_cloud(pts, white), size=(160, 120))
+    assert render.points_in_view(pts, CameraControls(), (160, 120)) == len(pts)
+    assert not render.is_blank(img)
+    # a camera inside a cloud 20 m deep keeps the 1 cm floor
+    deep = np.vstack([np.zeros((50, 3)), rng.uniform([-5, -5, 1], [5, 5, 10], (950, 3))])
+    assert render.robust_clipping_range(deep, [0, 0, 0])[0] == render.MIN_NEAR

@@ -96,6 +96,10 @@ CLIP_HIGH_PERCENTILE = 99.5
 NEAR_FACTOR = 0.5
 FAR_FACTOR = 2.0
 MIN_NEAR = 0.01  # metres
+#: ... or this fraction of the far distance when that is less (VTK's own near-plane tolerance for
+#: a 24-bit depth buffer): a cloud a few millimetres away (a stereo microscope's) was clipped
+#: whole by the 1 cm floor.
+MIN_NEAR_OF_FAR = 0.001
 CLIP_SAMPLE = 20_000  # points used to estimate the range
 
 #: The camera looks at a point this far ahead when there is no scene depth to use (metres).
@@ -448,7 +452,8 @@ def robust_clipping_range(points: npt.ArrayLike, position: npt.ArrayLike) -> tup
     """Near and far clipping distances covering the bulk of ``points`` seen from ``position``.
 
     ``near = NEAR_FACTOR x`` the :data:`CLIP_LOW_PERCENTILE` distance (at least
-    :data:`MIN_NEAR`), ``far = FAR_FACTOR x`` the :data:`CLIP_HIGH_PERCENTILE` distance; at most
+    :data:`MIN_NEAR`, or :data:`MIN_NEAR_OF_FAR` of the far distance when that is less: a scene
+    within 10 m), ``far = FAR_FACTOR x`` the :data:`CLIP_HIGH_PERCENTILE` distance; at most
     :data:`CLIP_SAMPLE` evenly spaced points are used.
 
     Returns
@@ -463,8 +468,10 @@ def robust_clipping_range(points: npt.ArrayLike, position: npt.ArrayLike) -> tup
     dist = dist[np.isfinite(dist)]
     if dist.size == 0:
         return MIN_NEAR, 1000.0 * MIN_NEAR
-    near = max(MIN_NEAR, NEAR_FACTOR * float(np.percentile(dist, CLIP_LOW_PERCENTILE)))
-    far = max(near * 10, FAR_FACTOR * float(np.percentile(dist, CLIP_HIGH_PERCENTILE)))
+    reach = FAR_FACTOR * float(np.percentile(dist, CLIP_HIGH_PERCENTILE))
+    floor = min(MIN_NEAR, MIN_NEAR_OF_FAR * reach) if reach > 0 else MIN_NEAR
+    near = max(floor, NEAR_FACTOR * float(np.percentile(dist, CLIP_LOW_PERCENTILE)))
+    far = max(near * 10, reach)
     return near, far
 
 
