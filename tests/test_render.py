@@ -1919,3 +1919,30 @@ def test_a_cloud_millimetres_away_is_not_clipped_whole():
     # a camera inside a cloud 20 m deep keeps the 1 cm floor
     deep = np.vstack([np.zeros((50, 3)), rng.uniform([-5, -5, 1], [5, 5, 10], (950, 3))])
     assert render.robust_clipping_range(deep, [0, 0, 0])[0] == render.MIN_NEAR
+
+
+def test_view_window_of_a_wide_scene_shows_all_of_it(monkeypatch):
+    """A scene folder's window (its textured surface, with the scene's own camera) opened at the
+    fixed 60 degrees too: a wide scene lost its sides there as a bare cloud did. It opens
+    wide enough for all of it (the scene's 3.3:1 camera would not fill the 4:3 window)."""
+    pts, colors = _wide_cloud()
+    cloud = render.point_cloud(pts, colors)
+    kitti = render.Intrinsics(f=721.5, cx=609.5, cy=172.9, width=1242, height=375)
+    monkeypatch.setattr(render, "load_view_source", lambda source, max_points: (cloud, kitti))
+    monkeypatch.setattr(render, "_has_display", lambda: True)
+    make = render.make_plotter
+    monkeypatch.setattr(render, "make_plotter", lambda size, off_screen=True: make(size))
+    seen: dict[str, object] = {}
+
+    def draw(plotter, *args, **kwargs):
+        seen["img"] = np.asarray(plotter.screenshot(return_img=True))[..., :3].astype(int)
+        seen["size"] = tuple(plotter.window_size)
+
+    monkeypatch.setattr(pv.Plotter, "show", draw)
+    args = _view_args(Path("scene"), None)
+    assert args.func(args) == 0
+    rgb = seen["img"]
+    red = (rgb[..., 0] > 150) & (rgb[..., 1] < 60) & (rgb[..., 2] < 60)
+    blue = (rgb[..., 2] > 150) & (rgb[..., 0] < 60) & (rgb[..., 1] < 60)
+    assert red.sum() > 50 and blue.sum() > 50, (red.sum(), blue.sum())
+    assert seen["size"] == render.VIEW_WINDOW_SIZE == (1024, 768)

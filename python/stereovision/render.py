@@ -76,6 +76,9 @@ MAX_FIT_FOV_DEG = 120.0
 #: Size (width, height) of a render without intrinsics, pixels.
 DEFAULT_VIEW_SIZE = (800, 600)
 
+#: Size (width, height) of ``stereovision view``'s window, pixels.
+VIEW_WINDOW_SIZE = (1024, 768)
+
 #: Background of every render (RGB, 0-255): dark grey, so black texture pixels stay visible.
 BACKGROUND = (32, 32, 36)
 
@@ -1523,22 +1526,18 @@ def cmd_view(args: argparse.Namespace) -> int:
             "display only; --max-points 0 shows all)",
             file=sys.stderr,
         )
-    if intr is None:  # a bare cloud: a view wide enough for all of it
-        intr = cloud_view_intrinsics(geometry.points)
-        fitted = True
-    else:
-        fitted = False
     if window:
-        plotter = make_plotter((1024, 768), off_screen=False)
+        size = VIEW_WINDOW_SIZE
+        plotter = make_plotter(size, off_screen=False)
         add_geometry(plotter, geometry)
         # a mouse drag resets the clipping range from the bounds, which far outliers ruin
         keep_robust_clipping(plotter, geometry.points)
         apply_camera(
             plotter,
             controls,
-            # the fitted view's angle (the window has its 4:3 shape); a scene's own camera,
-            # of another shape, is not forced on the window
-            intrinsics=intr if fitted else None,
+            # a view wide enough for all of it, a scene's too: its own camera (KITTI's is 3.3:1)
+            # would not fill the window's 4:3, and the fixed 60 degrees lost a wide one's sides
+            intrinsics=cloud_view_intrinsics(geometry.points, size),
             focal_distance=median_depth(geometry),
             points=geometry.points,
         )
@@ -1555,6 +1554,8 @@ def cmd_view(args: argparse.Namespace) -> int:
             f"{why}: no window; writing a screenshot to {out} instead (-o names another)",
             stacklevel=1,
         )
+    if intr is None:  # a bare cloud: a view wide enough for all of it
+        intr = cloud_view_intrinsics(geometry.points)
     img = render_view(geometry, controls, intrinsics=intr)
     if points_in_view(geometry.points, controls, (img.shape[1], img.shape[0]), intr) == 0:
         import warnings
