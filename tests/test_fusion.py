@@ -821,6 +821,39 @@ def test_vote_bounds_are_inclusive() -> None:
     assert len(res) == 1 and res.dispy[4, 4] == pytest.approx(0.5)
 
 
+@pytest.mark.parametrize("bad", [float("nan"), "0.2", None, -0.1, 1.5, True])
+def test_a_conf_min_that_is_no_confidence_is_named(bad: object) -> None:
+    """``a_conf_min`` NaN took no Gabor value at all without a word (``conf >= nan`` is False:
+    match(method="fused", a_conf_min=nan) fused the sparse channels alone), a string or None
+    failed in NumPy's comparison naming no parameter. 0 and 1 are its edges."""
+    hop = _m([(5, 5, 10.0)])
+    with pytest.raises(ValueError, match=r"^a_conf_min: expected a"):
+        fuse(_dense(10.0, 0.5), {"hopfield": hop}, a_conf_min=bad)  # type: ignore[arg-type]
+    assert fuse(_dense(10.0, 0.0), {"hopfield": hop}, a_conf_min=0).sources[0] == 1 | 4
+    assert fuse(_dense(10.0, 1.0), {"hopfield": hop}, a_conf_min=1.0).sources[0] == 1 | 4
+
+
+@pytest.mark.parametrize("bad", [float("nan"), 2.5, "2", None, True])
+def test_min_agree_that_is_no_count_is_named(bad: object) -> None:
+    """``min_agree`` NaN or 2.5 failed in range() ("'float' object cannot be interpreted as an
+    integer"), a string or None in a comparison, naming no parameter; a NumPy int is a count."""
+    hop = _m([(5, 5, 10.0)])
+    with pytest.raises(ValueError, match=r"^min_agree: expected a whole number of channels"):
+        fuse(_dense(10.0), {"hopfield": hop}, min_agree=bad)  # type: ignore[arg-type]
+    assert len(fuse(_dense(10.0), {"hopfield": hop}, min_agree=np.int64(2))) == 1
+
+
+@pytest.mark.parametrize("name", ["fill_confidence", "second_confidence"])
+@pytest.mark.parametrize("bad", ["0.5", None])
+def test_dense_confidence_that_is_no_number_is_named(name: str, bad: object) -> None:
+    """fused_dense's confidences given a string or None failed in the range check's comparison
+    ("'<' not supported between instances of 'int' and 'str'"), naming no parameter
+    (depth_map(..., second_confidence="0.5") too)."""
+    d = np.full((H, W), np.nan, np.float32)
+    with pytest.raises(ValueError, match=f"^{name}: expected a finite number"):
+        fused_dense(d, d, d, **{name: bad})
+
+
 def test_tau_dy_alone_bounds_the_y_disparity() -> None:
     """``tau_dy`` (not ``tau_dx``) decides on y: 1.5 px apart vertically, same x-disparity."""
     sparse = {"mcgm": _m([(4, 4, 9.0)], dy=0.0), "hopfield": _m([(4, 4, 9.0)], dy=1.5)}

@@ -276,8 +276,9 @@ def fuse(
     Raises
     ------
     ValueError
-        No sparse channel, an unknown channel name, maps of different sizes, a bad mode or a
-        non-positive tolerance.
+        No sparse channel, an unknown channel name, maps of different sizes, a bad mode, a
+        non-positive tolerance, an ``a_conf_min`` that is not a number in ``[0, 1]`` or a
+        ``min_agree`` that is not a whole number of at least 2.
     """
     if mode not in ("vote", "intersection"):
         raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
@@ -289,6 +290,13 @@ def fuse(
     for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
         if finite_number(v, pname) <= 0:
             raise ValueError(f"{pname}: expected a positive number, got {v}")
+    # NaN took no Gabor value without a word (every ``conf >= nan`` is False), a string or None
+    # failed in NumPy's comparison naming no parameter
+    if not 0 <= finite_number(a_conf_min, "a_conf_min") <= 1:
+        raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
+    # a string, None or NaN failed in a comparison or in range(), naming no parameter
+    if isinstance(min_agree, (bool, np.bool_)) or not isinstance(min_agree, (int, np.integer)):
+        raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
     if min_agree < 2:
         raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
 
@@ -899,7 +907,7 @@ def fused_dense(
     ------
     ValueError
         Maps of different shapes, a negative radius / tolerance, ``fill_confidence`` or
-        ``second_confidence`` outside (0, 1] (0 is the filled pixels' mark).
+        ``second_confidence`` not a number in (0, 1] (0 is the filled pixels' mark).
     """
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
@@ -923,9 +931,10 @@ def fused_dense(
     # Confidence 0 marks a filled disparity (DepthResult.depth_counts, point_image(filled=True)):
     # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
     # or every pixel only the census map measured.
-    if not 0 < fill_confidence <= 1:
+    # a string or None failed in the comparison, naming no parameter
+    if not 0 < finite_number(fill_confidence, "fill_confidence") <= 1:
         raise ValueError(f"fill_confidence: expected a value in (0, 1], got {fill_confidence}")
-    if not 0 < second_confidence <= 1:
+    if not 0 < finite_number(second_confidence, "second_confidence") <= 1:
         raise ValueError(f"second_confidence: expected a value in (0, 1], got {second_confidence}")
     out = d.copy()
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
