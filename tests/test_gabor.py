@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from stereovision import _core
-from stereovision.matching.gabor import GaborResult, gabor_disparity, gabor_responses
+from stereovision.matching.gabor import DEFAULTS, GaborResult, gabor_disparity, gabor_responses
 from tests.reference import gabor_ref as ref
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -449,3 +449,40 @@ def test_orientations_of_another_type_are_named(value: object) -> None:
     img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
     with pytest.raises(ValueError, match=r"^orientations_deg must be a sequence of degrees, got "):
         gabor_disparity(img, img, max_disparity=8, orientations_deg=value)
+
+
+_REAL_KEYS = [k for k, v in DEFAULTS.items() if isinstance(v, float) or k == "smooth_sigma"]
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        (k, v)
+        for k in _REAL_KEYS
+        for v in ("0.3", None, True, [0.3])
+        if not (k == "smooth_sigma" and v is None)
+    ],
+)
+def test_a_real_parameter_that_is_no_number_is_named(name: str, value: object) -> None:
+    """freq, bandwidth_oct, ... given a string, None or a list were the binding's TypeError
+    "must be real number, not str", naming no parameter (depth_map(method="gabor",
+    freq="0.3") too), and True a value of 1 (aspect=True ran as aspect 1.0). smooth_sigma's
+    None is its default (automatic)."""
+    img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
+    with pytest.raises(ValueError, match=f"^{name}: expected a number, got "):
+        gabor_disparity(img, img, max_disparity=8, **{name: value})
+
+
+def test_a_real_parameter_read_from_an_array_is_its_number() -> None:
+    """A size-1 array is its value (np.array([0.25]) was NumPy's "only 0-dimensional arrays
+    can be converted"), as are a NumPy float and a Fraction: the map of the plain float."""
+    from fractions import Fraction
+
+    rng = np.random.default_rng(0)
+    left = rng.random((48, 80), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    base = gabor_disparity(left, right, max_disparity=16, freq=0.25).disparity
+    assert np.count_nonzero(np.isfinite(base)) > 1000
+    for v in (np.array(0.25), np.array([0.25]), np.float32(0.25), Fraction(1, 4)):
+        got = gabor_disparity(left, right, max_disparity=16, freq=v).disparity
+        np.testing.assert_array_equal(got, base)

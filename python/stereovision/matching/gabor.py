@@ -10,6 +10,7 @@ removal. Pixels that are not confident are ``NaN``.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -142,9 +143,10 @@ def gabor_disparity(
     ------
     ValueError
         If an image is not 2-D, empty, not floating point, non-finite or has values outside
-        ``[0, 1]``, the shapes differ, a parameter is unknown or out of range, or the range is
-        one no pixel can match in (``min_disparity`` not below the image width, or
-        ``max_disparity`` not above minus it; as :func:`stereovision.match`).
+        ``[0, 1]``, the shapes differ, a parameter is unknown, no number (a string, None, a
+        bool) or out of range, or the range is one no pixel can match in (``min_disparity``
+        not below the image width, or ``max_disparity`` not above minus it; as
+        :func:`stereovision.match`).
     TypeError
         If a switch (``lr_check``, ``research_finest``, ``lr_light``) is not True or False.
     MemoryError
@@ -170,8 +172,19 @@ def gabor_disparity(
             raise ValueError(f"{name}: {v!r} is beyond float32's range")
     kw: dict[str, Any] = {**DEFAULTS, **params}
     for name, default in DEFAULTS.items():
-        if isinstance(default, float) or default is None:
-            float_sized(kw[name], name)  # 10**400: the binding's OverflowError
+        if (isinstance(default, float) or default is None) and name not in _COUNT_KEYS:
+            value: object = kw[name]
+            if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
+                # a value read from an array: its number (np.array([0.3]) was NumPy's "only
+                # 0-dimensional arrays can be converted", naming no parameter)
+                value = kw[name] = value.reshape(())[()]
+            # a string or None (smooth_sigma's None is its default) was the binding's TypeError
+            # "must be real number, not str", naming no parameter; True was a value of 1
+            if not (value is None and default is None) and (
+                isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)
+            ):
+                raise ValueError(f"{name}: expected a number, got {value!r}")
+            float_sized(value, name)  # 10**400: the binding's OverflowError
         # the switches: 5 was the binding's TypeError "'int' object is not an instance of 'bool'"
         if isinstance(default, bool):
             if not isinstance(kw[name], (bool, np.bool_)):
