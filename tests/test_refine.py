@@ -210,6 +210,21 @@ def test_bad_parameters_raise(kwargs: dict, match: str) -> None:
         refine_disparity(a, a, a, max_disparity=8, **kwargs)
 
 
+def test_an_unknown_parameter_names_the_valid_ones() -> None:
+    """A misspelt key was "unknown refinement parameter(s): ['win_sigmma']": neither the
+    nearest spelling nor the valid keys, which the matchers' own errors give."""
+    a = np.zeros((8, 24), np.float32)
+    with pytest.raises(ValueError) as err:
+        refine_disparity(a, a, a, max_disparity=8, win_sigmma=3.0)
+    text = str(err.value)
+    assert text.startswith(
+        "unknown refinement parameter(s) ['win_sigmma'] (did you mean 'win_sigma'?)"
+    )
+    assert text.endswith(
+        f"expected one of {', '.join(sorted(DEFAULTS))} (stereovision.refine.DEFAULTS)"
+    )
+
+
 def test_bad_inputs_raise() -> None:
     a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
     with pytest.raises(ValueError, match="differ in shape"):

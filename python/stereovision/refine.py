@@ -30,6 +30,7 @@ from stereovision._validate import (
     check_unit_range,
     disparity_range,
     number_shown,
+    refuse_unknown,
 )
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
@@ -153,9 +154,9 @@ def refine_disparity(
         has a value, a parameter is unknown, no number (a bool, a string) or out of range,
         ``fill_plane`` not a bool.
     """
-    unknown = set(params) - set(DEFAULTS)
-    if unknown:
-        raise ValueError(f"unknown refinement parameter(s): {sorted(unknown)}")
+    # the valid keys and the nearest spelling too ("unknown refinement parameter(s):
+    # ['win_sigmma']" named neither), as the matchers' own parameters are refused
+    refuse_unknown("refinement parameter", params, DEFAULTS, "stereovision.refine.DEFAULTS")
     lft, rgt, dsp = _grey(left, "left"), _grey(right, "right"), _grey(disparity, "disparity")
     check_unit_range(lft, "left")
     check_unit_range(rgt, "right")
