@@ -483,6 +483,49 @@ def test_a_result_owns_its_arrays_and_a_filtered_copy_is_a_copy() -> None:
         res.filtered(min_depth=5, max_depth=3)
 
 
+def _valid_named(text: str) -> set[str]:
+    """The keys an unknown-parameter error names as valid ("expected one of a, b (where)")."""
+    listed = text.split("expected one of ", 1)[1].split(" (", 1)[0]
+    return set(listed.split(", "))
+
+
+def test_an_unknown_matcher_parameter_names_what_the_method_takes() -> None:
+    """The matchers' own checks named their own keys only: method="census" left out the dense
+    map's second_confidence (which it takes), "fused" the dense map's options and semi_global
+    while naming remeasure_gabor, dense_sgm and census_members, which depth_map sets itself:
+    given, they failed as "fuse_pair() got multiple values for keyword argument"."""
+    from stereovision.matching import fusion, gabor, sgm
+
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    takes = {
+        "census": {*sgm.DEFAULTS, "second_confidence", "speckle_area", "edge_jump"},
+        "fast": {*sgm.DEFAULTS, "second_confidence", "edge_radius"},
+        "fused": {*fusion.DEFAULTS, *fusion.DENSE_DEFAULTS, "semi_global", "channels"},
+        "gabor": set(gabor.DEFAULTS),
+    }
+    for method, keys in takes.items():
+        with pytest.raises(
+            ValueError, match=r"^unknown \w+ (option|parameter)\(s\) \['bogus'\]"
+        ) as e:
+            sv.depth_map(img, img, max_disparity=8, method=method, bogus=1)
+        named = _valid_named(str(e.value))
+        assert keys <= named, (method, keys - named)
+        assert not named & {"remeasure_gabor", "dense_sgm", "census_members", "min_disparity"}
+    for key, says in (
+        ("remeasure_gabor", "give refine= instead"),
+        ("dense_sgm", "give semi_global= instead"),
+        ("census_members", "its dense map is checked anyway"),
+    ):
+        with pytest.raises(
+            ValueError, match=f"^{key}: depth_map sets this fuse_pair option itself \\({says}\\)$"
+        ):
+            sv.depth_map(img, img, max_disparity=8, **{key: False})
+    # a switch: "no" ran the census map, None skipped it
+    for bad in ("no", None, 0):
+        with pytest.raises(TypeError, match=r"^semi_global: expected True or False, got "):
+            sv.depth_map(img, img, max_disparity=8, semi_global=bad)
+
+
 def test_pair_and_calibration_mistakes_are_named() -> None:
     """A grey and a colour image made a pair (match() refused it); calibration= failed as an
     unknown fusion option; a size error always suggested scaled_to, even for swapped sizes or

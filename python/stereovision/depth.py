@@ -36,6 +36,7 @@ from stereovision._validate import (
     known_unit,
     pair_shape_error,
     path_given,
+    refuse_unknown,
     same_aspect,
     unreachable_range,
     user_stacklevel,
@@ -81,6 +82,49 @@ _CENSUS_DENSE = (
 #: bad-2.0 ratio to SGBM-3WAY + fill: no re-measure 0.520, 0.5 px 0.515, 1 px 0.513, 1.5 px
 #: 0.523, unbounded 0.584; moved values dropped instead of kept: 1 px 0.521).
 _CENSUS_REMEASURE_STEP = 1.0
+#: :func:`~stereovision.matching.fusion.fuse_pair` switches ``depth_map(method="fused")`` sets
+#: itself, and the argument of its own that stands for each (None: none does).
+_FUSED_SET_HERE = {"remeasure_gabor": "refine", "dense_sgm": "semi_global", "census_members": None}
+
+
+def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
+    """Refuse the ``**params`` :func:`depth_map`'s ``method`` does not take, naming the ones it
+    does, and a ``semi_global`` that is not a bool, before the pair is rectified and matched.
+
+    The matchers' own checks named their own keys only: ``"census"`` left out the dense map's
+    (``second_confidence``, ...), which it takes, and ``"fused"`` the dense map's and
+    ``semi_global`` while naming ``remeasure_gabor``, ``dense_sgm`` and ``census_members``,
+    which then failed as ``fuse_pair() got multiple values for keyword argument``."""
+    from stereovision.matching import fusion, gabor, sgm
+
+    if method == "gabor":
+        refuse_unknown(
+            "Gabor parameter", params, gabor.DEFAULTS, "stereovision.matching.gabor.DEFAULTS"
+        )
+    elif method == "fused":
+        for key, instead in _FUSED_SET_HERE.items():
+            if key in params:
+                how = f"give {instead}= instead" if instead else "its dense map is checked anyway"
+                raise ValueError(f"{key}: depth_map sets this fuse_pair option itself ({how})")
+        own = ("channels", "check_members", "edge_members", "semi_global")
+        refuse_unknown(
+            "fusion option",
+            params,
+            [*fusion.DEFAULTS, *own, *fusion.DENSE_DEFAULTS],
+            "stereovision.matching.fusion.DEFAULTS and DENSE_DEFAULTS",
+        )
+        semi_global = params.get("semi_global", True)
+        if not isinstance(semi_global, (bool, np.bool_)):
+            # as the other switches: "no" ran the census map, None skipped it
+            raise TypeError(f"semi_global: expected True or False, got {semi_global!r}")
+    else:
+        refuse_unknown(
+            "SGM option",
+            params,
+            [*sgm.DEFAULTS, *_CENSUS_DENSE],
+            "stereovision.matching.sgm.DEFAULTS and the dense map's",
+        )
+
 
 # Automatic disparity range: ORB matches on the epipolar band, a high percentile with margin.
 _AUTO_DY_TOL = 2.0  # px: rectified pairs keep matches within a couple of rows
@@ -1006,7 +1050,7 @@ def _run_matcher(
         from stereovision.matching import fusion
 
         dense_kw = {k: params.pop(k) for k in list(params) if k in fusion.DENSE_DEFAULTS}
-        semi_global = bool(params.pop("semi_global", True))
+        semi_global = bool(params.pop("semi_global", True))  # a bool (_refuse_unknown_params)
         fr = fusion.fuse_pair(
             left,
             right,
@@ -1300,11 +1344,14 @@ def depth_map(
         Called with a stage name as the pipeline advances.
     **params
         Passed to the matcher (see :func:`stereovision.matching.gabor.gabor_disparity`). For
-        ``"fused"``: :func:`stereovision.matching.fusion.fuse`'s options, the dense map's
-        (:data:`stereovision.matching.fusion.DENSE_DEFAULTS`), and ``semi_global`` (default
-        True: the census semi-global map, :mod:`stereovision.matching.sgm`, completes and
-        checks the Gabor map; False skips it, about 0.15 s less on a 0.35-megapixel pair). For
-        ``"census"``: :data:`stereovision.matching.sgm.DEFAULTS`' keys and the dense map's
+        ``"fused"``: :func:`stereovision.matching.fusion.fuse`'s options,
+        :func:`~stereovision.matching.fusion.fuse_pair`'s ``channels``, ``check_members`` and
+        ``edge_members`` (its other switches are this function's ``refine`` and
+        ``semi_global``), the dense map's (:data:`stereovision.matching.fusion.DENSE_DEFAULTS`),
+        and ``semi_global`` (default True: the census semi-global map,
+        :mod:`stereovision.matching.sgm`, completes and checks the Gabor map; False skips it,
+        about 0.15 s less on a 0.35-megapixel pair). For ``"census"`` and ``"fast"``:
+        :data:`stereovision.matching.sgm.DEFAULTS`' keys and the dense map's
         ``second_confidence`` (the confidence of every measured pixel, default 0.5),
         ``speckle_area``, ``speckle_diff``, ``edge_radius``, ``edge_ratio`` and ``edge_jump``.
 
@@ -1315,7 +1362,8 @@ def depth_map(
     Raises
     ------
     ValueError
-        Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method;
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method,
+        a parameter the method does not take (the message names those it does);
         a range no pixel can match in (``min_disparity`` not below the image width, or
         ``max_disparity`` not above minus it) or one float32 cannot tell apart (10 to
         10.0000001).
@@ -1351,6 +1399,7 @@ def depth_map(
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     if "calibration" in params:  # the result's field is .calibration; the argument is calib
         raise TypeError("depth_map: the calibration is the argument calib, not calibration")
+    _refuse_unknown_params(method, params)
     # The switches and the range are checked for their type first: "no" would be true, True
     # a disparity of 1, and "32" failed in NumPy's isfinite.
     for name, flag in (("fill", fill), ("refine", refine)):
