@@ -139,6 +139,22 @@ def test_refine_false_is_the_matcher_output(data_dir: Path) -> None:
     assert np.all(ref.confidence[filled] == np.float32(0.25))
 
 
+def test_n_filled_counts_the_dropped_pixels_the_fill_measured_again(data_dir: Path) -> None:
+    """``n_filled`` was documented as the pixels "that had no input value and were filled";
+    it also counts the pixels the re-measure dropped and a fill pass measured again (cones:
+    1,564 of 11,589), which take fill_confidence, not their input confidence."""
+    scene = load_scene(data_dir / "middlebury2003" / "cones")
+    gl, gr = as_gray_float(scene.left), as_gray_float(scene.right)
+    g = gabor_disparity(gl, gr, max_disparity=61)
+    ref = refine_disparity(gl, gr, g.disparity, g.confidence, max_disparity=61)
+    had, has = np.isfinite(g.disparity), np.isfinite(ref.disparity)
+    new = ~had & has
+    again = had & has & (ref.confidence != g.confidence)
+    assert np.all(ref.confidence[again] == np.float32(DEFAULTS["fill_confidence"]))  # type: ignore[arg-type]
+    assert again.sum() > 1000
+    assert ref.n_filled == new.sum() + again.sum()
+
+
 def test_recovers_a_subpixel_shift_of_a_real_image(data_dir: Path) -> None:
     """A real image against itself shifted by 5.3 px, from a start 0.3 px off everywhere.
 

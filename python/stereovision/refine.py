@@ -65,7 +65,10 @@ class RefineResult:
         ``(H, W)`` float32: the input confidence of refined pixels, ``fill_confidence`` for
         filled ones, 0 where NaN.
     n_filled : int
-        Pixels that had no input value and were filled.
+        Pixels the fill passes gave a value: holes of the input, and pixels whose input value
+        the re-measure dropped (a disagreeing correlation, or outside the range) and the fill
+        then measured again (on cones' Gabor map 1,564 of the 11,589: with
+        ``fill_confidence``, not their input confidence).
     """
 
     disparity: npt.NDArray[np.float32]
