@@ -130,6 +130,37 @@ def test_imread_truncated_says_it_once(tmp_path: Path, capfd: pytest.CaptureFixt
     assert cv2.utils.logging.getLogLevel() == level  # type: ignore[attr-defined]
 
 
+@pytest.mark.parametrize("deep", [False, True], ids=["8-bit", "16-bit"])
+def test_a_png_cut_short_prints_no_libpng_line(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], deep: bool
+) -> None:
+    """A PNG cut anywhere in its data (an interrupted copy) printed libpng's own "libpng error:
+    PNG input buffer is incomplete" on the C stderr, once per decode (twice for read_image and
+    `stereovision depth`), before our one error line; OpenCV's log level does not reach it.
+    Cut files are still refused, silently; the whole file, junk after its end too, still reads.
+    """
+    from stereovision.io import decode_image, read_image
+
+    rng = np.random.default_rng(0)
+    img = cv2.GaussianBlur(rng.integers(0, 256, (120, 160, 3), dtype=np.uint8), (5, 5), 2)
+    pixels = img.astype(np.uint16) * 257 if deep else img
+    ok, png = cv2.imencode(".png", pixels)
+    assert ok
+    data = png.tobytes()
+    for keep in (len(data) // 10, len(data) // 2, len(data) - 13, len(data) - 1):
+        cut = tmp_path / f"cut{keep}.png"
+        cut.write_bytes(data[:keep])
+        for read in (imread, read_image):
+            with pytest.raises(ValueError, match=r"^cannot decode .*cut\d+\.png as an image$"):
+                read(cut)
+        assert decode_image(data[:keep]) is None
+        assert capfd.readouterr().err == ""
+    whole = tmp_path / "whole.png"
+    whole.write_bytes(data + b"junk after IEND")
+    np.testing.assert_array_equal(read_image(whole), pixels)
+    np.testing.assert_array_equal(imread(whole), img)
+
+
 def test_concurrent_decodes_put_the_log_level_back() -> None:
     """Threads decoding at once (good and bad files): OpenCV's process-wide log level ends as it
     was, and each call's result is its own."""

@@ -870,11 +870,38 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
     return None if img is None else np.asarray(img, dtype=np.uint8)
 
 
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _png_cut_short(buf: npt.NDArray[np.uint8]) -> bool:
+    """Whether ``buf`` is a PNG whose chunks stop before a whole ``IEND`` chunk (a file cut
+    short by an interrupted copy or download), found from the chunks' lengths alone.
+
+    libpng prints "libpng error: PNG input buffer is incomplete" on the C stderr for such a
+    file, once per decode, before OpenCV returns None: the CLI's one error line came after one
+    or two of these, which OpenCV's log level does not silence. A PNG without its ``IEND`` is
+    None from OpenCV either way, so refusing it here changes no result.
+    """
+    if buf.size < 8 or buf[:8].tobytes() != _PNG_SIGNATURE:
+        return False
+    pos, size = 8, int(buf.size)
+    while pos + 8 <= size:
+        length = int.from_bytes(buf[pos : pos + 4].tobytes(), "big")
+        end = pos + 12 + length  # length, type, data, CRC
+        if buf[pos + 4 : pos + 8].tobytes() == b"IEND":
+            return end > size
+        pos = end
+    return True
+
+
 def _imdecode(buf: npt.NDArray[np.uint8], flags: int) -> npt.NDArray[Any] | None:
     """``cv2.imdecode``, quiet, None for bytes it cannot decode: a header whose size is 0,
     negative or over OpenCV's pixel limit (a corrupt or hostile PNG, a PFM of width -3) raised
     cv2.error from its size check where other unreadable bytes give None. A MemoryError when
-    the pixels of a readable image cannot be allocated: not "cannot decode" of a good file."""
+    the pixels of a readable image cannot be allocated: not "cannot decode" of a good file.
+    A PNG cut short is None without being decoded (:func:`_png_cut_short`)."""
+    if _png_cut_short(buf):
+        return None
     with _opencv_quiet():
         try:
             return cv2.imdecode(buf, flags)  # type: ignore[no-any-return]
