@@ -694,6 +694,29 @@ def test_matches_csv_text_and_bad_files(tmp_path: Path) -> None:
         sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
 
 
+def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_path: Path) -> None:
+    """An image given as the matches' CSV was a UnicodeDecodeError naming no file ("'utf-8'
+    codec can't decode byte 0x89 in position 0"), a folder an IsADirectoryError: each now
+    names the file, as the other readers do."""
+    png = tmp_path / "left.png"
+    ok, data = cv2.imencode(".png", np.zeros((4, 4, 3), np.uint8))
+    assert ok
+    png.write_bytes(data.tobytes())
+    with pytest.raises(
+        ValueError, match=r"left\.png: not a CSV text file \(a byte 0x89 is not UTF-8 text\)"
+    ):
+        sv.Matches.from_csv(png, (4, 4))
+    header = "x_left,y_left,x_right,y_right,score"
+    latin = tmp_path / "latin.csv"
+    latin.write_bytes(f"{header}\n1,2,3,4,1\n".encode() + b"\xe9\n")
+    with pytest.raises(ValueError, match=r"latin\.csv: not a CSV text file \(a byte 0xe9 "):
+        sv.Matches.from_csv(latin, (4, 4))
+    with pytest.raises(ValueError, match=r"^matches CSV file is not a regular file: .*"):
+        sv.Matches.from_csv(tmp_path, (4, 4))
+    with pytest.raises(FileNotFoundError, match=r"^matches CSV file not found: .*none\.csv$"):
+        sv.Matches.from_csv(tmp_path / "none.csv", (4, 4))
+
+
 def test_matches_to_points_read_a_raw_rig_through_its_rectified_geometry() -> None:
     """Matches are in rectified pixels: a raw rig's calibration is read through
     rectified_calibration() (its raw K1 put the points off: another f and principal point)."""

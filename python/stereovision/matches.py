@@ -319,17 +319,31 @@ class Matches:
 
         Raises
         ------
+        FileNotFoundError
+            If ``path`` does not exist.
         ValueError
-            Another header, or a row without five numbers.
+            If ``path`` is a folder or not UTF-8 text (an image given by mistake), another
+            header, or a row without five numbers, naming the file.
         """
+        from stereovision.io import _existing_file
+
+        # a folder was IsADirectoryError, and a binary file (a PNG given by mistake) a
+        # UnicodeDecodeError naming no file: "'utf-8' codec can't decode byte 0x89 ..."
+        _existing_file(path, "matches CSV file")
         # utf-8-sig: a file saved again by a spreadsheet (Excel) starts with a BOM, which made
         # the header "another header"
-        with open(path, encoding="utf-8-sig") as fh:
-            head = fh.readline().strip()
-            if head != _CSV_HEADER:
-                raise ValueError(f"{path}: expected the header {_CSV_HEADER!r}, got {head!r}")
-            # (line number, text) of the non-blank rows, for the messages
-            lines = [(k, ln) for k, ln in enumerate(fh.read().splitlines(), 2) if ln.strip()]
+        try:
+            with open(path, encoding="utf-8-sig") as fh:
+                head = fh.readline().strip()
+                if head != _CSV_HEADER:
+                    raise ValueError(f"{path}: expected the header {_CSV_HEADER!r}, got {head!r}")
+                # (line number, text) of the non-blank rows, for the messages
+                lines = [(k, ln) for k, ln in enumerate(fh.read().splitlines(), 2) if ln.strip()]
+        except UnicodeDecodeError as exc:
+            raise ValueError(
+                f"{path}: not a CSV text file (a byte 0x{exc.object[exc.start]:02x} is not "
+                f"UTF-8 text); expected the header {_CSV_HEADER!r}"
+            ) from None
         rows = [ln.split(",") for _, ln in lines]
         short = next((k for k, r in enumerate(rows) if len(r) != 5), None)
         if short is not None:
