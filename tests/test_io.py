@@ -599,6 +599,24 @@ def test_load_scene_errors(tmp_path: Path) -> None:
     assert s.gt is None and s.max_disparity == 16
 
 
+@pytest.mark.parametrize("name", ["gt_disp.pfm", "calib.txt", "Q.dat"])
+def test_load_scene_refuses_a_link_to_nothing(tmp_path: Path, name: str) -> None:
+    """A scene's GT or calibration that is a link whose target moved (exists() is False) was
+    taken as absent: the scene loaded without it, and `eval` said "no ground truth
+    (gt_disp.pfm)" of a folder listing one. It is a FileNotFoundError naming link and target."""
+    img = np.zeros((4, 6, 3), np.uint8)
+    for side in ("left.png", "right.png"):
+        cv2.imwrite(str(tmp_path / side), img)
+    assert load_scene(tmp_path).gt is None  # no such file at all: still loaded without it
+    (tmp_path / name).symlink_to(tmp_path / "moved" / name)
+    with pytest.raises(FileNotFoundError) as err:
+        load_scene(tmp_path)
+    assert str(err.value) == (
+        f"{tmp_path / name} is a link to {tmp_path / 'moved' / name}, which does not exist "
+        "(moved or deleted?)"
+    )
+
+
 def test_load_scene_reads_q_dat_when_there_is_no_calib_txt(data_dir: Path) -> None:
     """middeval3/teddyH ships only OpenCV's Q (f 3000 px, 1/B 12.5 per metre, cx 398, cy 375):
     it was loaded without a calibration, so no depth, no 3-D and no metric figures."""

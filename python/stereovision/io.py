@@ -1598,6 +1598,27 @@ def _absolute_as_read(path: Path) -> Path:
     return shown
 
 
+def _present(path: Path) -> bool:
+    """Whether a scene's optional file is there; a link to nothing is refused, not absent.
+
+    ``exists()`` is False for a link whose target moved (a dataset linked in from a download
+    folder that was then moved): the scene was loaded without its GT or calibration, and
+    ``eval`` said "no ground truth (gt_disp.pfm)" of a folder that lists one.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` is a link whose target does not exist, naming both.
+    """
+    if path.exists():
+        return True
+    if path.is_symlink():
+        raise FileNotFoundError(
+            f"{path} is a link to {os.readlink(path)}, which does not exist (moved or deleted?)"
+        )
+    return False
+
+
 def load_scene(directory: PathLike) -> Scene:
     """Load one scene directory (``left.png``, ``right.png``, optional GT and calibration).
 
@@ -1617,7 +1638,8 @@ def load_scene(directory: PathLike) -> Scene:
     Raises
     ------
     FileNotFoundError
-        If the directory, ``left.png`` or ``right.png`` is missing.
+        If the directory, ``left.png`` or ``right.png`` is missing, or ``gt_disp.pfm``,
+        ``calib.txt`` or ``Q.dat`` is a link to a file that does not exist.
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
         its size differs from the left image, or the calibration file is invalid (an
@@ -1637,7 +1659,7 @@ def load_scene(directory: PathLike) -> Scene:
         )
     gt: npt.NDArray[np.float32] | None = None
     gt_path = d / "gt_disp.pfm"
-    if gt_path.exists():
+    if _present(gt_path):
         gt = read_pfm(gt_path)
         if gt.ndim == 3:  # else refused below as 'gt_disp.pfm is 6x4, left.png 6x4'
             raise ValueError(
@@ -1653,7 +1675,7 @@ def load_scene(directory: PathLike) -> Scene:
     calib: Calibration | None = None
     ndisp: float | None = None
     calib_path = d / "calib.txt"
-    if calib_path.exists():
+    if _present(calib_path):
         calib = Calibration.from_middlebury(calib_path)
         ndisp = parse_middlebury_calib(calib_path).get("ndisp")
         if ndisp is not None and not (math.isfinite(ndisp) and ndisp > 0):
@@ -1662,7 +1684,7 @@ def load_scene(directory: PathLike) -> Scene:
                 f"{calib_path}: ndisp={ndisp:g}: expected the disparity range in pixels, a "
                 "positive finite number"
             )
-    elif (d / "Q.dat").exists():
+    elif _present(d / "Q.dat"):
         calib = Calibration.from_q(d / "Q.dat", (left.shape[1], left.shape[0]))
     # named from the absolute path, '..' folded: '.', 'tsukuba' or '../tsukuba' gave '/',
     # '/tsukuba' or '../tsukuba' (links keep their own names, as resolve() would not)
