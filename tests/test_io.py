@@ -1204,6 +1204,29 @@ def test_a_folder_or_a_float_file_is_no_image(tmp_path: Path) -> None:
         read_image(tmp_path / "f.tiff")
 
 
+@pytest.mark.parametrize("channels", [1, 3], ids=["Pf", "PF"])
+def test_a_pfm_is_no_image(tmp_path: Path, channels: int) -> None:
+    """OpenCV decodes a PFM under IMREAD_COLOR, its floats rounded and clipped to 0-255: a
+    disparity map given as an image was read as [[0, 1, 4], [100, 255, 0]] (a Pf file as a
+    2-D array, not the documented (H, W, 3)), `depth gt_disp.pfm gt_disp.pfm` matched it, and
+    imread(gray=True) was OpenCV's "Bad number of channels". It is refused, saying what it is."""
+    from stereovision.io import decode_image, read_image
+
+    values = np.array([[0.4, 0.6, 3.7], [100.2, 300.0, -5.0]], np.float32)
+    path = write_pfm(tmp_path / "disp.pfm", np.dstack([values] * 3) if channels == 3 else values)
+    says = (
+        r"^cannot decode .*disp\.pfm as an image: it is a PFM file of floating-point values "
+        r"\(a disparity map\?\), not an 8- or 16-bit image$"
+    )
+    for read in (imread, read_image, lambda p: imread(p, gray=True)):
+        with pytest.raises(ValueError, match=says):
+            read(path)
+    assert decode_image(path.read_bytes()) is None
+    np.testing.assert_array_equal(
+        read_pfm(path)[..., 0] if channels == 3 else read_pfm(path), values
+    )
+
+
 def test_a_video_is_named_whatever_the_case_of_its_suffix(tmp_path: Path) -> None:
     for name, says in (("CLIP.AVI", "it is a video"), ("run.Bag", "it is a ROS bag")):
         (tmp_path / name).write_bytes(b"\x00" * 64)

@@ -840,7 +840,8 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
     Returns
     -------
     numpy.ndarray or None
-        ``uint8`` ``(H, W, 3)`` BGR; None if the bytes are empty or not a readable image.
+        ``uint8`` ``(H, W, 3)`` BGR; None if the bytes are empty or not a readable image, a
+        PFM file's floating-point values included (:func:`_is_pfm`).
 
     Raises
     ------
@@ -864,10 +865,22 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
             else type(data).__name__
         )
         raise TypeError(f"data: expected the file's bytes or a 1-D uint8 array, got {what}")
-    if buf.size == 0:
+    if buf.size == 0 or _is_pfm(buf):
         return None
     img = _imdecode(buf, cv2.IMREAD_COLOR)
     return None if img is None else np.asarray(img, dtype=np.uint8)
+
+
+def _is_pfm(buf: npt.NDArray[np.uint8]) -> bool:
+    """Whether ``buf`` starts as a PFM file (``Pf`` or ``PF`` and a whitespace character).
+
+    OpenCV decodes a PFM even under ``IMREAD_COLOR``, its floats rounded and clipped to 0-255
+    (a disparity of 300 px read as 255, 0.4 as 0), a ``Pf`` file as a 2-D ``(H, W)`` array: a
+    disparity map given as an image was matched as one, and ``imread(gray=True)`` was
+    OpenCV's "Bad number of channels". Such a file is no 8- or 16-bit image: it is refused
+    (:func:`read_pfm` reads it), as a float TIFF is.
+    """
+    return buf.size >= 3 and buf[:2].tobytes() in (b"Pf", b"PF") and bytes(buf[2:3]).isspace()
 
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -940,8 +953,14 @@ _VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".webm", ".m4v", ".mpg", ".mp
 _BAG_SUFFIXES = (".bag", ".db3", ".mcap")
 
 
-def _not_an_image_hint(path: Path) -> str:
-    """What an undecodable file looks like instead, as the end of the error's one line."""
+def _not_an_image_hint(path: Path, data: npt.NDArray[np.uint8]) -> str:
+    """What an undecodable file (its bytes ``data``) looks like instead, as the end of the
+    error's one line."""
+    if _is_pfm(data):
+        return (
+            ": it is a PFM file of floating-point values (a disparity map?), not an 8- or "
+            "16-bit image"
+        )
     suffix = path.suffix.lower()
     if suffix in _VIDEO_SUFFIXES:
         return (
@@ -984,7 +1003,7 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
     data = np.fromfile(p, dtype=np.uint8)
     img = decode_image(data)
     if img is None:
-        raise ValueError(f"cannot decode {p} as an image{_not_an_image_hint(p)}")
+        raise ValueError(f"cannot decode {p} as an image{_not_an_image_hint(p, data)}")
     if gray:
         # Same conversion as everywhere else in the package (cv2.cvtColor, BT.601), not the
         # codec's own (libpng's differs by one grey level on some pixels).
