@@ -1907,6 +1907,34 @@ def test_from_file_reads_an_indented_middlebury_calib(data_dir: Path, tmp_path: 
     assert Calibration.from_file(indented) == Calibration.from_file(src)
 
 
+def test_a_middlebury_calib_saved_with_a_byte_order_mark_reads(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A calib.txt saved by Windows Notepad (a UTF-8 BOM, CRLF lines) was "calib.txt:1:
+    expected key=value, got '\\ufeffcam0=[...]'" from from_middlebury, from_file (the CLI's
+    --calib) and load_scene (eval's scenes): parse_middlebury_calib read it again without the
+    "-sig" that from_middlebury's own reading has. It reads as the file without them."""
+    from stereovision.baselines import round_up16
+    from stereovision.calibration import parse_middlebury_calib
+    from stereovision.io import load_scene
+
+    scene = data_dir / "eth3d" / "terrace"
+    src = scene / "calib.txt"
+    noted = tmp_path / "terrace"
+    noted.mkdir()
+    for name in ("left.png", "right.png"):
+        (noted / name).write_bytes((scene / name).read_bytes())
+    calib = noted / "calib.txt"
+    calib.write_bytes(b"\xef\xbb\xbf" + src.read_bytes().replace(b"\n", b"\r\n"))
+    assert Calibration.from_middlebury(calib) == Calibration.from_middlebury(src)
+    assert Calibration.from_file(calib) == Calibration.from_file(src)
+    assert parse_middlebury_calib(calib).keys() == parse_middlebury_calib(src).keys()
+    loaded = load_scene(noted)
+    assert loaded.calib == Calibration.from_middlebury(src)
+    # no GT in the copy: its range is calib.txt's ndisp (713 px) rounded up
+    assert loaded.max_disparity == round_up16(parse_middlebury_calib(src)["ndisp"]) == 720
+
+
 def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
     """KITTI's files hold four cameras; from_kitti read the colour pair (2, 3) alone, so the
     grey sequences (image_0/ + image_1/, the odometry benchmark's) got the colour pair's

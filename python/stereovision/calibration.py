@@ -2428,7 +2428,9 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     if not p.is_file():
         raise FileNotFoundError(f"Middlebury calibration not found: {p}")
     out: dict[str, Any] = {}
-    for n, line in enumerate(p.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+    # "-sig": a byte-order mark (Windows Notepad writes one) made line 1 "expected key=value,
+    # got '\ufeffcam0=[...]'", though from_middlebury's own _read_text skips it
+    for n, line in enumerate(p.read_text(encoding="utf-8-sig", errors="replace").splitlines(), 1):
         if not line.strip():
             continue
         m = _MB_LINE.match(line)
