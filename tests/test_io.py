@@ -1193,15 +1193,25 @@ def test_images_are_read_upright_as_their_exif_orientation_says(tmp_path: Path) 
 def test_a_folder_or_a_float_file_is_no_image(tmp_path: Path) -> None:
     """A folder given as an image is 'not a regular file' (ValueError, as for any other input),
     not 'not found' nor NumPy's IsADirectoryError; a float32 TIFF is refused, not read
-    as uint16 by a cast (0.5 -> 0)."""
+    as uint16 by a cast (0.5 -> 0), saying why (it was "cannot decode" alone)."""
     (tmp_path / "left.png").mkdir()
     for read in (imread, read_image):
         with pytest.raises(ValueError, match=r"^image file is not a regular file: .*left\.png \("):
             read(tmp_path / "left.png")
     colour = np.dstack([np.array([[0.5, 300.0]], np.float32)] * 3)  # decodes as float32 BGR
     assert cv2.imwrite(str(tmp_path / "f.tiff"), colour)
-    with pytest.raises(ValueError, match=r"^cannot decode .*f\.tiff as an image$"):
-        read_image(tmp_path / "f.tiff")
+    # it decodes, as float32: said so, not only "cannot decode" as of a damaged file
+    says = r": its pixels are float32 values, not 8- or 16-bit ones \(save it as an 8- or 16-bit"
+    for read in (imread, read_image):
+        with pytest.raises(ValueError, match=rf"^cannot decode .*f\.tiff as an image{says}"):
+            read(tmp_path / "f.tiff")
+    assert cv2.imwrite(str(tmp_path / "i.tiff"), np.zeros((2, 3), np.int32))
+    with pytest.raises(ValueError, match=r"i\.tiff as an image: its pixels are int32 values"):
+        read_image(tmp_path / "i.tiff")
+    cut = tmp_path / "cut.tiff"  # a TIFF that does not decode at all: no such words
+    cut.write_bytes((tmp_path / "f.tiff").read_bytes()[:40])
+    with pytest.raises(ValueError, match=r"^cannot decode .*cut\.tiff as an image$"):
+        read_image(cut)
 
 
 @pytest.mark.parametrize("channels", [1, 3], ids=["Pf", "PF"])

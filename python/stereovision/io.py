@@ -961,6 +961,15 @@ def _not_an_image_hint(path: Path, data: npt.NDArray[np.uint8]) -> str:
             ": it is a PFM file of floating-point values (a disparity map?), not an 8- or "
             "16-bit image"
         )
+    if data[:4].tobytes() in (b"II*\x00", b"MM\x00*"):
+        # a TIFF of float32 or int32 pixels decodes, but not as 8 or 16 bits: "cannot decode"
+        # alone read as a damaged file
+        pixels = _imdecode(data, cv2.IMREAD_UNCHANGED)
+        if pixels is not None and pixels.dtype not in (np.uint8, np.uint16):
+            return (
+                f": its pixels are {pixels.dtype} values, not 8- or 16-bit ones (save it as an "
+                "8- or 16-bit PNG or TIFF)"
+            )
     suffix = path.suffix.lower()
     if suffix in _VIDEO_SUFFIXES:
         return (
