@@ -617,6 +617,31 @@ def test_load_scene_refuses_a_link_to_nothing(tmp_path: Path, name: str) -> None
     )
 
 
+def test_a_scene_image_linked_to_nothing_is_found_and_named(tmp_path: Path) -> None:
+    """A scene whose right.png is a link to a moved file was left out of find_scenes without a
+    word (eval skipped it), where one whose left.png is was listed; both are listed now, and
+    load_scene (and imread) say the link is broken, not only "not found". A folder named
+    right.png still makes no scene."""
+    img = np.zeros((4, 6, 3), np.uint8)
+    for scene in ("a", "b", "c", "d"):
+        (tmp_path / scene).mkdir()
+        for side in ("left.png", "right.png"):
+            cv2.imwrite(str(tmp_path / scene / side), img)
+    for scene, side in (("b", "right.png"), ("c", "left.png")):
+        (tmp_path / scene / side).unlink()
+        (tmp_path / scene / side).symlink_to(tmp_path / "moved" / side)
+    (tmp_path / "d" / "right.png").unlink()
+    (tmp_path / "d" / "right.png").mkdir()
+    assert find_scenes(tmp_path) == [tmp_path / "a", tmp_path / "b", tmp_path / "c"]
+    for scene, side in (("b", "right.png"), ("c", "left.png")):
+        with pytest.raises(FileNotFoundError) as err:
+            load_scene(tmp_path / scene)
+        assert str(err.value) == (
+            f"image file not found: {tmp_path / scene / side} (a link to "
+            f"{tmp_path / 'moved' / side}, which does not exist)"
+        )
+
+
 def test_load_scene_reads_q_dat_when_there_is_no_calib_txt(data_dir: Path) -> None:
     """middeval3/teddyH ships only OpenCV's Q (f 3000 px, 1/B 12.5 per metre, cx 398, cy 375):
     it was loaded without a calibration, so no depth, no 3-D and no metric figures."""

@@ -731,7 +731,9 @@ def check_pair_files(
 def _existing_file(path: PathLike, what: str) -> Path:
     p = Path(path)
     if not p.exists():
-        raise FileNotFoundError(f"{what} not found: {p}")
+        # a link whose target moved reads as no file at all: which one is missing is said
+        gone = f" (a link to {os.readlink(p)}, which does not exist)" if p.is_symlink() else ""
+        raise FileNotFoundError(f"{what} not found: {p}{gone}")
     if not p.is_file():
         hint = _pair_in_folder(p) if what == "image file" else ""
         raise ValueError(f"{what} is not a regular file: {p}{hint}")
@@ -1780,9 +1782,13 @@ def find_scenes(root: PathLike) -> list[Path]:
     # run3's scenes twice and `bench` counted them twice in its mean.
     from stereovision.batch import _walk
 
+    # a right.png that is a link to nothing is listed, as such a left.png is: load_scene says
+    # which link is broken (the scene was left out without a word, so eval skipped it)
     found = [
         Path(folder)
         for folder, _, files, _ in _walk(r)
-        if "left.png" in files and os.path.isfile(os.path.join(folder, "right.png"))
+        if "left.png" in files
+        and os.path.lexists(right := os.path.join(folder, "right.png"))
+        and not os.path.isdir(right)
     ]
     return sorted(found)
