@@ -825,6 +825,23 @@ def test_matches_repr_gives_the_median_disparity() -> None:
     )
 
 
+def test_matches_repr_summarises_the_finite_values_and_counts_the_others() -> None:
+    """One NaN position or score (a row another tool wrote as "nan", read by from_csv) made
+    the whole summary "disparity nan-nan px (median nan); score nan-nan"."""
+    m = sv.Matches(
+        xl=[11.0, 12.0, np.nan, 19.0], yl=[1.0] * 4, xr=[10.0] * 4, yr=[1.0] * 4,
+        score=[0.5, np.nan, 0.75, 1.0], image_shape=(8, 30),
+    )  # fmt: skip
+    assert repr(m) == (
+        "Matches(4 matches in 30x8; disparity 1.00-9.00 px (median 2.00), 1 not finite; "
+        "score 0.5-1, 1 not finite)"
+    )
+    nothing = sv.Matches(
+        xl=[np.nan], yl=[1.0], xr=[np.inf], yr=[1.0], score=[np.nan], image_shape=(8, 30)
+    )
+    assert repr(nothing) == "Matches(1 matches in 30x8; no finite disparity; no finite score)"
+
+
 def test_save_csv_that_fails_leaves_the_old_file_and_no_temporary(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

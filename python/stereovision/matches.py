@@ -116,12 +116,22 @@ class Matches:
         n = len(self)
         if n == 0:
             return f"Matches(0 matches in {w}x{h})"
+        # over the finite values, the others counted: one NaN (a row another tool wrote as
+        # "nan", read by from_csv) made the whole summary "disparity nan-nan px (median nan)"
         d = self.xl - self.xr
-        return (
-            f"Matches({n} matches in {w}x{h}; disparity {float(d.min()):.2f}-"
-            f"{float(d.max()):.2f} px (median {float(np.median(d)):.2f}); score "
-            f"{float(self.score.min()):.3g}-{float(self.score.max()):.3g})"
+        d, s = d[np.isfinite(d)], self.score[np.isfinite(self.score)]
+        disparity = (
+            f"disparity {float(d.min()):.2f}-{float(d.max()):.2f} px (median "
+            f"{float(np.median(d)):.2f})"
+            if d.size
+            else "no finite disparity"
         )
+        score = f"score {float(s.min()):.3g}-{float(s.max()):.3g}" if s.size else "no finite score"
+        if 0 < d.size < n:
+            disparity += f", {n - d.size} not finite"
+        if 0 < s.size < n:
+            score += f", {n - s.size} not finite"
+        return f"Matches({n} matches in {w}x{h}; {disparity}; {score})"
 
     def __getitem__(self, index: Any) -> Matches:
         """The matches picked by a slice, an integer array or a boolean mask, as ``Matches``
