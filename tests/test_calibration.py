@@ -1935,6 +1935,21 @@ def test_a_middlebury_calib_saved_with_a_byte_order_mark_reads(
     assert loaded.max_disparity == round_up16(parse_middlebury_calib(src)["ndisp"]) == 720
 
 
+def test_a_middlebury_key_given_twice_is_refused(data_dir: Path, tmp_path: Path) -> None:
+    """A calib.txt edited by hand with a second baseline= line (the old one kept) was read
+    with the last one, without a word: 1 mm instead of 193 mm is depth 193 times off."""
+    src = data_dir / "eth3d" / "terrace" / "calib.txt"
+    lines = src.read_text().splitlines()
+    twice = tmp_path / "calib.txt"
+    twice.write_text("\n".join([*lines, "", "baseline=1"]) + "\n")
+    n = next(i for i, line in enumerate(lines, 1) if line.startswith("baseline="))
+    with pytest.raises(ValueError) as err:
+        Calibration.from_middlebury(twice)
+    assert str(err.value) == (
+        f"{twice}:{len(lines) + 2}: baseline given again (first on line {n}); keep one of them"
+    )
+
+
 def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
     """KITTI's files hold four cameras; from_kitti read the colour pair (2, 3) alone, so the
     grey sequences (image_0/ + image_1/, the odometry benchmark's) got the colour pair's

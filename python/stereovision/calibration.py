@@ -2422,12 +2422,13 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     FileNotFoundError
         If the file does not exist.
     ValueError
-        If a line is not ``key=value`` or a value does not parse.
+        If a line is not ``key=value``, a value does not parse, or a key is given twice.
     """
     p = Path(path)
     if not p.is_file():
         raise FileNotFoundError(f"Middlebury calibration not found: {p}")
     out: dict[str, Any] = {}
+    first: dict[str, int] = {}  # the line each key was given on, for a second one
     # "-sig": a byte-order mark (Windows Notepad writes one) made line 1 "expected key=value,
     # got '\ufeffcam0=[...]'", though from_middlebury's own _read_text skips it
     for n, line in enumerate(p.read_text(encoding="utf-8-sig", errors="replace").splitlines(), 1):
@@ -2437,6 +2438,12 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
         if m is None:
             raise ValueError(f"{p}:{n}: expected key=value, got {line!r}")
         key, val = m.group(1), m.group(2)
+        if key in first:
+            # the last one was taken without a word: which baseline (or cam0) was meant?
+            raise ValueError(
+                f"{p}:{n}: {key} given again (first on line {first[key]}); keep one of them"
+            )
+        first[key] = n
         try:
             if val.startswith("["):
                 rows = [r.split() for r in val.strip("[]").split(";")]
