@@ -11,6 +11,7 @@ import dataclasses
 import io
 import json
 import math
+import re
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -1203,6 +1204,57 @@ def test_cli_capture_says_its_pairs_are_kept_when_a_recorded_frame_does_not_deco
     assert said.endswith(f"; 2 pairs were saved in {out_dir} and are kept")
     assert sorted(p.name for p in out_dir.iterdir()) == [
         "left_0001.png", "left_0002.png", "right_0001.png", "right_0002.png"]  # fmt: skip
+
+
+def _damaged_ros1_bag(cones: Any, tmp_path: Path) -> Path:
+    """``tmp_path / "rig.bag"``: forty 128x96 pairs in a ROS 1 bag (a 1 MB chunk holds 28
+    images), the record header of the 61st message (left frame 30, in the third chunk)
+    overwritten: a field longer than the header, as a disk or copy error leaves it."""
+    left, right = cones.left[100:196, 100:228], cones.right[100:196, 100:228]
+    stamps = [T0 + k * PERIOD_NS for k in range(40)]
+    bag = write_bag(tmp_path / "rig.bag", [(s, left, s, right) for s in stamps], flavour="ros1")
+    data = bytearray(bag.read_bytes())
+    # a message record's header: its fields, each a 4-byte length and "name=value"; op 2
+    records = [m.start() for m in re.finditer(re.escape(b"\x04\x00\x00\x00op=\x02"), data)]
+    assert len(records) == 80
+    data[records[60] : records[60] + 4] = b"\xff\xff\xff\x00"
+    bag.write_bytes(bytes(data))
+    return bag
+
+
+def test_a_bag_damaged_part_way_is_a_failure_of_the_source(cones: Any, tmp_path: Path) -> None:
+    """rosbags' ReaderError (apsw's CorruptError for a damaged .db3) came out of ``read`` as
+    it was: no bag named, and the CLI called it an internal error. Now a SourceError (not an
+    end) naming the bag and the pairs read before, as a frame that does not decode is."""
+    bag = _damaged_ros1_bag(cones, tmp_path)
+    with BagCamera(bag) as cam:
+        with pytest.raises(SourceError) as caught:
+            while True:
+                cam.read()
+        assert 0 < cam.count < 31
+        exc = caught.value
+        assert not exc.end and exc.frames == cam.count
+        assert str(exc).startswith(
+            f"bag {bag} cannot be read past {cam.count} pairs (damaged or cut short?): ReaderError"
+        )
+
+
+@PIPELINED
+def test_cli_stream_keeps_its_summary_when_a_bag_is_damaged_part_way(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """The pairs before the damage were streamed, then "internal ReaderError ... (please
+    report this)" with no summary; now the summary of those pairs, "source failed", exit 2."""
+    bag = _damaged_ros1_bag(cones, tmp_path)
+    code, out, err = run("stream", "--from-bag", str(bag), "--no-display", "--json",
+                         "--method", "gabor", "--max-disparity", "16", "--no-check")  # fmt: skip
+    assert code == 2
+    summary = json.loads(out.strip().splitlines()[-1])
+    done = summary["frames"]
+    assert 0 < done < 31 and summary["ended"] == "source failed"
+    said = f"bag {bag} cannot be read past {done} pairs (damaged or cut short?): ReaderError"
+    assert summary["error"].startswith(said)
+    assert err.strip().splitlines()[-1].startswith(f"stereovision: error: {said}")
 
 
 def test_rgba8_and_rgb16_decode_with_their_channel_order(cones: Any) -> None:

@@ -1230,12 +1230,41 @@ class BagCamera(PairSource):
             rights.popleft()
             self.dropped["right"] += 1
 
+    def _messages(self) -> Iterator[tuple[Any, int, Any]]:
+        """The two image topics' messages, deserialised, in recording order.
+
+        A bag damaged part-way (a ROS 1 chunk, a ``.db3`` page or an MCAP record overwritten)
+        raised rosbags', apsw's or sqlite's own error out of :meth:`read`: ``stream`` lost the
+        summary of the pairs done and the CLI called it an internal error ("please report
+        this"), ``capture`` did not say its pairs were kept. It is a failure of the source now
+        (:class:`~stereovision.capture.SourceError`, not an end), naming the bag and the pairs
+        read before.
+        """
+        messages = self._reader.messages(connections=self._conns)
+        try:
+            while True:
+                try:
+                    item = next(messages, None)
+                    if item is None:
+                        return
+                    conn, recorded, raw = item
+                    msg = self._reader.deserialize(raw, conn.msgtype)
+                except Exception as exc:  # rosbags' errors name no common base class
+                    raise SourceError(
+                        f"bag {self.path} cannot be read past {_pairs(self.count)} (damaged or "
+                        f"cut short?): {type(exc).__name__}: {exc}",
+                        end=False,
+                        frames=self.count,
+                    ) from exc
+                yield conn, recorded, msg
+        finally:
+            messages.close()
+
     def _pair_iter(self) -> Iterator[tuple[int, Any, int, Any]]:
         lefts: deque[tuple[int, Any]] = deque()
         rights: deque[tuple[int, Any]] = deque()
         left_topic = self.topics["left"]
-        for conn, recorded, raw in self._reader.messages(connections=self._conns):
-            msg = self._reader.deserialize(raw, conn.msgtype)
+        for conn, recorded, msg in self._messages():
             side = "left" if conn.topic == left_topic else "right"
             stamp = _stamp_ns(msg, recorded)
             if len(self._first[side]) < PERIOD_SAMPLE:
@@ -1298,7 +1327,8 @@ class BagCamera(PairSource):
         ------
         SourceError
             At the end of the recording, or when the bag is closed; for a frame whose shape
-            differs from the first left frame's (``end`` False).
+            differs from the first left frame's, or a bag that cannot be read on (damaged,
+            cut short), the bag and the pairs read before named (``end`` False).
         ValueError
             If a frame does not decode (its topic and stamp named).
         """
