@@ -138,6 +138,23 @@ def test_bayer_patterns_keep_red_and_blue(cones: Any, pattern: str) -> None:
     assert swapped > 3 * err, (pattern, err, swapped)  # red and blue not exchanged
 
 
+@pytest.mark.parametrize("encoding", ["bayer_rggb8", "bayer_gbrg8", "bayer_grbg16"])
+def test_a_compressed_bayer_image_is_demosaiced(cones: Any, encoding: str) -> None:
+    """image_transport compresses a Bayer image as its mosaic, in a grey PNG or JPEG, with
+    the format ``"bayer_rggb8; png compressed "``: it came out grey with the mosaic's
+    checkerboard. Now as the raw topic's message decodes (red and blue in place)."""
+    smooth = cv2.GaussianBlur(cones.left, (0, 0), 2.0)
+    if encoding.endswith("16"):
+        smooth = smooth.astype(np.uint16) << 4  # 12-bit data in 16 bits
+    raw = _image_fields(smooth, encoding)
+    mosaic = raw["data"].view("<u2" if encoding.endswith("16") else np.uint8)
+    _ok, png = cv2.imencode(".png", mosaic.reshape(raw["height"], raw["width"]))
+    out = decode_image(_Msg(format=f"{encoding}; png compressed ", data=png.reshape(-1)))
+    np.testing.assert_array_equal(out, decode_image(_Msg(**raw)))
+    scale = 16 if encoding.endswith("16") else 1
+    assert np.abs(out.astype(int) - smooth).mean() < 2.0 * scale  # demosaiced, not grey
+
+
 def test_compressed_images(cones: Any) -> None:
     _, png = cv2.imencode(".png", cones.left)
     out = decode_image(_Msg(format="bgr8; png compressed bgr8", data=png.reshape(-1)))

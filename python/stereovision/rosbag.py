@@ -51,7 +51,8 @@ as :class:`~stereovision.capture.StereoCamera`, so ``stream``, ``capture``, ``ca
   partner is skipped and counted (:attr:`BagCamera.dropped`).
 - **Images** of every ROS encoding a camera driver publishes (``mono8/16``, ``bgr8``, ``rgb8``,
   ``bgra8``, ``rgba8`` and their 16-bit forms, the four Bayer patterns, ``yuv422``/``uyvy`` and
-  ``yuyv``; row padding and big-endian data) and compressed ones (JPEG, PNG) come out as BGR
+  ``yuyv``; row padding and big-endian data) and compressed ones (JPEG, PNG; a Bayer mosaic,
+  as image_transport compresses it, demosaiced) come out as BGR
   ``uint8``, like a camera's. 16-bit pairs are brought to 8 bits by one power-of-two shift for
   both images, the smallest that keeps their brightest pixel (a 12-bit sensor in a 16-bit
   container is shifted by 4, not left nearly black).
@@ -792,6 +793,8 @@ def decode_image(msg: Any) -> np.ndarray:
     -------
     numpy.ndarray
         ``(H, W, 3)`` BGR, ``uint8`` or, for 16-bit encodings, ``uint16`` (see :func:`to_8bit`).
+        A compressed grey image whose format names a Bayer encoding (``"bayer_rggb8; png
+        compressed "``: image_transport compresses the mosaic as it is) is demosaiced.
 
     Raises
     ------
@@ -810,6 +813,12 @@ def decode_image(msg: Any) -> np.ndarray:
         img = _imdecode(buf, cv2.IMREAD_UNCHANGED) if buf.size else None
         if img is None:
             raise ValueError(f"compressed image ({fmt!r}, {buf.size} bytes) does not decode")
+        # image_transport compresses a Bayer image as it is, the mosaic in a grey JPEG or PNG,
+        # and says so in the format ("bayer_rggb8; png compressed "): it came out grey, the
+        # mosaic's checkerboard kept. Demosaiced now, as the raw topic is.
+        source = _ENCODINGS.get(fmt.split(";", 1)[0].strip().lower())
+        if img.ndim == 2 and source is not None and source[0] == 1 and source[2] is not None:
+            return np.asarray(cv2.cvtColor(img, source[2]))
         if img.ndim == 2:
             return np.asarray(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR))
         if img.shape[2] == 4:
