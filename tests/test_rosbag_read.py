@@ -1274,6 +1274,32 @@ def test_cli_stream_keeps_its_summary_when_a_bag_is_damaged_part_way(
     assert err.strip().splitlines()[-1].startswith(f"stereovision: error: {said}")
 
 
+def test_a_damaged_camera_info_is_said_with_its_bag_and_topic(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """The record of the first left camera_info (the third message) overwritten: rosbags'
+    ReaderError came out of ``calibration`` as it was, and ``info`` (as ``stream --from-bag``)
+    said "internal ReaderError ... (please report this)". Now a ValueError naming the bag and
+    the topic, one line from the CLI."""
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, cones.right) for k in range(2)]
+    bag = write_bag(tmp_path / "rig.bag", frames, flavour="ros1", infos=cams)
+    data = bytearray(bag.read_bytes())
+    # recorded in order: the left and right images, then their camera_info (1 ns later)
+    records = [m.start() for m in re.finditer(re.escape(b"\x04\x00\x00\x00op=\x02"), data)]
+    data[records[2] : records[2] + 4] = b"\xff\xff\xff\x00"
+    bag.write_bytes(bytes(data))
+    said = (
+        f"bag {bag}: its first /stereo/left/camera_info message cannot be read (damaged or cut "
+        "short?): ReaderError: "
+    )
+    with BagCamera(bag) as cam, pytest.raises(ValueError) as caught:
+        cam.calibration()
+    assert str(caught.value).startswith(said)
+    code, _out, err = run("info", str(bag))
+    assert code == 2 and err.strip().splitlines()[-1].startswith(f"stereovision: error: {said}")
+
+
 def test_rgba8_and_rgb16_decode_with_their_channel_order(cones: Any) -> None:
     """Mutation audit: ``rgba8`` and ``rgb16`` were not read in the tests (red and blue
     exchanged, or the alpha taken for a colour, went unseen)."""

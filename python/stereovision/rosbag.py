@@ -1459,7 +1459,8 @@ class BagCamera(PairSource):
         ValueError
             If a ``camera_info`` is not a stereo camera's (no baseline), its model is not
             supported, it describes a region of interest (named) or a malformed one (a zero
-            width or height alone), or the two bin differently.
+            width or height alone), or the two bin differently; if the first ``camera_info``
+            message cannot be read (a damaged bag, named).
         """
         from stereovision.calibration import Calibration, _ros_yaml
 
@@ -1470,8 +1471,18 @@ class BagCamera(PairSource):
         for side in ("left", "right"):
             topic = self.info_topics[side]
             conns = [c for c in self._reader.connections if c.topic == topic]
-            conn, _, raw = next(iter(self._reader.messages(connections=conns)))
-            msg = self._reader.deserialize(raw, conn.msgtype)
+            messages = self._reader.messages(connections=conns)
+            try:
+                conn, _, raw = next(messages)
+                msg = self._reader.deserialize(raw, conn.msgtype)
+            except Exception as exc:  # rosbags' errors name no common base class
+                # a damaged bag's ReaderError was "internal ReaderError (please report this)"
+                raise ValueError(
+                    f"bag {self.path}: its first {topic} message cannot be read (damaged or "
+                    f"cut short?): {type(exc).__name__}: {exc}"
+                ) from exc
+            finally:
+                messages.close()
 
             # ROS 2 spells the matrices k, d, r, p; ROS 1 K, D, R, P
             K, D, R, P = (
