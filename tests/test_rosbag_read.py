@@ -1071,6 +1071,32 @@ def test_capture_of_a_bag_without_a_pair_is_an_error(
         capture(cam, tmp_path / "more")
 
 
+def test_a_bag_without_a_pair_says_how_far_apart_the_topics_stamps_are(
+    cones: Any, tmp_path: Path
+) -> None:
+    """The right camera stamping with its own clock (seconds since boot): every frame without a
+    partner, and the error said no why. It now gives the first stamps' difference."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    boot = 500 * 10**9
+    frames = [(T0 + k * PERIOD_NS, small[0], boot + k * PERIOD_NS, small[1]) for k in range(10)]
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag) as cam, pytest.raises(SourceError) as caught:
+        cam.read()
+    assert str(caught.value) == (
+        f"bag {bag}: end of the recording after 0 pairs (10 left and 10 right frames without a "
+        "partner); no left and right stamps within 16.7 ms of each other: the first left stamp "
+        f"is +{(T0 - boot) / 1e9:.3f} s from the first right one (cameras stamping with "
+        "different clocks?)"
+    )
+    # a pair read: the end is said as before
+    frames[3] = (frames[3][0], small[0], frames[3][0], small[1])
+    bag = write_bag(tmp_path / "one", frames)
+    with BagCamera(bag, max_skew_ms=1) as cam, pytest.raises(SourceError) as caught:
+        while True:
+            cam.read()
+    assert str(caught.value).endswith("(9 left and 9 right frames without a partner)")
+
+
 @pytest.mark.parametrize("flavour", ["ros2", "mcap"])
 def test_a_ros2_bag_without_its_metadata_is_read(
     cones: Any, tmp_path: Path, flavour: str, run: Callable[..., tuple[int, str, str]]

@@ -1345,10 +1345,21 @@ class BagCamera(PairSource):
             raise SourceError("the bag is closed")
         nxt = self._next_pair()
         if nxt is None:
+            firsts = self._first["left"][:1] + self._first["right"][:1]
+            hint = ""
+            if self.count == 0 and len(firsts) == 2:
+                # frames on both sides and no pair said no why: two cameras stamping with two
+                # clocks (one its own, since boot) are seconds or years apart, which this shows
+                hint = (
+                    f"; no left and right stamps within {self.max_skew_ms:.3g} ms of each other: "
+                    "the first left stamp is "
+                    f"{(firsts[0] - firsts[1]) / 1e9:+.3f} s from the first right one (cameras "
+                    "stamping with different clocks?)"
+                )
             raise SourceError(
                 f"bag {self.path}: end of the recording after {_pairs(self.count)} "
                 f"({self.dropped['left']} left and {self.dropped['right']} right frames without "
-                "a partner)"
+                f"a partner){hint}"
             )
         sl, ml, sr, mr = nxt
         imgs = []
