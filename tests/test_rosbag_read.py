@@ -1097,6 +1097,33 @@ def test_a_bag_without_a_pair_says_how_far_apart_the_topics_stamps_are(
     assert str(caught.value).endswith("(9 left and 9 right frames without a partner)")
 
 
+def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """rosbag record killed leaves NAME.bag.active without an index: ``info`` took it for a
+    calibration file ("not a text calibration file"), ``stream --from-bag`` said rosbags'
+    "Unrecognized storage format '.active'". Both now say what it is and how to index it."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    bag = write_bag(tmp_path / "rig.bag", [(T0, small[0], T0, small[1])], flavour="ros1")
+    data = bytearray(bag.read_bytes())
+    at = data.index(b"index_pos=") + len(b"index_pos=")
+    data[at : at + 8] = bytes(8)  # the header's index position, as the recorder opened it
+    active = tmp_path / "rig.bag.active"
+    active.write_bytes(bytes(data))
+    bag.unlink()
+    from stereovision.rosbag import is_bag
+
+    assert is_bag(active)
+    said = (
+        f"stereovision: error: {active} is a ROS 1 recording left unfinished (its recorder "
+        f"stopped before writing the index): `rosbag reindex {active}` indexes it; then rename "
+        "it to .bag"
+    )
+    for argv in (["info", str(active)], ["stream", "--from-bag", str(active), "--no-display"]):
+        code, _out, err = run(*argv)
+        assert code == 2 and err.strip().splitlines() == [said], argv
+
+
 @pytest.mark.parametrize("flavour", ["ros2", "mcap"])
 def test_a_ros2_bag_without_its_metadata_is_read(
     cones: Any, tmp_path: Path, flavour: str, run: Callable[..., tuple[int, str, str]]

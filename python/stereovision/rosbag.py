@@ -705,6 +705,11 @@ def _bag_paths(path: Path) -> list[Path]:
     return [path]
 
 
+class _UnfinishedBagError(ValueError):
+    """A ROS 1 recording its recorder left unfinished (``.bag.active``): said as it is, not
+    wrapped in "not a readable bag"."""
+
+
 def _open_reader(path: Path) -> Any:
     """rosbags' reader of a ROS 1 or ROS 2 bag, opened. A ROS 2 bag recorded before Iron holds
     no message definitions: ``sensor_msgs`` are then read with Humble's (the same since)."""
@@ -715,6 +720,13 @@ def _open_reader(path: Path) -> Any:
         raise ImportError(
             "reading ROS bags needs rosbags: pip install 'stereovision-rs[ros]'"
         ) from None
+    if path.name.endswith(".bag.active"):
+        # rosbag record's file until it is closed: killed, it holds no index (rosbags said
+        # "Unrecognized storage format '.active'", info "not a text calibration file")
+        raise _UnfinishedBagError(
+            f"{path} is a ROS 1 recording left unfinished (its recorder stopped before writing "
+            f"the index): `rosbag reindex {path}` indexes it; then rename it to .bag"
+        )
     reader = AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.ROS2_HUMBLE))
     reader.open()
     return reader
@@ -771,7 +783,7 @@ def bag_topics(path: str | os.PathLike[str]) -> str:
         p = p.parent  # a file of a ROS 2 bag, as BagCamera takes it
     try:
         reader = _open_reader(p)
-    except ImportError:
+    except (ImportError, _UnfinishedBagError):
         raise
     except Exception as exc:  # rosbags' errors name no common base class
         raise ValueError(f"{p} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
@@ -867,13 +879,15 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 def is_bag(path: str | os.PathLike[str]) -> bool:
-    """Does ``path`` name a ROS bag: a ``.bag`` file, a folder of them (a split recording), a
-    ROS 2 bag folder (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it), one of
-    its files, or a ``.db3`` / ``.mcap`` file alone (a recorder that left no metadata.yaml)?"""
+    """Does ``path`` name a ROS bag: a ``.bag`` file (or a ``.bag.active`` one, a recording
+    left unfinished, which the reader refuses with its remedy), a folder of them (a split
+    recording), a ROS 2 bag folder (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files
+    without it), one of its files, or a ``.db3`` / ``.mcap`` file alone (a recorder that left
+    no metadata.yaml)?"""
     p = Path(path)
     # a bag's storage file alone is read (its recorder left no metadata.yaml): `info` took
     # it for a calibration file
-    if p.is_file() and p.suffix in (".bag", ".db3", ".mcap"):
+    if p.is_file() and (p.suffix in (".bag", ".db3", ".mcap") or p.name.endswith(".bag.active")):
         return True
     folder = p if p.is_dir() else p.parent
     if (folder / "metadata.yaml").is_file():
@@ -1088,7 +1102,7 @@ class BagCamera(PairSource):
         self.requested_size = parse_size(image_size, "image_size")
         try:
             reader = _open_reader(self.path)
-        except ImportError:
+        except (ImportError, _UnfinishedBagError):
             raise
         except Exception as exc:  # rosbags' errors name no common base class
             raise ValueError(f"{self.path} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
