@@ -1124,6 +1124,31 @@ def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
         assert code == 2 and err.strip().splitlines() == [said], argv
 
 
+def test_an_mcap_recording_left_unfinished_is_said_with_its_remedy(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A recorder killed before writing the MCAP summary and footer: rosbags' "File end magic
+    is invalid." was all the error said. Now what it is and the tool that rebuilds it, for the
+    bag folder, the file, and the file alone (no metadata.yaml)."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    frames = [(T0 + k * PERIOD_NS, small[0], T0 + k * PERIOD_NS, small[1]) for k in range(4)]
+    bag = write_bag(tmp_path / "rig", frames, flavour="mcap")
+    (mcap,) = bag.glob("*.mcap")
+    mcap.write_bytes(mcap.read_bytes()[: mcap.stat().st_size * 6 // 10])
+    lone = tmp_path / "lone"
+    lone.mkdir()
+    (lone / mcap.name).write_bytes(mcap.read_bytes())
+    for path, file in ((bag, mcap), (mcap, mcap), (lone / mcap.name, lone / mcap.name)):
+        said = (
+            f"stereovision: error: {file} is an MCAP recording left unfinished (its recorder "
+            "stopped before writing its summary, or is still recording): `mcap recover "
+            f"{file} -o FIXED.mcap` (the mcap CLI) rebuilds it"
+        )
+        for argv in (["info", str(path)], ["stream", "--from-bag", str(path), "--no-display"]):
+            code, _out, err = run(*argv)
+            assert code == 2 and err.strip().splitlines() == [said], argv
+
+
 @pytest.mark.parametrize("flavour", ["ros2", "mcap"])
 def test_a_ros2_bag_without_its_metadata_is_read(
     cones: Any, tmp_path: Path, flavour: str, run: Callable[..., tuple[int, str, str]]

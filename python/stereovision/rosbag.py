@@ -706,8 +706,31 @@ def _bag_paths(path: Path) -> list[Path]:
 
 
 class _UnfinishedBagError(ValueError):
-    """A ROS 1 recording its recorder left unfinished (``.bag.active``): said as it is, not
-    wrapped in "not a readable bag"."""
+    """A recording its recorder left unfinished (a ROS 1 ``.bag.active``, an MCAP file without
+    its summary): said as it is, with its remedy, not wrapped in "not a readable bag"."""
+
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def _unfinished_mcap(path: Path) -> Path | None:
+    """The MCAP file of ``path`` (the file, or a ROS 2 bag folder's) that starts as MCAP and
+    does not end as one: its recorder stopped (killed, power lost) before writing the summary
+    and footer, or is still writing it. rosbags said "File end magic is invalid."."""
+    files = [path] if path.is_file() else sorted(path.glob("*.mcap")) if path.is_dir() else []
+    for f in files:
+        if f.suffix != ".mcap":
+            continue
+        try:
+            with f.open("rb") as fh:
+                head = fh.read(len(_MCAP_MAGIC))
+                fh.seek(max(0, f.stat().st_size - len(_MCAP_MAGIC)))
+                tail = fh.read(len(_MCAP_MAGIC))
+        except OSError:
+            continue  # rosbags says what it can of an unreadable file
+        if head == _MCAP_MAGIC and tail != _MCAP_MAGIC:
+            return f
+    return None
 
 
 def _open_reader(path: Path) -> Any:
@@ -726,6 +749,13 @@ def _open_reader(path: Path) -> Any:
         raise _UnfinishedBagError(
             f"{path} is a ROS 1 recording left unfinished (its recorder stopped before writing "
             f"the index): `rosbag reindex {path}` indexes it; then rename it to .bag"
+        )
+    cut = _unfinished_mcap(path)
+    if cut is not None:
+        raise _UnfinishedBagError(
+            f"{cut} is an MCAP recording left unfinished (its recorder stopped before writing "
+            f"its summary, or is still recording): `mcap recover {cut} -o FIXED.mcap` (the mcap "
+            "CLI) rebuilds it"
         )
     reader = AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.ROS2_HUMBLE))
     reader.open()
