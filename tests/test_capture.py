@@ -4176,6 +4176,32 @@ def test_a_warning_made_an_error_at_the_open_closes_what_was_opened(
     assert [c.released for c in caps] == [1, 1]
 
 
+def test_open_sources_same_source_warning_made_an_error_closes_the_camera(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """open_source's own open warning (--left and --right one file) under ``python -W error``
+    raised after the StereoCamera was open: both captures stayed open, no object returned to
+    close them (the clean-up StereoCamera's warnings got left this one out)."""
+    left, _right = _videos(tmp_path, 3, 3)
+    opened: list[Any] = []
+    real = capmod._open_path
+
+    def recording(path: str, first: Any) -> Any:
+        opened.append(real(path, first))
+        return opened[-1]
+
+    monkeypatch.setattr(capmod, "_open_path", recording)
+    args = _parser().parse_args(
+        ["capture", "--left", str(left), "--right", f"{tmp_path}/./{left.name}", "-o",
+         str(tmp_path / "pairs")]
+    )  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match=r"^--left and --right are the same source "):
+            capmod.open_source(args)
+    assert len(opened) == 2 and not any(c.isOpened() for c in opened)
+
+
 class _UnpluggedCamera:
     """A camera device (``cv2.VideoCapture(index)`` stand-in) that delivers 3 frames, then
     none if its index is in ``gone``: unplugged."""

@@ -2312,13 +2312,17 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     if _same_path(left, right):
         # a typo: every pair is one view twice, every disparity 0, and nothing said it (said
         # once the source opens: a missing one is said as such)
-        warnings.warn(
-            f"--left and --right are the same source {mask_url_secrets(str(left))!r}: every "
-            "pair is one view twice and every disparity comes out 0 (two cameras' views are "
-            "needed)",
-            UserWarning,
-            stacklevel=2,
-        )
+        try:
+            warnings.warn(
+                f"--left and --right are the same source {mask_url_secrets(str(left))!r}: "
+                "every pair is one view twice and every disparity comes out 0 (two cameras' "
+                "views are needed)",
+                UserWarning,
+                stacklevel=2,
+            )
+        except BaseException:  # made an error (python -W error): cam is never returned
+            cam.close()
+            raise
     return cam
 
 
