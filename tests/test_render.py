@@ -1840,6 +1840,9 @@ def test_render_view_refuses_a_size_it_would_not_render(size, said):
         ({"max_jump": "0.1"}, r"^max_jump must be positive, got '0.1'"),  # a TypeError
         ({"max_jump": None}, r"^max_jump must be positive, got None"),
         ({"max_jump": True}, r"^max_jump must be positive, got True"),
+        # float()'s OverflowError named neither (-10**400 was refused in its name before)
+        ({"max_jump": 10**400}, r"^max_jump: an integer of 401 digits is beyond a float's"),
+        ({"max_jump": -(10**400)}, r"^max_jump: a negative integer of 401 digits is beyond"),
     ],
 )
 def test_surface_mesh_refuses_a_step_or_jump_that_is_no_number(result, kwargs, said):

@@ -761,12 +761,13 @@ def surface_mesh(
     """
     pv = _pv()
     _check_result(result)
-    from stereovision._validate import _real_scalar
+    from stereovision._validate import _real_scalar, float_sized
 
     # a bool was taken as a stride of 1, and a text or None for max_jump raised a TypeError
     # naming neither ('>' not supported)
     if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1:
         raise ValueError(f"step must be a positive integer, got {step!r}")
+    float_sized(max_jump, "max_jump")  # 10**400: float()'s OverflowError named nothing
     try:
         jump = math.nan if isinstance(max_jump, bool) else _real_scalar(max_jump)
     except TypeError:
