@@ -1855,6 +1855,25 @@ def test_surface_mesh_refuses_a_step_or_jump_that_is_no_number(result, kwargs, s
     assert every.n_cells == _oracle_triangle_count(result.depth, math.inf)
 
 
+def test_render_view_refuses_the_size_its_intrinsics_scale_to(monkeypatch):
+    """With intrinsics only the size's width counts: (100000, 1), a valid size, scaled a
+    400 x 300 camera to a 100000 x 75000 picture (past the 32-bit pixel indices) and that went
+    to the window unchecked, as did intrinsics of that size without a size; both are refused
+    before any window, naming what set the size."""
+
+    def no_window(size, **kwargs):
+        raise AssertionError(f"a window of {size} was made")
+
+    cloud = render.point_cloud(np.array([[0.0, 0.0, 2.0], [0.1, 0.1, 2.0]]))
+    intr = render.Intrinsics(f=400.0, cx=199.5, cy=149.5, width=400, height=300)
+    monkeypatch.setattr(render, "make_plotter", no_window)
+    with pytest.raises(ValueError, match=r"^size: render of 100000x75000 pixels is too large"):
+        render.render_view(cloud, intrinsics=intr, size=(100_000, 1))
+    huge = render.Intrinsics(f=4e4, cx=49999.5, cy=37499.5, width=100_000, height=75_000)
+    with pytest.raises(ValueError, match=r"^intrinsics: render of 100000x75000 pixels is too"):
+        render.render_view(cloud, intrinsics=huge)
+
+
 def _wide_cloud() -> tuple[np.ndarray, np.ndarray]:
     """A wall 5 m ahead seen by a KITTI-wide camera (81 degrees across, 29 down): grey, with a
     red column at its left edge and a blue one at its right."""

@@ -1060,7 +1060,8 @@ def render_view(
     ------
     ValueError
         Both ``controls`` and ``camera`` given, or a ``size`` that is not two whole numbers of
-        pixels >= 1 (within the writer's 32-bit pixel indices).
+        pixels >= 1 (within the writer's 32-bit pixel indices), or a picture past those indices
+        once ``intrinsics`` are scaled to ``size`` (or given alone).
     """
     if camera is not None and controls is not None:
         raise ValueError("render_view: give controls or camera, not both")
@@ -1068,9 +1069,15 @@ def render_view(
     if size is not None:
         size = _render_size(size)
     if intrinsics is not None:
+        # the picture is the intrinsics' (scaled to size's width): (100000, 1) made a 400 x 300
+        # camera's 100000 x 75000, past the check of size alone
+        from stereovision._validate import check_index_range
+
+        what = "intrinsics" if size is None else "size"
         if size is not None:
             intrinsics = intrinsics.scaled(size[0] / intrinsics.width)
         size = (intrinsics.width, intrinsics.height)
+        check_index_range((size[1], size[0]), what, "render")
     size = DEFAULT_VIEW_SIZE if size is None else size  # not `or`: a NumPy size has no truth value
     plotter = make_plotter(size)
     try:
