@@ -1855,6 +1855,17 @@ def test_surface_mesh_refuses_a_step_or_jump_that_is_no_number(result, kwargs, s
     assert every.n_cells == _oracle_triangle_count(result.depth, math.inf)
 
 
+def test_surface_mesh_takes_a_step_of_any_numpy_integer_type(result):
+    """A NumPy step passed the check but was used as given: np.uint64(2) made the vertex
+    indices float64 (IndexError), np.int8(2) overflowed at the 160th column (OverflowError);
+    every integer type now gives the mesh of the plain 2."""
+    plain = render.surface_mesh(result, step=2)
+    for step in (np.uint64(2), np.int8(2), np.int64(2)):
+        mesh = render.surface_mesh(result, step=step)
+        assert np.array_equal(mesh.faces, plain.faces)
+        assert np.array_equal(mesh.points, plain.points)
+
+
 def test_render_view_refuses_the_size_its_intrinsics_scale_to(monkeypatch):
     """With intrinsics only the size's width counts: (100000, 1), a valid size, scaled a
     400 x 300 camera to a 100000 x 75000 picture (past the 32-bit pixel indices) and that went

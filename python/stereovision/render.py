@@ -767,6 +767,8 @@ def surface_mesh(
     # naming neither ('>' not supported)
     if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1:
         raise ValueError(f"step must be a positive integer, got {step!r}")
+    # as an int: np.uint64 made the indices float64, np.int8 overflowed at column 160
+    step = int(step)
     float_sized(max_jump, "max_jump")  # 10**400: float()'s OverflowError named nothing
     try:
         jump = math.nan if isinstance(max_jump, bool) else _real_scalar(max_jump)
