@@ -2587,3 +2587,21 @@ def test_the_checking_progress_says_a_plain_line_every_progress_seconds_while_re
     before = err.getvalue()
     assert list(quiet.over([cast(Any, None)] * 3)) == [None] * 3
     assert err.getvalue() == before
+
+
+def test_a_float_tiff_pair_says_why_it_is_no_image(tmp_path: Path) -> None:
+    """A float32 TIFF pair (a disparity or depth map given as images) failed in batch as
+    "cannot decode left.tif as an image" alone, the words of a damaged file, where `depth`
+    and imread say its pixels are float32 values; batch now says the same."""
+    from stereovision.batch import _task, process_pair
+
+    values = np.dstack([np.array([[0.5, 300.0], [2.0, 7.5]], np.float32)] * 3)
+    for name in ("left.tif", "right.tif"):
+        assert cv2.imwrite(str(tmp_path / name), values)
+    (job,) = find_pairs(tmp_path)
+    says = (
+        r"^cannot decode .*left\.tif as an image: its pixels are float32 values, not 8- or "
+        r"16-bit ones \(save it as an 8- or 16-bit PNG or TIFF\)$"
+    )
+    with pytest.raises(ValueError, match=says):
+        process_pair(_task(job, {"method": "gabor", "max_disparity": 16, "fill": None}))

@@ -578,14 +578,18 @@ def _without_side(sub: str) -> str:
 
 
 def _decode(name: str, data: bytes) -> Any:
-    from stereovision.io import _decode_16bit, decode_image
+    import numpy as np
+
+    from stereovision.io import _decode_16bit, _not_an_image_hint, decode_image
 
     # 16-bit files keep their 16 bits, as `stereovision depth` reads them (read_image)
     img: Any = _decode_16bit(data)
     if img is None:
         img = decode_image(data)
     if img is None:
-        raise ValueError(f"cannot decode {name} as an image")
+        # imread's words: a float32 TIFF or a PFM was "cannot decode" alone, as a damaged file
+        hint = _not_an_image_hint(Path(name), np.frombuffer(data, np.uint8))
+        raise ValueError(f"cannot decode {name} as an image{hint}")
     return img
 
 
