@@ -642,6 +642,34 @@ def test_a_scene_image_linked_to_nothing_is_found_and_named(tmp_path: Path) -> N
         )
 
 
+def test_a_link_loop_is_said_to_be_one(tmp_path: Path) -> None:
+    """A link that leads back to itself (gt_disp.pfm -> gt.pfm -> gt_disp.pfm) was said to be "a
+    link to gt.pfm, which does not exist (moved or deleted?)", of a gt.pfm that is there (a link
+    too): the user looked for a moved file. Both readers now say it is a loop of links."""
+    img = np.zeros((4, 6, 3), np.uint8)
+    for side in ("left.png", "right.png"):
+        cv2.imwrite(str(tmp_path / side), img)
+    (tmp_path / "gt_disp.pfm").symlink_to("gt.pfm")
+    (tmp_path / "gt.pfm").symlink_to("gt_disp.pfm")
+    with pytest.raises(FileNotFoundError) as err:
+        load_scene(tmp_path)
+    assert str(err.value) == (
+        f"{tmp_path / 'gt_disp.pfm'} is a link to gt.pfm, one of a loop of links that never "
+        "reaches a file"
+    )
+    (tmp_path / "gt_disp.pfm").unlink()
+    (tmp_path / "right.png").unlink()
+    (tmp_path / "right.png").symlink_to("right.png")
+    assert find_scenes(tmp_path) == [tmp_path]
+    for read in (load_scene, lambda d: imread(d / "right.png")):
+        with pytest.raises(FileNotFoundError) as err:
+            read(tmp_path)
+        assert str(err.value) == (
+            f"image file not found: {tmp_path / 'right.png'} (a link to right.png, one of a "
+            "loop of links that never reaches a file)"
+        )
+
+
 def test_load_scene_reads_q_dat_when_there_is_no_calib_txt(data_dir: Path) -> None:
     """middeval3/teddyH ships only OpenCV's Q (f 3000 px, 1/B 12.5 per metre, cx 398, cy 375):
     it was loaded without a calibration, so no depth, no 3-D and no metric figures."""

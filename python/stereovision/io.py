@@ -728,11 +728,25 @@ def check_pair_files(
     return None
 
 
+def _broken_link(link: Path) -> str:
+    """Why ``link``, a link that ``exists()`` says reaches no file, reaches none: its target
+    does not exist, or it is one of a loop of links. ``exists()`` is False for both (ELOOP);
+    "which does not exist" of a loop's target, which is there, sent the user looking for a
+    moved file."""
+    target = os.readlink(link)
+    try:
+        os.stat(link)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return f"a link to {target}, one of a loop of links that never reaches a file"
+    return f"a link to {target}, which does not exist"
+
+
 def _existing_file(path: PathLike, what: str) -> Path:
     p = Path(path)
     if not p.exists():
         # a link whose target moved reads as no file at all: which one is missing is said
-        gone = f" (a link to {os.readlink(p)}, which does not exist)" if p.is_symlink() else ""
+        gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
         raise FileNotFoundError(f"{what} not found: {p}{gone}")
     if not p.is_file():
         hint = _pair_in_folder(p) if what == "image file" else ""
@@ -1643,9 +1657,9 @@ def _present(path: Path) -> bool:
     if path.exists():
         return True
     if path.is_symlink():
-        raise FileNotFoundError(
-            f"{path} is a link to {os.readlink(path)}, which does not exist (moved or deleted?)"
-        )
+        said = _broken_link(path)
+        moved = " (moved or deleted?)" if said.endswith("does not exist") else ""
+        raise FileNotFoundError(f"{path} is {said}{moved}")
     return False
 
 
