@@ -717,6 +717,37 @@ def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_pa
         sv.Matches.from_csv(tmp_path / "none.csv", (4, 4))
 
 
+def test_matches_from_csv_reads_a_pipe(tmp_path: Path) -> None:
+    """A named pipe (a shell's <(...), /dev/stdin of `... < m.csv`) was read as the file it
+    streams until the check for a folder (3b5d3b5) refused every file that is not regular:
+    "matches CSV file is not a regular file". A pipe is read again; a folder is still refused.
+    """
+    import os
+    import threading
+
+    pipe = tmp_path / "m.csv"
+    os.mkfifo(pipe)
+    text = "x_left,y_left,x_right,y_right,score\n5.5,2,3.25,2,0.5\n"
+
+    def write() -> None:
+        with open(pipe, "w", encoding="utf-8") as fh:
+            fh.write(text)
+
+    writer = threading.Thread(target=write, daemon=True)
+    writer.start()
+    try:
+        m = sv.Matches.from_csv(pipe, (4, 8))
+    finally:
+        if writer.is_alive():  # unblock the writer if the reader refused without opening
+            os.close(os.open(pipe, os.O_RDONLY | os.O_NONBLOCK))
+        writer.join(5)
+    np.testing.assert_array_equal(m.xl, [5.5])
+    np.testing.assert_array_equal(m.xr, [3.25])
+    np.testing.assert_array_equal(m.score, [0.5])
+    with pytest.raises(ValueError, match=r"^matches CSV file is not a regular file: .*"):
+        sv.Matches.from_csv(tmp_path, (4, 8))
+
+
 def test_matches_to_points_read_a_raw_rig_through_its_rectified_geometry() -> None:
     """Matches are in rectified pixels: a raw rig's calibration is read through
     rectified_calibration() (its raw K1 put the points off: another f and principal point)."""

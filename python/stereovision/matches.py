@@ -318,7 +318,8 @@ class Matches:
         Parameters
         ----------
         path : str or os.PathLike
-            A CSV with the header ``x_left,y_left,x_right,y_right,score``.
+            A CSV with the header ``x_left,y_left,x_right,y_right,score``, or a named pipe
+            streaming one (a shell's ``<(...)``).
         image_shape : tuple of int
             ``(H, W)`` of the left image (the file does not hold it; :attr:`dispx` needs it).
 
@@ -332,14 +333,17 @@ class Matches:
         FileNotFoundError
             If ``path`` does not exist.
         ValueError
-            If ``path`` is a folder or not UTF-8 text (an image given by mistake), another
-            header, or a row without five numbers, naming the file.
+            If ``path`` is a folder (or another file that is neither regular nor a pipe) or
+            not UTF-8 text (an image given by mistake), another header, or a row without five
+            numbers, naming the file.
         """
         from stereovision.io import _existing_file
 
         # a folder was IsADirectoryError, and a binary file (a PNG given by mistake) a
-        # UnicodeDecodeError naming no file: "'utf-8' codec can't decode byte 0x89 ..."
-        _existing_file(path, "matches CSV file")
+        # UnicodeDecodeError naming no file: "'utf-8' codec can't decode byte 0x89 ...". A
+        # pipe (a shell's <(...), /dev/stdin) is no regular file but is read as one.
+        if not Path(path).is_fifo():
+            _existing_file(path, "matches CSV file")
         # utf-8-sig: a file saved again by a spreadsheet (Excel) starts with a BOM, which made
         # the header "another header"
         try:
