@@ -1918,8 +1918,9 @@ def test_view_of_a_wide_cloud_shows_all_of_it(tmp_path, monkeypatch):
     default_f = 300 / math.tan(math.radians(render.DEFAULT_FOV_DEG / 2))
     for kept in (pts * [0.5, 0.5, 1.0], pts * [1.0, 1.0, -1.0]):
         assert render.cloud_view_intrinsics(kept).f == pytest.approx(default_f, rel=1e-12)
-    # as wide as MAX_FIT_FOV_DEG at most: a point almost beside the camera cannot fit
-    beside = np.vstack([pts, [[10.0, 0.0, 1e-6]]])
+    # as wide as MAX_FIT_FOV_DEG at most: points almost beside the camera cannot fit (1 % of
+    # the cloud: one alone is a stray, left out of the fit)
+    beside = np.vstack([pts, np.tile([10.0, 0.0, 1e-6], (len(pts) // 100, 1))])
     widest = math.degrees(2 * math.atan(300 / render.cloud_view_intrinsics(beside).f))
     assert widest == pytest.approx(render.MAX_FIT_FOV_DEG)
     # the window (1024 x 768, 4:3 as the screenshot) opens with the same angle
@@ -1933,6 +1934,28 @@ def test_view_of_a_wide_cloud_shows_all_of_it(tmp_path, monkeypatch):
     args = _view_args(tmp_path / "wide.ply", None)
     assert args.func(args) == 0
     assert seen["angle"] == pytest.approx(math.degrees(2 * math.atan(300 / intr.f)))
+
+
+def test_a_stray_point_does_not_widen_the_view_of_a_cloud():
+    """The view of a bare cloud was fitted to its single widest point: one stray (a mismatched
+    pixel 100 m to the side, common in stereo clouds) widened it to MAX_FIT_FOV_DEG and shrank
+    the scene. The fit takes FIT_PERCENTILE of the points' angles: the view is the one without
+    the stray, and every point of the cloud itself stays in it."""
+    pts, _ = _wide_cloud()
+
+    def fov(points: np.ndarray) -> float:
+        return math.degrees(2 * math.atan(300 / render.cloud_view_intrinsics(points).f))
+
+    clean = fov(pts)
+    assert 60.0 < clean < 90.0
+    for stray in ([100.0, 0.0, 10.0], [-100.0, 0.0, 10.0], [0.0, 100.0, 10.0]):
+        with_stray = np.vstack([pts, [stray]])
+        assert fov(with_stray) == pytest.approx(clean, abs=1.0), stray
+        intr = render.cloud_view_intrinsics(with_stray)
+        assert render.points_in_view(pts, CameraControls(), (800, 600), intr) == len(pts)
+    # a cloud inside 60 degrees keeps them with a stray too
+    narrow = np.vstack([pts * [0.5, 0.5, 1.0], [[100.0, 0.0, 10.0]]])
+    assert fov(narrow) == pytest.approx(render.DEFAULT_FOV_DEG)
 
 
 def test_a_cloud_millimetres_away_is_not_clipped_whole():
