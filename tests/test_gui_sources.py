@@ -787,13 +787,20 @@ def test_a_camera_whose_size_setting_hangs_is_given_up(
         time.sleep(0.01)
 
 
+@pytest.mark.parametrize(
+    ("left", "right", "files"), [("rtsp://a/1", "rtsp://a/2", False), ("a.avi", "b.avi", True)]
+)
 def test_a_stream_given_by_name_is_not_reopened_when_its_read_hangs(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, left: str, right: str, files: bool
 ) -> None:
     """Sources given by name (``rtsp://...``, ``/dev/video0``: "files", opened again at their
     end) were opened again when their read was given up as hung (a SourceError is an OSError):
     a second open of the hung device and a second full wait, the page frozen twice as long. The
-    read says the time-out after one wait; a file's end still starts it again."""
+    read says the time-out after one wait; a file's end still starts it again.
+
+    A stream is no file since test_open_stereo_source_takes_streams_and_device_nodes_as_live
+    (it pinned ``_files is True`` for rtsp://): a pair of files given up as hung is not opened
+    again either."""
     import stereovision.capture as capture
 
     real = capture.StereoCamera
@@ -804,13 +811,53 @@ def test_a_stream_given_by_name_is_not_reopened_when_its_read_hangs(
         return real(_SlowStart(0.5), _SlowStart(0.0))
 
     monkeypatch.setattr(capture, "StereoCamera", slow)
-    src = sources.open_stereo_source("rtsp://a/1", "rtsp://a/2", read_timeout=0.2)
-    assert src._files is True  # type: ignore[attr-defined]
+    src = sources.open_stereo_source(left, right, read_timeout=0.2)
+    assert src._files is files  # type: ignore[attr-defined]
     t0 = time.perf_counter()
     with pytest.raises(capture.SourceError, match=r" delivered no frame in 0\.2 s"):
         src.read()
     assert time.perf_counter() - t0 < 0.35 and len(opened) == 1
     src.close()
+
+
+def test_open_stereo_source_takes_streams_and_device_nodes_as_live(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """With the capture module (the page's path), any text source was a file: a stream
+    (rtsp://, http://) or a camera by its device node (/dev/video7, a /dev/v4l/by-id link) that
+    stopped was opened again as a file's end is, its end said as nothing (73cb4e7 fixed only
+    VideoPair). Their end is now the error StereoCamera says; files still start again."""
+    import stereovision.capture as capture
+
+    link = tmp_path / "usb-cam-video-index0"
+    link.symlink_to("/dev/video7")  # a by-id link: resolved to the node, existing or not
+    ended = "left source /dev/video7 stopped delivering frames after 2 (disconnected?)"
+    made: list[tuple[Any, Any]] = []
+    results: list[Any] = []  # shared: a camera opened again goes on from where the last ended
+
+    def fake_camera(left: Any, right: Any, **kw: Any) -> FakeCamera:
+        made.append((left, right))
+        return FakeCamera(results, [])
+
+    monkeypatch.setattr(capture, "StereoCamera", fake_camera)
+    for left, right in (
+        ("rtsp://cam/0", "rtsp://cam/1"),
+        ("http://cam/l.mjpg", "http://cam/r.mjpg"),
+        ("/dev/video7", "/dev/video8"),
+        (str(link), "/dev/video8"),
+        ("rtsp://cam/0", "a.avi"),
+    ):
+        made.clear()
+        results[:] = [capture.SourceError(ended, side="left"), (_frame(1), _frame(2))]
+        src = sources.open_stereo_source(left, right)
+        with pytest.raises(capture.SourceError, match=rf"^{re.escape(ended)}$"):
+            src.read()
+        assert made == [(left, right)], (left, right)  # not opened again
+    # a pair of files (a video, a sequence) still starts again at its end
+    made.clear()
+    results[:] = [capture.SourceError(ended, side="left"), (_frame(1), _frame(2))]
+    src = sources.open_stereo_source("a.avi", "r_%03d.png")
+    assert [int(x[0, 0, 0]) for x in src.read()] == [1, 2] and len(made) == 2
 
 
 def test_open_stereo_source_falls_back_to_opencv(

@@ -341,6 +341,14 @@ def _ask_size(size: tuple[int, int], cap: Any, doing: Callable[[str], None]) -> 
         cap.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
 
 
+def _is_file(src: int | str) -> bool:
+    """Whether source ``src`` (as :func:`parse_source` gives it) is a file or image sequence,
+    which ends and is started again, not a live source: a stream URL (``rtsp://``, ``http://``)
+    or a camera's device node (``/dev/video2``, a ``/dev/v4l/by-id/...`` link,
+    :func:`~stereovision.capture._camera_device`) has no end to rewind."""
+    return isinstance(src, str) and "://" not in src and _camera_device(src) is None
+
+
 def _open_capture(src: int | str, first: tuple[int, str] | None) -> Any:
     """A device, a video file or an image-sequence pattern (``first``: its first file,
     :func:`~stereovision.capture._sequence_first`) opened as ``stereovision capture`` and
@@ -402,7 +410,7 @@ class VideoPair:
                 # (rtsp://cam/0) was refused as "camera source not found", a /dev/video2 was
                 # not asked the size and its missing frame was taken for a file's end.
                 device = not isinstance(src, str) or _camera_device(src) is not None
-                is_file = isinstance(src, str) and not device and "://" not in src
+                is_file = _is_file(src)
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
                     raise FileNotFoundError(
                         f"{side} camera source not found: {mask_url_secrets(str(src))}"
@@ -483,8 +491,9 @@ class _CaptureAdapter:
     """Wraps ``stereovision.capture.StereoCamera`` into :class:`StereoSource`.
 
     When both sources are files (videos, image sequences) and one ends, the pair is opened again
-    from the start, like :class:`VideoPair`. A read is given up after ``read_timeout`` seconds
-    (:func:`~stereovision.capture.read_within`; None: no limit).
+    from the start, like :class:`VideoPair`; a camera or stream (by index, device node or URL)
+    that ends raises what ``StereoCamera`` says of it. A read is given up after
+    ``read_timeout`` seconds (:func:`~stereovision.capture.read_within`; None: no limit).
     """
 
     def __init__(self, factory: Any, files: bool, read_timeout: float | None = None) -> None:
@@ -603,7 +612,9 @@ def open_stereo_source(
     Parameters
     ----------
     left, right : int or str
-        Device index, video file or image-sequence pattern.
+        Device index or node (``/dev/video0``), stream URL, video file or image-sequence
+        pattern. A pair of files starts again when one ends; a camera or stream that ends is
+        an error.
     size : (int, int), optional
         Requested ``(width, height)``.
     fourcc : str, optional
@@ -629,7 +640,9 @@ def open_stereo_source(
     except ImportError:
         return VideoPair(left, right, size, open_timeout)
     code = parse_fourcc(fourcc)
-    files = isinstance(left, str) and isinstance(right, str)
+    # only files start again: a stream or a device node (any text was a "file") that stopped
+    # was opened again silently, its end said as nothing (VideoPair's rule, 73cb4e7)
+    files = _is_file(left) and _is_file(right)
     first = [True]
 
     def make() -> StereoCamera:
