@@ -1334,6 +1334,57 @@ def test_a_bag_damaged_part_way_is_a_failure_of_the_source(cones: Any, tmp_path:
         )
 
 
+def _bag_damaged_at(cones: Any, tmp_path: Path, record: int, n: int = 12) -> Path:
+    """A ROS 1 bag of ``n`` small pairs, left and right stamped alike (recorded left first),
+    the header of its message ``record`` (in recording order) overwritten."""
+    left, right = cones.left[:48, :64], cones.right[:48, :64]
+    stamps = [T0 + k * 100_000_000 for k in range(n)]
+    bag = write_bag(tmp_path / "rig.bag", [(s, left, s, right) for s in stamps], flavour="ros1")
+    data = bytearray(bag.read_bytes())
+    records = [m.start() for m in re.finditer(re.escape(b"\x04\x00\x00\x00op=\x02"), data)]
+    data[records[record] : records[record] + 4] = b"\xff\xff\xff\x00"
+    bag.write_bytes(bytes(data))
+    return bag
+
+
+def test_the_pairs_before_a_damage_are_all_delivered(cones: Any, tmp_path: Path) -> None:
+    """The left frame of pair 5 damaged: pairs 0-4 are whole, but were still waiting (the
+    tolerance is decided on the first PERIOD_SAMPLE frames of each side) when the error was
+    raised, so none was read and the error said "past 0 pairs". They are read now, the error
+    then, and again on a read after it (it said "end of the recording after 5 pairs")."""
+    bag = _bag_damaged_at(cones, tmp_path, 10)
+    with BagCamera(bag) as cam:
+        got = []
+        with pytest.raises(SourceError) as caught:
+            while True:
+                got.append(round((cam.read().t_left * 1e9 - T0) / 100_000_000))
+        assert got == [0, 1, 2, 3, 4] and cam.count == 5
+        said = f"bag {bag} cannot be read past 5 pairs (damaged or cut short?): ReaderError: "
+        assert str(caught.value).startswith(said)
+        assert not caught.value.end and caught.value.frames == 5
+        with pytest.raises(SourceError) as again:
+            cam.read()
+        assert str(again.value) == str(caught.value) and not again.value.end
+
+
+def test_realtime_playback_delivers_the_pair_due_before_a_damage(
+    cones: Any, tmp_path: Path
+) -> None:
+    """``realtime`` with a slow reader (250 ms a pair, pairs 100 ms apart): looking for the
+    newest pair due, it met the damage after pair 4 and raised, losing pair 4 it held."""
+    bag = _bag_damaged_at(cones, tmp_path, 10)
+    now = [0.0]
+    with BagCamera(bag, realtime=True) as cam:
+        cam._clock, cam._sleep = (lambda: now[0]), (lambda dt: None)
+        got = []
+        with pytest.raises(SourceError) as caught:
+            while True:
+                got.append(round((cam.read().t_left * 1e9 - T0) / 100_000_000))
+                now[0] += 0.25
+    assert got == [0, 2, 4] and cam.skipped == 2
+    assert str(caught.value).startswith(f"bag {bag} cannot be read past 3 pairs (damaged")
+
+
 @PIPELINED
 def test_cli_stream_keeps_its_summary_when_a_bag_is_damaged_part_way(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]

@@ -1211,6 +1211,8 @@ class BagCamera(PairSource):
             None if max_skew_ms is None else math.floor(round(max_skew_ms * 1e6, 6))
         )
         self._first: dict[str, list[int]] = {"left": [], "right": []}
+        self._damage: Exception | None = None  # what stopped the reading of a damaged bag
+        self._failed = False  # the damage met: its error is raised by every read after it
         self._pairs = self._pair_iter()
 
     # ------------------------------------------------------------------------------ pairing
@@ -1291,7 +1293,8 @@ class BagCamera(PairSource):
         summary of the pairs done and the CLI called it an internal error ("please report
         this"), ``capture`` did not say its pairs were kept. It is a failure of the source now
         (:class:`~stereovision.capture.SourceError`, not an end), naming the bag and the pairs
-        read before.
+        read before. The messages end at the damage, which is kept in ``self._damage`` for
+        :meth:`_pair_iter` to raise once the pairs read before it are delivered.
         """
         messages = self._reader.messages(connections=self._conns)
         try:
@@ -1303,12 +1306,8 @@ class BagCamera(PairSource):
                     conn, recorded, raw = item
                     msg = self._reader.deserialize(raw, conn.msgtype)
                 except Exception as exc:  # rosbags' errors name no common base class
-                    raise SourceError(
-                        f"bag {self.path} cannot be read past {_pairs(self.count)} (damaged or "
-                        f"cut short?): {type(exc).__name__}: {exc}",
-                        end=False,
-                        frames=self.count,
-                    ) from exc
+                    self._damage = exc
+                    return
                 yield conn, recorded, msg
         finally:
             messages.close()
@@ -1324,8 +1323,25 @@ class BagCamera(PairSource):
                 self._first[side].append(stamp)
             (lefts if side == "left" else rights).append((stamp, msg))
             yield from self._match(lefts, rights, final=False)
+        # the frames read before a damage are paired as at the end of a recording: raised at
+        # once, it lost the pairs still waiting (the first PERIOD_SAMPLE frames, a left frame
+        # waiting for a nearer right one), and said fewer pairs than the bag holds
         yield from self._match(lefts, rights, final=True)
         self.dropped["right"] += len(rights)
+        if self._damage is not None:
+            raise self._damage_error()
+
+    def _damage_error(self) -> SourceError:
+        """The error of a bag that cannot be read past :attr:`count` pairs (``_damage``)."""
+        exc = self._damage
+        error = SourceError(
+            f"bag {self.path} cannot be read past {_pairs(self.count)} (damaged or cut short?): "
+            f"{type(exc).__name__}: {exc}",
+            end=False,
+            frames=self.count,
+        )
+        error.__cause__ = exc
+        return error
 
     # ------------------------------------------------------------------------------ reading
 
@@ -1449,8 +1465,16 @@ class BagCamera(PairSource):
         return self._origin
 
     def _next_pair(self) -> tuple[int, Any, int, Any] | None:
-        """The next pair; with ``realtime``, the newest whose time has come (waiting for it)."""
-        nxt = self._peeked.popleft() if self._peeked else next(self._pairs, None)
+        """The next pair; with ``realtime``, the newest whose time has come (waiting for it).
+        A damaged bag's error (:meth:`_pair_iter`) is raised again on every read after it: the
+        pairs' generator ended, and a read said "end of the recording" instead."""
+        if self._failed:
+            raise self._damage_error()
+        try:
+            nxt = self._peeked.popleft() if self._peeked else next(self._pairs, None)
+        except SourceError:
+            self._failed = True
+            raise
         if not self.realtime or nxt is None:
             return nxt
         if self._start is None:
@@ -1459,7 +1483,11 @@ class BagCamera(PairSource):
         wall0, stamp0 = self._start
         due = stamp0 + (self._clock() - wall0) * 1e9  # the recording's time now
         while nxt[0] <= due:
-            later = next(self._pairs, None)
+            try:
+                later = next(self._pairs, None)
+            except SourceError:
+                self._failed = True  # said on the next read: the pair due is delivered first
+                break
             if later is None or later[0] > due:
                 if later is not None:
                     self._peeked.append(later)
