@@ -1095,6 +1095,16 @@ def test_a_bag_without_a_pair_says_how_far_apart_the_topics_stamps_are(
         while True:
             cam.read()
     assert str(caught.value).endswith("(9 left and 9 right frames without a partner)")
+    # a gap under a second in ms: 0.3 ms to a 0.1 ms max skew was "-0.000 s"
+    frames = [(T0 + k * PERIOD_NS, small[0], T0 + k * PERIOD_NS + 300_000, small[1])
+              for k in range(10)]  # fmt: skip
+    bag = write_bag(tmp_path / "near", frames)
+    with BagCamera(bag, max_skew_ms=0.1) as cam, pytest.raises(SourceError) as caught:
+        cam.read()
+    assert str(caught.value).endswith(
+        "no left and right stamps within 0.1 ms of each other: the first left stamp is -0.3 ms "
+        "from the first right one (cameras stamping with different clocks?)"
+    )
 
 
 def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
