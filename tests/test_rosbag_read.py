@@ -1134,6 +1134,43 @@ def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
         assert code == 2 and err.strip().splitlines() == [said], argv
 
 
+def test_a_split_ros1_recording_whose_last_piece_is_unfinished_is_said(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """``rosbag record --split`` killed: a folder of finished pieces and the last one
+    NAME_2.bag.active. The folder was read without that piece, its pairs lost without a word
+    (10 of 15 pairs); a folder holding only the .bag.active was "not a readable ROS 1 or ROS 2
+    bag: Expected metadata file". Both now name the unfinished piece and its remedy."""
+    from stereovision.rosbag import is_bag
+
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    split, alone = tmp_path / "split", tmp_path / "alone"
+    split.mkdir()
+    alone.mkdir()
+    for i in range(3):
+        stamps = [T0 + (5 * i + k) * PERIOD_NS for k in range(5)]
+        write_bag(split / f"rig_{i}.bag", [(s, small[0], s, small[1]) for s in stamps],
+                  flavour="ros1")  # fmt: skip
+    active = split / "rig_2.bag.active"
+    (split / "rig_2.bag").rename(active)
+    (alone / active.name).write_bytes(active.read_bytes())
+    for folder in (split, alone):
+        assert is_bag(folder)
+        piece = folder / active.name
+        said = (
+            f"stereovision: error: {piece} is a ROS 1 recording left unfinished (its recorder "
+            f"stopped before writing the index): `rosbag reindex {piece}` indexes it; then "
+            "rename it to .bag"
+        )
+        for argv in (["info", str(folder)], ["stream", "--from-bag", str(folder), "--no-display"]):
+            code, _out, err = run(*argv)
+            assert code == 2 and err.strip().splitlines() == [said], argv
+    # the piece finished: all 15 pairs read, as before
+    active.rename(split / "rig_2.bag")
+    with BagCamera(split) as cam:
+        assert len(list(cam.frames())) == 15
+
+
 def test_an_mcap_recording_left_unfinished_is_said_with_its_remedy(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

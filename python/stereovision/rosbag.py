@@ -743,12 +743,20 @@ def _open_reader(path: Path) -> Any:
         raise ImportError(
             "reading ROS bags needs rosbags: pip install 'stereovision-rs[ros]'"
         ) from None
-    if path.name.endswith(".bag.active"):
-        # rosbag record's file until it is closed: killed, it holds no index (rosbags said
-        # "Unrecognized storage format '.active'", info "not a text calibration file")
+    # rosbag record's file until it is closed: killed, it holds no index (rosbags said
+    # "Unrecognized storage format '.active'", info "not a text calibration file"). In a folder
+    # of a split recording it is the last piece, which was left out without a word
+    active = (
+        [path]
+        if path.name.endswith(".bag.active")
+        else sorted(path.glob("*.bag.active"))
+        if path.is_dir() and not (path / "metadata.yaml").is_file()
+        else []
+    )
+    if active:
         raise _UnfinishedBagError(
-            f"{path} is a ROS 1 recording left unfinished (its recorder stopped before writing "
-            f"the index): `rosbag reindex {path}` indexes it; then rename it to .bag"
+            f"{active[0]} is a ROS 1 recording left unfinished (its recorder stopped before "
+            f"writing the index): `rosbag reindex {active[0]}` indexes it; then rename it to .bag"
         )
     cut = _unfinished_mcap(path)
     if cut is not None:
@@ -911,9 +919,9 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
 def is_bag(path: str | os.PathLike[str]) -> bool:
     """Does ``path`` name a ROS bag: a ``.bag`` file (or a ``.bag.active`` one, a recording
     left unfinished, which the reader refuses with its remedy), a folder of them (a split
-    recording), a ROS 2 bag folder (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files
-    without it), one of its files, or a ``.db3`` / ``.mcap`` file alone (a recorder that left
-    no metadata.yaml)?"""
+    recording, whose last piece may be left unfinished), a ROS 2 bag folder
+    (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it), one of its files, or a
+    ``.db3`` / ``.mcap`` file alone (a recorder that left no metadata.yaml)?"""
     p = Path(path)
     # a bag's storage file alone is read (its recorder left no metadata.yaml): `info` took
     # it for a calibration file
@@ -922,7 +930,8 @@ def is_bag(path: str | os.PathLike[str]) -> bool:
     folder = p if p.is_dir() else p.parent
     if (folder / "metadata.yaml").is_file():
         return True
-    return p.is_dir() and any(any(p.glob(f"*{ext}")) for ext in (".bag", ".db3", ".mcap"))
+    exts = (".bag", ".db3", ".mcap", ".bag.active")
+    return p.is_dir() and any(any(p.glob(f"*{ext}")) for ext in exts)
 
 
 def _rate(count: int, reader: Any) -> float:
