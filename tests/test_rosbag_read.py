@@ -1185,7 +1185,16 @@ def test_an_mcap_recording_left_unfinished_is_said_with_its_remedy(
     lone = tmp_path / "lone"
     lone.mkdir()
     (lone / mcap.name).write_bytes(mcap.read_bytes())
-    for path, file in ((bag, mcap), (mcap, mcap), (lone / mcap.name, lone / mcap.name)):
+    # killed as it began: the leading magic alone ("ord() expected a character, but string of
+    # length 0 found"), its tail its head
+    begun = tmp_path / "begun.mcap"
+    begun.write_bytes(mcap.read_bytes()[:8])
+    for path, file in (
+        (bag, mcap),
+        (mcap, mcap),
+        (lone / mcap.name, lone / mcap.name),
+        (begun, begun),
+    ):
         said = (
             f"stereovision: error: {file} is an MCAP recording left unfinished (its recorder "
             "stopped before writing its summary, or is still recording): `mcap recover "

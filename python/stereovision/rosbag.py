@@ -724,11 +724,14 @@ def _unfinished_mcap(path: Path) -> Path | None:
         try:
             with f.open("rb") as fh:
                 head = fh.read(len(_MCAP_MAGIC))
-                fh.seek(max(0, f.stat().st_size - len(_MCAP_MAGIC)))
+                size = f.stat().st_size
+                fh.seek(max(0, size - len(_MCAP_MAGIC)))
                 tail = fh.read(len(_MCAP_MAGIC))
         except OSError:
             continue  # rosbags says what it can of an unreadable file
-        if head == _MCAP_MAGIC and tail != _MCAP_MAGIC:
+        # a file of the leading magic alone (the recorder killed as it began) ends as it
+        # starts: its tail is its head, and rosbags said "ord() expected a character"
+        if head == _MCAP_MAGIC and (tail != _MCAP_MAGIC or size < 2 * len(_MCAP_MAGIC)):
             return f
     return None
 
