@@ -843,6 +843,47 @@ def test_min_agree_that_is_no_count_is_named(bad: object) -> None:
     assert len(fuse(_dense(10.0), {"hopfield": hop}, min_agree=np.int64(2))) == 1
 
 
+@pytest.mark.parametrize("mode", ["vote", "intersection"])
+@pytest.mark.parametrize("given", [np.array(3), np.array([3]), 3.0, np.float32(3.0)])
+def test_min_agree_given_as_a_whole_number_is_its_count(mode: str, given: object) -> None:
+    """The check of a count refused what it had taken: np.array(3) (a value read from an array;
+    range() reads it) and 3.0 in intersection mode (where min_agree is not used), with "expected
+    a whole number of channels, got 3.0". Each is the count 3: with two agreeing channels out of
+    three, no member in vote mode (two make one: np.array([2])); intersection mode wants all."""
+    mcgm, hop = _m([(4, 4, 10.0)]), _m([(4, 4, 10.2)])
+    sparse = {"mcgm": mcgm, "hopfield": hop}
+    want = fuse(_dense(14.0), sparse, mode=mode, min_agree=3)
+    got = fuse(_dense(14.0), sparse, mode=mode, min_agree=given)  # type: ignore[arg-type]
+    assert len(got) == len(want) == 0
+    assert len(fuse(_dense(14.0), sparse, min_agree=np.array([2]))) == 1  # type: ignore[arg-type]
+
+
+def test_a_fraction_is_the_confidence_it_stands_for() -> None:
+    """a_conf_min, fill_confidence and second_confidence given a Fraction were compared as the
+    number it is; the checks made it "expected a finite number, got Fraction(1, 4)". Each gives
+    the plain float's result (as gabor_disparity reads a Fraction)."""
+    from fractions import Fraction
+
+    hop = _m([(5, 5, 10.0)])
+    # Gabor at confidence 0.25 and Hopfield agree: a member while Gabor takes part
+    for cut, members in ((Fraction(1, 4), 1), (Fraction(3, 10), 0)):
+        res = fuse(_dense(10.0, 0.25), {"hopfield": hop}, a_conf_min=cut)  # type: ignore[arg-type]
+        assert len(res) == members
+    d = np.full((H, W), np.nan, np.float32)
+    members = np.full((H, W), np.nan, np.float32)
+    members[5, 5] = 12.0
+    second = np.full((H, W), 7.0, np.float32)
+    second[4:7, 3:8] = np.nan  # around the member: its anchor fill shows there
+    kw: dict[str, Any] = {"fill_radius": 1.0, "speckle_area": 0.0, "second": second}
+    out, conf = fused_dense(
+        d, d, members, fill_confidence=Fraction(1, 4), second_confidence=Fraction(3, 4), **kw
+    )
+    want = fused_dense(d, d, members, fill_confidence=0.25, second_confidence=0.75, **kw)
+    np.testing.assert_array_equal(out, want[0])
+    np.testing.assert_array_equal(conf, want[1])
+    assert out[5, 4] == 12.0 and conf[5, 4] == 0.25 and out[0, 0] == 7.0 and conf[0, 0] == 0.75
+
+
 @pytest.mark.parametrize("name", ["fill_confidence", "second_confidence"])
 @pytest.mark.parametrize("bad", ["0.5", None])
 def test_dense_confidence_that_is_no_number_is_named(name: str, bad: object) -> None:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import numbers
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -237,6 +238,23 @@ def remeasure(
     return np.where(np.isfinite(r.disparity), r.disparity, d).astype(np.float32)
 
 
+def _plain_real(value: Any) -> Any:
+    """A real number that is no Python or NumPy number (a :class:`fractions.Fraction`) as its
+    float, anything else as it is.
+
+    :func:`finite_number` refuses a Fraction as "no finite number", where ``fuse`` and
+    ``fused_dense`` had compared it as the number it is; read as its float it gives the plain
+    float's result, as :func:`stereovision.matching.gabor.gabor_disparity` reads one. A value
+    too large for a float is left for ``finite_number`` to refuse, naming the parameter.
+    """
+    if isinstance(value, numbers.Real) and not isinstance(value, (int, float, np.generic)):
+        try:
+            return float(value)
+        except (OverflowError, ValueError):
+            return value
+    return value
+
+
 def fuse(
     gabor: tuple[npt.ArrayLike, npt.ArrayLike] | None,
     sparse: Mapping[str, Matches],
@@ -292,11 +310,19 @@ def fuse(
             raise ValueError(f"{pname}: expected a positive number, got {v}")
     # NaN took no Gabor value without a word (every ``conf >= nan`` is False), a string or None
     # failed in NumPy's comparison naming no parameter
+    a_conf_min = _plain_real(a_conf_min)
     if not 0 <= finite_number(a_conf_min, "a_conf_min") <= 1:
         raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
-    # a string, None or NaN failed in a comparison or in range(), naming no parameter
-    if isinstance(min_agree, (bool, np.bool_)) or not isinstance(min_agree, (int, np.integer)):
+    # a string, None or NaN failed in a comparison or in range(), naming no parameter; a whole
+    # number given as 2.0 or a size-1 array (a value read from one) is its count
+    agree = _plain_real(min_agree)
+    if isinstance(agree, np.ndarray) and agree.size == 1 and agree.dtype.kind in "iuf":
+        agree = agree.reshape(())[()]
+    if isinstance(agree, (float, np.floating)) and float(agree).is_integer():
+        agree = int(agree)
+    if isinstance(agree, (bool, np.bool_)) or not isinstance(agree, (int, np.integer)):
         raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
+    min_agree = int(agree)
     if min_agree < 2:
         raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
 
@@ -932,6 +958,8 @@ def fused_dense(
     # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
     # or every pixel only the census map measured.
     # a string or None failed in the comparison, naming no parameter
+    fill_confidence = _plain_real(fill_confidence)
+    second_confidence = _plain_real(second_confidence)
     if not 0 < finite_number(fill_confidence, "fill_confidence") <= 1:
         raise ValueError(f"fill_confidence: expected a value in (0, 1], got {fill_confidence}")
     if not 0 < finite_number(second_confidence, "second_confidence") <= 1:
