@@ -858,16 +858,21 @@ def test_min_agree_given_as_a_whole_number_is_its_count(mode: str, given: object
     assert len(fuse(_dense(14.0), sparse, min_agree=np.array([2]))) == 1  # type: ignore[arg-type]
 
 
-def test_a_fraction_is_the_confidence_it_stands_for() -> None:
-    """a_conf_min, fill_confidence and second_confidence given a Fraction were compared as the
-    number it is; the checks made it "expected a finite number, got Fraction(1, 4)". Each gives
-    the plain float's result (as gabor_disparity reads a Fraction)."""
+@pytest.mark.parametrize("kind", ["Fraction", "Decimal"])
+def test_a_fraction_is_the_confidence_it_stands_for(kind: str) -> None:
+    """a_conf_min, fill_confidence and second_confidence given a Fraction or a Decimal were
+    compared as the number it is; the checks made it "expected a finite number, got
+    Fraction(1, 4)". Each gives the plain float's result (as gabor_disparity reads them)."""
+    from decimal import Decimal
     from fractions import Fraction
+
+    def num(a: int, b: int) -> Any:
+        return Fraction(a, b) if kind == "Fraction" else Decimal(a) / Decimal(b)
 
     hop = _m([(5, 5, 10.0)])
     # Gabor at confidence 0.25 and Hopfield agree: a member while Gabor takes part
-    for cut, members in ((Fraction(1, 4), 1), (Fraction(3, 10), 0)):
-        res = fuse(_dense(10.0, 0.25), {"hopfield": hop}, a_conf_min=cut)  # type: ignore[arg-type]
+    for cut, members in ((num(1, 4), 1), (num(3, 10), 0)):
+        res = fuse(_dense(10.0, 0.25), {"hopfield": hop}, a_conf_min=cut)
         assert len(res) == members
     d = np.full((H, W), np.nan, np.float32)
     members = np.full((H, W), np.nan, np.float32)
@@ -876,7 +881,7 @@ def test_a_fraction_is_the_confidence_it_stands_for() -> None:
     second[4:7, 3:8] = np.nan  # around the member: its anchor fill shows there
     kw: dict[str, Any] = {"fill_radius": 1.0, "speckle_area": 0.0, "second": second}
     out, conf = fused_dense(
-        d, d, members, fill_confidence=Fraction(1, 4), second_confidence=Fraction(3, 4), **kw
+        d, d, members, fill_confidence=num(1, 4), second_confidence=num(3, 4), **kw
     )
     want = fused_dense(d, d, members, fill_confidence=0.25, second_confidence=0.75, **kw)
     np.testing.assert_array_equal(out, want[0])

@@ -486,3 +486,20 @@ def test_a_real_parameter_read_from_an_array_is_its_number() -> None:
     for v in (np.array(0.25), np.array([0.25]), np.float32(0.25), Fraction(1, 4)):
         got = gabor_disparity(left, right, max_disparity=16, freq=v).disparity
         np.testing.assert_array_equal(got, base)
+
+
+def test_a_decimal_real_parameter_is_its_number() -> None:
+    """A Decimal (a config read with ``json.loads(parse_float=Decimal)``) is no numbers.Real:
+    the check of the real parameters refused it as "freq: expected a number, got
+    Decimal('0.25')", where the binding had read it as its float. It gives that float's map."""
+    from decimal import Decimal
+
+    rng = np.random.default_rng(0)
+    left = rng.random((48, 80), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    base = gabor_disparity(left, right, max_disparity=16, freq=0.25, lr_tol=1.5).disparity
+    assert np.count_nonzero(np.isfinite(base)) > 1000
+    kw = {"freq": Decimal("0.25"), "lr_tol": Decimal("1.5")}
+    np.testing.assert_array_equal(
+        gabor_disparity(left, right, max_disparity=16, **kw).disparity, base
+    )

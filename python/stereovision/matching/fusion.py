@@ -17,6 +17,7 @@ channels themselves are the Rust kernels.
 
 from __future__ import annotations
 
+import decimal
 import functools
 import itertools
 import numbers
@@ -239,15 +240,16 @@ def remeasure(
 
 
 def _plain_real(value: Any) -> Any:
-    """A real number that is no Python or NumPy number (a :class:`fractions.Fraction`) as its
-    float, anything else as it is.
+    """A real number that is no Python or NumPy number (a :class:`fractions.Fraction`, a
+    :class:`decimal.Decimal`) as its float, anything else as it is.
 
-    :func:`finite_number` refuses a Fraction as "no finite number", where ``fuse`` and
-    ``fused_dense`` had compared it as the number it is; read as its float it gives the plain
-    float's result, as :func:`stereovision.matching.gabor.gabor_disparity` reads one. A value
-    too large for a float is left for ``finite_number`` to refuse, naming the parameter.
+    :func:`finite_number` refuses them as "no finite number", where ``fuse`` and
+    ``fused_dense`` had compared them as the numbers they are; read as its float each gives the
+    plain float's result, as :func:`stereovision.matching.gabor.gabor_disparity` reads them. A
+    value too large for a float is left for ``finite_number`` to refuse, naming the parameter.
     """
-    if isinstance(value, numbers.Real) and not isinstance(value, (int, float, np.generic)):
+    real = isinstance(value, (numbers.Real, decimal.Decimal))
+    if real and not isinstance(value, (int, float, np.generic)):
         try:
             return float(value)
         except (OverflowError, ValueError):

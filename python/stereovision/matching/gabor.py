@@ -10,6 +10,7 @@ removal. Pixels that are not confident are ``NaN``.
 
 from __future__ import annotations
 
+import decimal
 import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -179,9 +180,11 @@ def gabor_disparity(
                 # 0-dimensional arrays can be converted", naming no parameter)
                 value = kw[name] = value.reshape(())[()]
             # a string or None (smooth_sigma's None is its default) was the binding's TypeError
-            # "must be real number, not str", naming no parameter; True was a value of 1
+            # "must be real number, not str", naming no parameter; True was a value of 1. A
+            # Decimal (no numbers.Real) is a number the binding reads, as it did before.
             if not (value is None and default is None) and (
-                isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real)
+                isinstance(value, (bool, np.bool_))
+                or not isinstance(value, (numbers.Real, decimal.Decimal))
             ):
                 raise ValueError(f"{name}: expected a number, got {value!r}")
             float_sized(value, name)  # 10**400: the binding's OverflowError
