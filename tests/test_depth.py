@@ -526,6 +526,32 @@ def test_an_unknown_matcher_parameter_names_what_the_method_takes() -> None:
             sv.depth_map(img, img, max_disparity=8, semi_global=bad)
 
 
+def test_every_type_error_of_depth_map_is_documented() -> None:
+    """depth_map raises TypeError for a switch that is no bool (semi_global's, new, refuses 1
+    and 0), a range that is no number, a progress that is not callable and calibration=; its
+    Raises section named ValueError and MemoryError only. Each argument is named there."""
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    doc = sv.depth_map.__doc__ or ""
+    section = doc.split("    Raises\n", 1)[1].split("    Examples\n", 1)[0]
+    assert "\n    TypeError\n" in section
+    entry = " ".join(section.split("    TypeError\n", 1)[1].split("\n    MemoryError")[0].split())
+    bad: dict[str, object] = {
+        "fill": "no",
+        "refine": 1,
+        "return_channels": None,
+        "cloud": "yes",
+        "semi_global": 1,
+        "max_disparity": "32",
+        "min_disparity": True,
+        "progress": 3,
+        "calibration": None,
+    }
+    for name, value in bad.items():
+        with pytest.raises(TypeError, match=name):
+            sv.depth_map(img, img, **({"max_disparity": 8} | {name: value}))  # type: ignore[arg-type]
+        assert f"``{name}" in entry, name
+
+
 def test_pair_and_calibration_mistakes_are_named() -> None:
     """A grey and a colour image made a pair (match() refused it); calibration= failed as an
     unknown fusion option; a size error always suggested scaled_to, even for swapped sizes or

@@ -1367,6 +1367,11 @@ def depth_map(
         a range no pixel can match in (``min_disparity`` not below the image width, or
         ``max_disparity`` not above minus it) or one float32 cannot tell apart (10 to
         10.0000001).
+    TypeError
+        A switch that is no bool: ``fill`` or ``refine`` (which also take None),
+        ``return_channels``, ``cloud`` or ``"fused"``'s ``semi_global`` (1 and 0 are refused
+        too); a ``max_disparity`` or ``min_disparity`` that is no number, a ``progress`` that is
+        not callable, or ``calibration=`` given in ``calib``'s place.
     MemoryError
         With ``method="fused"`` or ``"census"``, before the census semi-global map allocates
         more than the memory available (3 bytes per pixel and disparity level: about 14 GiB for
