@@ -1209,3 +1209,42 @@ def test_fused_dense_refuses_each_negative_setting(name: str) -> None:
     d, c = _dense(5.0)
     with pytest.raises(ValueError, match=f"^{name}: expected a non-negative number"):
         fused_dense(d, c, np.full((H, W), np.nan, np.float32), **{name: -1})
+
+
+@pytest.mark.parametrize(
+    ("method", "bad"),
+    [
+        ("fused", {"a_conf_min": float("nan")}),
+        ("fused", {"min_agree": 1}),
+        ("fused", {"mode": "majority"}),
+        ("fused", {"fill_confidence": 0}),
+        ("fused", {"radius": -1.0}),
+        ("census", {"second_confidence": 0}),
+        ("fast", {"edge_jump": "2"}),
+    ],
+)
+def test_a_bad_fusion_value_is_said_before_the_matching(
+    method: str, bad: dict[str, Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """fuse's and fused_dense's values were checked in them, after every matcher had run
+    (0.4 s on cones, seconds on a large pair: depth_map reached its "rectify" and "prepare"
+    stages and ran the channels): depth_map now refuses them before it rectifies, and
+    fuse_pair (match(method="fused")) before its channels run."""
+    import stereovision.matching.gabor as gabor_mod
+    import stereovision.matching.sgm as sgm_mod
+    from stereovision.matching.fusion import DEFAULTS
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    monkeypatch.setattr(gabor_mod, "gabor_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    stages: list[str] = []
+    name = next(iter(bad))
+    with pytest.raises(ValueError, match=f"^{name}: expected "):
+        sv_depth_map(img, img, max_disparity=8, method=method, progress=stages.append, **bad)
+    assert stages == []
+    if name in DEFAULTS:
+        with pytest.raises(ValueError, match=f"^{name}: expected "):
+            fuse_pair(img, img, max_disparity=8, **bad)

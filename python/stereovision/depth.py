@@ -16,7 +16,7 @@ import functools
 import math
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
@@ -89,7 +89,8 @@ _FUSED_SET_HERE = {"remeasure_gabor": "refine", "dense_sgm": "semi_global", "cen
 
 def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
     """Refuse the ``**params`` :func:`depth_map`'s ``method`` does not take, naming the ones it
-    does, and a ``semi_global`` that is not a bool, before the pair is rectified and matched.
+    does, a ``semi_global`` that is not a bool and a bad value of the fusion's or the dense
+    map's options, before the pair is rectified and matched.
 
     The matchers' own checks named their own keys only: ``"census"`` left out the dense map's
     (``second_confidence``, ...), which it takes, and ``"fused"`` the dense map's and
@@ -117,6 +118,7 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
         if not isinstance(semi_global, (bool, np.bool_)):
             # as the other switches: "no" ran the census map, None skipped it
             raise TypeError(f"semi_global: expected True or False, got {semi_global!r}")
+        fusion._fuse_options(**{**fusion.DEFAULTS, **_given(params, fusion.DEFAULTS)})
     else:
         refuse_unknown(
             "SGM option",
@@ -124,6 +126,14 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
             [*sgm.DEFAULTS, *_CENSUS_DENSE],
             "stereovision.matching.sgm.DEFAULTS and the dense map's",
         )
+    if method != "gabor":
+        # the dense map's values too: a bad one was said after every matcher had run
+        fusion._dense_options(**{**fusion.DENSE_DEFAULTS, **_given(params, fusion.DENSE_DEFAULTS)})
+
+
+def _given(params: dict[str, Any], keys: Iterable[str]) -> dict[str, Any]:
+    """The entries of ``params`` whose key is one of ``keys``."""
+    return {k: v for k, v in params.items() if k in keys}
 
 
 # Automatic disparity range: ORB matches on the epipolar band, a high percentile with margin.

@@ -257,6 +257,42 @@ def _plain_real(value: Any) -> Any:
     return value
 
 
+def _fuse_options(
+    mode: str,
+    r_spatial: Any,
+    tau_dx: Any,
+    tau_dy: Any,
+    a_conf_min: Any,
+    min_agree: Any,
+) -> tuple[Any, int]:
+    """Check :func:`fuse`'s options (:data:`DEFAULTS`' keys); ``(a_conf_min, min_agree)`` as
+    ``fuse`` uses them. :func:`fuse_pair` and ``depth_map`` check them before the channels run
+    (a bad one was said only after every matcher had run: 0.4 s on cones)."""
+    if mode not in ("vote", "intersection"):
+        raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
+    for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
+        if finite_number(v, pname) <= 0:
+            raise ValueError(f"{pname}: expected a positive number, got {v}")
+    # NaN took no Gabor value without a word (every ``conf >= nan`` is False), a string or None
+    # failed in NumPy's comparison naming no parameter
+    a_conf_min = _plain_real(a_conf_min)
+    if not 0 <= finite_number(a_conf_min, "a_conf_min") <= 1:
+        raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
+    # a string, None or NaN failed in a comparison or in range(), naming no parameter; a whole
+    # number given as 2.0 or a size-1 array (a value read from one) is its count
+    agree = _plain_real(min_agree)
+    if isinstance(agree, np.ndarray) and agree.size == 1 and agree.dtype.kind in "iuf":
+        agree = agree.reshape(())[()]
+    if isinstance(agree, (float, np.floating)) and float(agree).is_integer():
+        agree = int(agree)
+    if isinstance(agree, (bool, np.bool_)) or not isinstance(agree, (int, np.integer)):
+        raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
+    min_agree = int(agree)
+    if min_agree < 2:
+        raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
+    return a_conf_min, min_agree
+
+
 def fuse(
     gabor: tuple[npt.ArrayLike, npt.ArrayLike] | None,
     sparse: Mapping[str, Matches],
@@ -307,26 +343,7 @@ def fuse(
     for name in sparse:
         if name not in CHANNEL_BITS or name == "gabor":
             raise ValueError(f"unknown sparse channel {name!r}: expected mcgm or hopfield")
-    for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
-        if finite_number(v, pname) <= 0:
-            raise ValueError(f"{pname}: expected a positive number, got {v}")
-    # NaN took no Gabor value without a word (every ``conf >= nan`` is False), a string or None
-    # failed in NumPy's comparison naming no parameter
-    a_conf_min = _plain_real(a_conf_min)
-    if not 0 <= finite_number(a_conf_min, "a_conf_min") <= 1:
-        raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
-    # a string, None or NaN failed in a comparison or in range(), naming no parameter; a whole
-    # number given as 2.0 or a size-1 array (a value read from one) is its count
-    agree = _plain_real(min_agree)
-    if isinstance(agree, np.ndarray) and agree.size == 1 and agree.dtype.kind in "iuf":
-        agree = agree.reshape(())[()]
-    if isinstance(agree, (float, np.floating)) and float(agree).is_integer():
-        agree = int(agree)
-    if isinstance(agree, (bool, np.bool_)) or not isinstance(agree, (int, np.integer)):
-        raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
-    min_agree = int(agree)
-    if min_agree < 2:
-        raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
+    a_conf_min, min_agree = _fuse_options(mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree)
 
     names: list[str] = []
     shape: tuple[int, int] | None = None
@@ -532,6 +549,7 @@ def fuse_pair(
     bad = sorted(set(channels) - set(CHANNEL_BITS))
     if bad:
         raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")
+    _fuse_options(**{**DEFAULTS, **params})  # before the channels run, not after
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     rng: dict[str, Any] = {"max_disparity": max_disparity, "min_disparity": min_disparity}
     runs: dict[str, Callable[..., Any]] = {
@@ -858,6 +876,50 @@ def _nearest_member(members: F32) -> tuple[F32, F32]:
     return values[lab].astype(np.float32), dist.astype(np.float32)
 
 
+def _dense_options(
+    radius: Any,
+    tau: Any,
+    fill_radius: Any,
+    fill_confidence: Any,
+    second_tol: Any,
+    second_confidence: Any,
+    occlusion_tau: Any,
+    speckle_area: Any,
+    speckle_diff: Any,
+    edge_radius: Any,
+    edge_ratio: Any,
+    edge_jump: Any,
+) -> tuple[Any, Any]:
+    """Check :func:`fused_dense`'s options (:data:`DENSE_DEFAULTS`' keys, in its order);
+    ``(fill_confidence, second_confidence)`` as it uses them. ``depth_map`` checks them before
+    it matches (a bad one was said only after every matcher had run)."""
+    for name, v in (
+        ("radius", radius),
+        ("tau", tau),
+        ("fill_radius", fill_radius),
+        ("second_tol", second_tol),
+        ("occlusion_tau", occlusion_tau),
+        ("speckle_area", speckle_area),
+        ("speckle_diff", speckle_diff),
+        ("edge_radius", edge_radius),
+        ("edge_ratio", edge_ratio),
+        ("edge_jump", edge_jump),
+    ):
+        if finite_number(v, name) < 0:
+            raise ValueError(f"{name}: expected a non-negative number, got {v}")
+    # Confidence 0 marks a filled disparity (DepthResult.depth_counts, point_image(filled=True)):
+    # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
+    # or every pixel only the census map measured.
+    # a string or None failed in the comparison, naming no parameter
+    fill_confidence = _plain_real(fill_confidence)
+    second_confidence = _plain_real(second_confidence)
+    if not 0 < finite_number(fill_confidence, "fill_confidence") <= 1:
+        raise ValueError(f"fill_confidence: expected a value in (0, 1], got {fill_confidence}")
+    if not 0 < finite_number(second_confidence, "second_confidence") <= 1:
+        raise ValueError(f"second_confidence: expected a value in (0, 1], got {second_confidence}")
+    return fill_confidence, second_confidence
+
+
 def fused_dense(
     disparity: npt.ArrayLike,
     confidence: npt.ArrayLike,
@@ -942,30 +1004,20 @@ def fused_dense(
     c = _check_map(confidence, "confidence", shape)
     a = _check_map(members, "members", shape)
     b = None if second is None else _check_map(second, "second", shape)
-    for name, v in (
-        ("radius", radius),
-        ("tau", tau),
-        ("fill_radius", fill_radius),
-        ("second_tol", second_tol),
-        ("occlusion_tau", occlusion_tau),
-        ("speckle_area", speckle_area),
-        ("speckle_diff", speckle_diff),
-        ("edge_radius", edge_radius),
-        ("edge_ratio", edge_ratio),
-        ("edge_jump", edge_jump),
-    ):
-        if finite_number(v, name) < 0:
-            raise ValueError(f"{name}: expected a non-negative number, got {v}")
-    # Confidence 0 marks a filled disparity (DepthResult.depth_counts, point_image(filled=True)):
-    # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
-    # or every pixel only the census map measured.
-    # a string or None failed in the comparison, naming no parameter
-    fill_confidence = _plain_real(fill_confidence)
-    second_confidence = _plain_real(second_confidence)
-    if not 0 < finite_number(fill_confidence, "fill_confidence") <= 1:
-        raise ValueError(f"fill_confidence: expected a value in (0, 1], got {fill_confidence}")
-    if not 0 < finite_number(second_confidence, "second_confidence") <= 1:
-        raise ValueError(f"second_confidence: expected a value in (0, 1], got {second_confidence}")
+    fill_confidence, second_confidence = _dense_options(
+        radius,
+        tau,
+        fill_radius,
+        fill_confidence,
+        second_tol,
+        second_confidence,
+        occlusion_tau,
+        speckle_area,
+        speckle_diff,
+        edge_radius,
+        edge_ratio,
+        edge_jump,
+    )
     out = d.copy()
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
     has = np.isfinite(a)
