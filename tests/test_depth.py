@@ -526,6 +526,27 @@ def test_an_unknown_matcher_parameter_names_what_the_method_takes() -> None:
             sv.depth_map(img, img, max_disparity=8, semi_global=bad)
 
 
+def test_fused_channels_without_the_gabor_channel_are_named() -> None:
+    """depth_map(method="fused") takes fuse_pair's channels (c9f1031 named it), but its dense
+    map is the Gabor map's: without "gabor" it failed as a bare KeyError 'gabor' after every
+    channel had run, with no sparse one after them too, and "gabor,mcgm" was read letter by
+    letter. Each is refused before the rectification; a tuple, list or array of names works."""
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    right = np.roll(img, -3, axis=1)
+    for bad in (("mcgm", "hopfield"), ("gabor",), "gabor,mcgm", ("gabor", "mcgm", "sgm"), [[1]]):
+        stages: list[str] = []
+        with pytest.raises(
+            ValueError, match=r"^channels: depth_map\(method='fused'\) needs 'gabor'"
+        ):
+            sv.depth_map(img, right, max_disparity=8, channels=bad, progress=stages.append)
+        assert stages == []
+    want = sv.depth_map(img, right, max_disparity=8, channels=("gabor", "mcgm")).disparity
+    assert np.isfinite(want).mean() > 0.9
+    for good in (["gabor", "mcgm"], np.array(["gabor", "mcgm"])):
+        got = sv.depth_map(img, right, max_disparity=8, channels=good).disparity
+        np.testing.assert_array_equal(got, want)
+
+
 def test_every_type_error_of_depth_map_is_documented() -> None:
     """depth_map raises TypeError for a switch that is no bool (semi_global's, new, refuses 1
     and 0), a range that is no number, a progress that is not callable and calibration=; its

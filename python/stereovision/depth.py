@@ -16,7 +16,7 @@ import functools
 import math
 import time
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Collection, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
@@ -119,6 +119,8 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
             # as the other switches: "no" ran the census map, None skipped it
             raise TypeError(f"semi_global: expected True or False, got {semi_global!r}")
         fusion._fuse_options(**{**fusion.DEFAULTS, **_given(params, fusion.DEFAULTS)})
+        if "channels" in params:
+            _check_fused_channels(params["channels"])
     else:
         refuse_unknown(
             "SGM option",
@@ -129,6 +131,29 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
     if method != "gabor":
         # the dense map's values too: a bad one was said after every matcher had run
         fusion._dense_options(**{**fusion.DENSE_DEFAULTS, **_given(params, fusion.DENSE_DEFAULTS)})
+
+
+def _check_fused_channels(channels: object) -> None:
+    """Refuse a ``channels`` the fused dense map cannot be built from: it is the Gabor map
+    corrected by the members, so it needs ``"gabor"`` and a sparse channel. Without
+    ``"gabor"`` it was a bare ``KeyError: 'gabor'`` after every channel had run, a string
+    was taken letter by letter."""
+    from stereovision.matching import fusion
+
+    try:
+        names = set(channels) if isinstance(channels, Collection) else set()
+    except TypeError:  # unhashable entries: no channel names
+        names = set()
+    if (
+        isinstance(channels, (str, bytes))
+        or "gabor" not in names
+        or not names & {"mcgm", "hopfield"}
+        or names - set(fusion.CHANNEL_BITS)
+    ):
+        raise ValueError(
+            "channels: depth_map(method='fused') needs 'gabor' (its dense map is the Gabor "
+            f"map's) and at least one of 'mcgm', 'hopfield', and no other, got {channels!r}"
+        )
 
 
 def _given(params: dict[str, Any], keys: Iterable[str]) -> dict[str, Any]:
@@ -1355,7 +1380,8 @@ def depth_map(
     **params
         Passed to the matcher (see :func:`stereovision.matching.gabor.gabor_disparity`). For
         ``"fused"``: :func:`stereovision.matching.fusion.fuse`'s options,
-        :func:`~stereovision.matching.fusion.fuse_pair`'s ``channels``, ``check_members`` and
+        :func:`~stereovision.matching.fusion.fuse_pair`'s ``channels`` (``"gabor"``, on whose
+        map the dense map is built, and one or both sparse ones), ``check_members`` and
         ``edge_members`` (its other switches are this function's ``refine`` and
         ``semi_global``), the dense map's (:data:`stereovision.matching.fusion.DENSE_DEFAULTS`),
         and ``semi_global`` (default True: the census semi-global map,
