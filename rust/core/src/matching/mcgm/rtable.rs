@@ -56,7 +56,7 @@ pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
 /// [`crate::CoreError::TooLarge`].
 pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Result<RTable> {
     const WHAT: &str = "an R-table of the MCGM matcher";
-    check_positions(theta, w, seg.pixels.len(), n_bins)?;
+    check_positions(&seg.pixels, theta, w, n_bins)?;
     let mut counts = try_zeroed::<u32>(n_bins + 1, WHAT)?;
     let bins = try_collect(
         seg.pixels.len(),
@@ -95,7 +95,10 @@ pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Re
 /// every pixel indexes `theta`, so its row is below `ceil(len / w)`. `n_pixels` pixels need a
 /// width and a bin count of at least 1 (`% w`, `% n_bins`: a division by zero panicked); with
 /// no pixel the result is empty, as [`super::zerocross::zero_crossings`]' for a 0-wide image.
-fn check_positions(theta: &[f32], w: usize, n_pixels: usize, n_bins: usize) -> Result<()> {
+/// A pixel index past `theta` (a public caller's bad input) is refused too: `theta[i]`
+/// panicked (one pass over the indices, next to the tables' own passes).
+fn check_positions(pixels: &[u32], theta: &[f32], w: usize, n_bins: usize) -> Result<()> {
+    let n_pixels = pixels.len();
     if n_pixels > 0 && w == 0 {
         return Err(crate::CoreError::param(
             "w",
@@ -106,6 +109,15 @@ fn check_positions(theta: &[f32], w: usize, n_pixels: usize, n_bins: usize) -> R
         return Err(crate::CoreError::param(
             "n_bins",
             format!("must be at least 1 for {n_pixels} pixels, got 0"),
+        ));
+    }
+    if let Some(&i) = pixels.iter().max().filter(|&&i| i as usize >= theta.len()) {
+        return Err(crate::CoreError::param(
+            "pixels",
+            format!(
+                "index {i} is past the image's {} pixels (theta)",
+                theta.len()
+            ),
         ));
     }
     crate::image::check_index_range(w, theta.len().div_ceil(w.max(1)))
@@ -132,7 +144,7 @@ pub fn voters(
     w: usize,
     n_bins: usize,
 ) -> Result<Vec<(i32, i32, u32)>> {
-    check_positions(theta, w, pixels.len(), n_bins)?;
+    check_positions(pixels, theta, w, n_bins)?;
     let it = pixels.iter().map(|&q| {
         let (x, y) = ((q as usize % w) as i32, (q as usize / w) as i32);
         (x, y, theta_bin(theta[q as usize], n_bins) as u32)

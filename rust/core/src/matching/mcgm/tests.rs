@@ -3120,3 +3120,31 @@ fn rtables_and_voters_of_a_zero_width_or_zero_bins_are_errors_or_empty() {
         [(0, 0, 0), (0, 2, 0)]
     );
 }
+
+#[test]
+fn rtables_and_voters_refuse_a_pixel_past_theta() {
+    // `theta[i]` of a pixel index past the image panicked (index out of bounds).
+    let seg = Segment {
+        pixels: vec![0, 5, 2],
+        centroid: (1.0, 0.0),
+        x_min: 0,
+        x_max: 2,
+        y_min: 0,
+        y_max: 1,
+        mean_theta: 0.0,
+    };
+    let theta = [0.0f32, 1.0, 2.0, 3.0];
+    let past = Err(CoreError::param(
+        "pixels",
+        "index 5 is past the image's 4 pixels (theta)",
+    ));
+    assert_eq!(voters(&seg.pixels, &theta, 2, 36).map(|_| ()), past);
+    assert_eq!(build_rtable(&seg, &theta, 2, 36).map(|_| ()), past);
+    // The last pixel (index 3 of 4) is still taken: (1, 1) in bin floor(36 * 3 / 2 pi) = 17.
+    assert_eq!(voters(&[3], &theta, 2, 36).unwrap(), [(1, 1, 17)]);
+    let last = Segment {
+        pixels: vec![3],
+        ..seg.clone()
+    };
+    assert_eq!(build_rtable(&last, &theta, 2, 36).unwrap().px, [(1, 1)]);
+}
