@@ -2132,7 +2132,9 @@ def test_depth_says_its_depths_in_metres_unless_unit_is_given(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The summary's depths are in metres by default and in --unit's unit when given (a wall
-    about 8 px apart, 150 px focal, 0.1 m baseline: near 1.9 m); depth.npy stays in metres."""
+    about 8 px apart, 150 px focal, 0.1 m baseline: near 1.9 m); depth.npy stays in metres.
+    A depth of 1000 or more in the unit was said in exponent form (``--unit mm``: "depth
+    1.87e+03-1.93e+03 mm"); now in whole units."""
     from tests import synthetic_scene as syn
 
     rng = np.random.default_rng(0)
@@ -2145,8 +2147,8 @@ def test_depth_says_its_depths_in_metres_unless_unit_is_given(
     argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "--calib", str(rig)]
     argv += ["--max-disparity", "16"]
     medians = {}
-    for unit in ("m", "ft"):
-        extra = [] if unit == "m" else ["--unit", "ft"]
+    for unit in ("m", "ft", "mm"):
+        extra = [] if unit == "m" else ["--unit", unit]
         assert main([*argv, *extra, "-o", str(tmp_path / unit)]) == 0
         line = capsys.readouterr().out.splitlines()[0]
         found = re.search(rf"depth [\d.]+-[\d.]+ {unit} \(median ([\d.]+) {unit}\)", line)
@@ -2156,6 +2158,7 @@ def test_depth_says_its_depths_in_metres_unless_unit_is_given(
         assert 1.8 < metres < 2.0  # the wall, in metres whatever --unit says
     assert medians["m"] == pytest.approx(metres, abs=0.005)
     assert medians["ft"] == pytest.approx(metres / 0.3048, abs=0.005)
+    assert medians["mm"] == pytest.approx(1000 * metres, abs=0.5)
 
 
 def test_depth_of_a_pair_16_px_wide_says_so_before_a_file_in_the_output_folder(

@@ -863,8 +863,14 @@ def _depth_range(depth: np.ndarray, unit: str) -> str:
     z = depth[np.isfinite(depth)] / UNIT_TO_METRES[unit]
     if not z.size:
         return "no depth"
-    lo, hi, mid = float(z.min()), float(z.max()), float(np.median(z))
-    return f"depth {lo:.3g}-{hi:.3g} {unit} (median {mid:.3g} {unit})"
+    lo, hi, mid = (_figure(float(v)) for v in (z.min(), z.max(), np.median(z)))
+    return f"depth {lo}-{hi} {unit} (median {mid} {unit})"
+
+
+def _figure(value: float) -> str:
+    """Three significant digits, whole units from 999.5 on: ``.3g`` wrote those in exponent
+    form (``--unit mm``: "depth 2.27e+03-2.92e+05 mm")."""
+    return f"{value:.3g}" if abs(value) < 999.5 else f"{value:.0f}"
 
 
 def _ground_outputs(
