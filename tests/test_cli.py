@@ -2615,6 +2615,45 @@ def test_check_fix_naming_a_folder_is_said_before_the_check(
     assert rig.is_dir() and not any(rig.iterdir())
 
 
+def test_check_fix_in_a_folder_that_cannot_be_written_is_said_before_the_check(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """check --fix ro/fixed.yaml (ro not writable) checked the pair and corrected the rig, then
+    failed to save it; now one line first, exit 2, as --plot's folder."""
+    import tempfile
+
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    (tmp_path / "ro").mkdir()
+    real = tempfile.mkstemp
+
+    def mkstemp(*args: object, dir: object = None, **kwargs: object) -> object:
+        if dir is not None and Path(str(dir)) == tmp_path / "ro":  # root writes anywhere
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)  # type: ignore[call-overload]
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    rig = tmp_path / "ro" / "fixed.yaml"
+    calib = scene / "calib.txt"
+    assert main(["check", *pair, "--calib", str(calib), "--fix", str(rig)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: --fix {rig}: its folder {tmp_path / 'ro'}: cannot write in "
+        f"{tmp_path / 'ro'} (Permission denied)\n"
+    )
+    assert not any((tmp_path / "ro").iterdir())
+
+
 def test_rectify_refuses_a_folder_under_a_listed_output_before_the_work(
     data_dir: Path,
     tmp_path: Path,
