@@ -942,17 +942,18 @@ fn level_data_holds_the_responses_demodulated_and_their_frequency_phasors() {
     }
 }
 
-#[test]
-fn stability_bits_follow_the_fleet_jepson_test() {
+/// Checks every stability bit of a textured level at `tau` against the Fleet-Jepson test;
+/// returns the bits set, the bits clear, and those clear by the frequency bound alone (inside
+/// the `tau / sigma_x` disk, below `k0 / 2`).
+fn check_stability_bits(tau: f32) -> (usize, usize, usize) {
     // Bit c where |psi - j k0| <= tau / sigma_x and Im psi >= k0 / 2, with Im psi = arg f and
     // Re psi = (ln |y(x+1)|^2 - ln |y(x-1)|^2) / 4; never on the first and last columns.
     let (w, h) = (40usize, 6usize);
     let img = texture(w, h, 0.0, 21);
     // Three channels: each has its own bit.
     let chans = channels(&DEFAULT_ORIENTATIONS);
-    let tau = 0.6;
     let ld = level_data(&img.data, w, h, &chans, tau, false).unwrap();
-    let (mut set, mut clear) = (0, 0);
+    let (mut set, mut clear, mut freq_only) = (0, 0, 0);
     for (ci, c) in chans.iter().enumerate() {
         let lim = (tau / c.sigma_x) as f64;
         for y in 0..h {
@@ -986,11 +987,31 @@ fn stability_bits_follow_the_fleet_jepson_test() {
                     set += 1;
                 } else {
                     clear += 1;
+                    freq_only += usize::from(r <= lim);
                 }
             }
         }
     }
+    (set, clear, freq_only)
+}
+
+#[test]
+fn stability_bits_follow_the_fleet_jepson_test() {
+    let (set, clear, _) = check_stability_bits(0.6);
     assert!(set > 20 && clear > 20, "{set} set, {clear} clear");
+}
+
+#[test]
+fn stability_needs_half_the_tuned_frequency_inside_a_wide_disk() {
+    // At tau 0.6 the disk (radius tau / sigma_x) lies above k0 / 2 in every channel, so the
+    // frequency bound decides nothing there; at tau 3 the disk reaches below it (and below 0:
+    // a negative local frequency) and the bound alone must clear those pixels.
+    let (set, clear, freq_only) = check_stability_bits(3.0);
+    assert!(set > 20 && clear > 20, "{set} set, {clear} clear");
+    assert!(
+        freq_only > 5,
+        "{freq_only} pixels cleared by the frequency bound alone"
+    );
 }
 
 #[test]
@@ -1612,4 +1633,42 @@ fn one_direction_is_the_top_search_then_the_newton_steps_by_their_definition() {
     want.iter_mut().for_each(|v| *v = v.clamp(-3.5, 10.7));
     let got = one_direction(&left.data, &right.data, w, h, &p, &chans, 0).unwrap();
     assert!(same(&got.disp, &want), "two levels");
+}
+
+#[test]
+fn newton_step_gives_no_weight_below_half_the_tuned_frequency() {
+    // Both pixels marked stable and far above the amplitude floor, so the joint local frequency
+    // k = arg(f_l + f_r) alone decides (A.5 step 3e: k_x >= k0 / 2). The left phasors forced to
+    // a frequency of 0.45 k0 (dominating the right's): no weight and no update anywhere; forced
+    // to k0 itself: the pixels inside the row weigh in.
+    let (w, h) = (31usize, 4usize);
+    let (left, right) = (texture(w, h, 0.0, 8), texture(w, h, 0.6, 8));
+    let chans = channels(&[0.0]);
+    let mut ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let mut rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+    ld.stable.iter_mut().for_each(|s| *s = 1);
+    rd.stable.iter_mut().for_each(|s| *s = 1);
+    let cc = level::chan_consts(&chans, &ld, &rd, 0.0);
+    let disp = vec![0.6f32; w * h];
+    let k0 = cc[0].kx;
+    let mut step_at = |k: f32| {
+        for y in 0..h {
+            let o = level::SUBROWS * y * w;
+            for x in 0..w {
+                ld.chan[0][o + 2 * w + x] = 1e6 * k.cos();
+                ld.chan[0][o + 3 * w + x] = 1e6 * k.sin();
+            }
+        }
+        level::newton_step(&ld, &rd, &cc, &disp).unwrap()
+    };
+    let (delta, conf) = step_at(0.45 * k0);
+    assert!(conf.iter().all(|&c| c == 0.0), "weight below k0 / 2");
+    assert!(delta.iter().all(|&d| d == 0.0), "update below k0 / 2");
+    let (_, conf) = step_at(k0);
+    let weighed = conf.iter().filter(|&&c| c > 0.5).count();
+    assert!(
+        weighed > w * h * 3 / 4,
+        "{weighed} of {} pixels weigh in at k0",
+        w * h
+    );
 }
