@@ -451,6 +451,52 @@ fn disambiguation_tolerance_is_inclusive_at_a_half_pixel_reference() {
     assert_eq!(disambiguate(&tie, &net, &state, &p).unwrap(), [0, 1, 2]);
 }
 
+/// C.5 on the right side: left points with one active neuron each but sharing a right pixel
+/// are a conflict too, resolved by the same rule (vertical disparity closest to the median of
+/// the singles in the 40x40 window, here 0, then the higher similarity; none farther than
+/// `tau_y`). Five singles of dy 3 far away make the global median 1: the reference must be the
+/// window's. Keeping every such pair (`>= 1` for `== 1` in the held count) and the global median
+/// for the local one both survived the tests.
+#[test]
+fn disambiguation_resolves_a_shared_right_pixel_by_the_same_rule() {
+    let at = |point: u32, (x, y): (i32, i32), xr: i32, yr: i32, sim: f32| Neuron {
+        xr,
+        yr,
+        sim,
+        ..neuron(point, (x, y), 0, 0.0, true)
+    };
+    let ns = vec![
+        at(0, (100, 100), 90, 100, 0.9),
+        at(1, (120, 100), 110, 100, 0.9),
+        // Right pixel (120, 100): dy 1 against dy 0; the latter kept.
+        at(2, (130, 101), 120, 100, 0.9),
+        at(3, (132, 100), 120, 100, 0.8),
+        // Right pixel (140, 100): both dy 0; the more similar kept.
+        at(4, (150, 100), 140, 100, 0.8),
+        at(5, (160, 100), 140, 100, 0.9),
+        // Right pixel (170, 100): dy 3 and -2, both beyond tau_y of their references: none.
+        at(6, (180, 103), 170, 100, 0.9),
+        at(7, (185, 98), 170, 100, 0.9),
+    ];
+    let far = (0..5).map(|i| {
+        at(
+            8 + i,
+            (400 + 5 * i as i32, 100),
+            380 + 5 * i as i32,
+            97,
+            0.9,
+        )
+    });
+    let ns: Vec<Neuron> = ns.into_iter().chain(far).collect();
+    let state = [1u8; 13];
+    let p = HopfieldParams::default();
+    let net = Network::new(&ns, &p.weights).unwrap();
+    assert_eq!(
+        disambiguate(&ns, &net, &state, &p).unwrap(),
+        [0, 1, 3, 5, 8, 9, 10, 11, 12]
+    );
+}
+
 /// `right = 0.5 left(x + d) + 0.2` (an exposure offset): the centre check, on window-mean-free
 /// grey levels, passes at the true disparity.
 #[test]
