@@ -84,6 +84,36 @@ fn negative_range_is_supported() {
 }
 
 #[test]
+fn a_texture_of_one_grey_level_is_matched() {
+    // The absolute amplitude floor (AMP_ABS_FLOOR) sits between a constant image's numerical
+    // noise and the response to one grey level (1/255) of texture: such a faint texture, here
+    // rescaled to a standard deviation of 1/255, is still dense and exact. A floor of 1e-3
+    // survived the tests.
+    let faint = |img: Image| {
+        let n = img.data.len() as f32;
+        let mean = img.data.iter().sum::<f32>() / n;
+        let sd = (img.data.iter().map(|v| (v - mean).powi(2)).sum::<f32>() / n).sqrt();
+        let data = img
+            .data
+            .iter()
+            .map(|v| 0.5 + (v - mean) / sd / 255.0)
+            .collect();
+        Image::new(img.width, img.height, data).unwrap()
+    };
+    let d = 2.3f32;
+    let (left, right) = (faint(texture(96, 64, 0.0, 7)), faint(texture(96, 64, d, 7)));
+    let p = GaborParams {
+        d_min: 0.0,
+        d_max: 16.0,
+        ..GaborParams::default()
+    };
+    let out = gabor_disparity(&left, &right, &p).unwrap();
+    let (med, n) = median_of_finite(&out.disparity.data);
+    assert!(n > 96 * 64 * 3 / 4, "density too low: {n}");
+    assert!((med - d).abs() < 0.05, "median = {med}");
+}
+
+#[test]
 fn textureless_pair_gives_all_nan() {
     let a = Image::filled(64, 48, 0.5).unwrap();
     let out = gabor_disparity(&a, &a, &GaborParams::default()).unwrap();
