@@ -267,6 +267,22 @@ trait PathCost: Copy + Ord {
     fn wide(self) -> u16;
     /// `c + min(b, min(a, n) + p1, lim) - m`, with `m <= min(b, ...)` and `lim = m + p2`.
     fn step(c: Self, a: Self, b: Self, n: Self, p1: Self, lim: Self, m: Self) -> Self;
+    /// [`step4`]'s loop by hand-written AVX2 (`n >= 32` levels; `lim_r = m_r + p2_r`); `None`
+    /// for the types that have none.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn step4_avx2(
+        _avx2: Avx2,
+        _lp: &[&[Self]; 4],
+        _m: [Self; 4],
+        _lim: [Self; 4],
+        _p1: Self,
+        _c: &[u8],
+        _out: &mut [&mut [Self]; 4],
+        _acc: &mut [u16],
+    ) -> Option<[Self; 4]> {
+        None
+    }
 }
 
 impl PathCost for u16 {
@@ -303,6 +319,132 @@ impl PathCost for u8 {
         // either way; the result is at most `c + p2`, below 256 when `u8_fits`.
         (b.min(a.min(n).saturating_add(p1)).min(lim) - m) + c
     }
+    #[inline(always)]
+    fn step4_avx2(
+        avx2: Avx2,
+        lp: &[&[Self]; 4],
+        m: [Self; 4],
+        lim: [Self; 4],
+        p1: Self,
+        c: &[u8],
+        out: &mut [&mut [Self]; 4],
+        acc: &mut [u16],
+    ) -> Option<[Self; 4]> {
+        step4_u8_avx2(avx2, lp, m, lim, p1, c, out, acc)
+    }
+}
+
+/// Proof that the running CPU has AVX2 (made only by [`Avx2::detect`]): the hand-written
+/// path step needs it.
+#[derive(Clone, Copy)]
+struct Avx2(());
+
+impl Avx2 {
+    fn detect() -> Option<Self> {
+        crate::simd::has_avx2().then_some(Avx2(()))
+    }
+}
+
+/// [`step4`] for `u8` path costs in AVX2, 32 levels a vector: the compiler's loop runs 16 (the
+/// `u16` sums set its width). The same operations per level as [`PathCost::step`] for `u8`,
+/// so the same integers; the four sums are widened in registers (even and odd levels as `u16`
+/// lanes, interleaved back at the end). `None` below 32 levels.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn step4_u8_avx2(
+    _avx2: Avx2,
+    lp: &[&[u8]; 4],
+    m: [u8; 4],
+    lim: [u8; 4],
+    p1: u8,
+    c: &[u8],
+    out: &mut [&mut [u8]; 4],
+    acc: &mut [u16],
+) -> Option<[u8; 4]> {
+    let n = c.len();
+    if n < 32
+        || acc.len() < n
+        || lp.iter().any(|v| v.len() < n + 2)
+        || out.iter().any(|v| v.len() < n + 2)
+    {
+        return None;
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        let lp = lp.map(|v| v.as_ptr());
+        let out = [0, 1, 2, 3].map(|r| out[r].as_mut_ptr());
+        // SAFETY: `_avx2` proves the CPU has AVX2; `kernel` reads `lp_r[..n + 2]` and `c[..n]`,
+        // writes `out_r[1..n + 1]` and `acc[..n]`, all within the lengths checked above.
+        Some(unsafe { kernel(lp, m, lim, p1, c.as_ptr(), n, out, acc.as_mut_ptr()) })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        None
+    }
+}
+
+/// [`step4_u8_avx2`]'s loop.
+///
+/// # Safety
+/// The CPU has AVX2; `lp_r` and `out_r` hold `n + 2` values, `c` and `acc` `n`, `n >= 32`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+#[inline]
+unsafe fn kernel(
+    lp: [*const u8; 4],
+    m: [u8; 4],
+    lim: [u8; 4],
+    p1: u8,
+    c: *const u8,
+    n: usize,
+    out: [*mut u8; 4],
+    acc: *mut u16,
+) -> [u8; 4] {
+    use std::arch::x86_64::*;
+    let pv = _mm256_set1_epi8(p1 as i8);
+    let mv = m.map(|v| _mm256_set1_epi8(v as i8));
+    let lv = lim.map(|v| _mm256_set1_epi8(v as i8));
+    let low = _mm256_set1_epi16(0xff);
+    let mut mn = [_mm256_set1_epi8(-1); 4];
+    let mut k = 0;
+    while k < n {
+        // The last block ends at level n, overlapping the one before: the levels computed
+        // twice get the same values (inputs and outputs are distinct buffers).
+        let k0 = k.min(n - 32);
+        let cv = _mm256_loadu_si256(c.add(k0).cast());
+        let (mut even, mut odd) = (_mm256_setzero_si256(), _mm256_setzero_si256());
+        for r in 0..4 {
+            let a = _mm256_loadu_si256(lp[r].add(k0).cast());
+            let b = _mm256_loadu_si256(lp[r].add(k0 + 1).cast());
+            let nx = _mm256_loadu_si256(lp[r].add(k0 + 2).cast());
+            let t = _mm256_adds_epu8(_mm256_min_epu8(a, nx), pv);
+            let t = _mm256_min_epu8(_mm256_min_epu8(b, t), lv[r]);
+            let v = _mm256_add_epi8(_mm256_sub_epi8(t, mv[r]), cv);
+            _mm256_storeu_si256(out[r].add(k0 + 1).cast(), v);
+            mn[r] = _mm256_min_epu8(mn[r], v);
+            even = _mm256_add_epi16(even, _mm256_and_si256(v, low));
+            odd = _mm256_add_epi16(odd, _mm256_srli_epi16::<8>(v));
+        }
+        // Per 128-bit half: levels 0-7 | 16-23 and 8-15 | 24-31, then in order.
+        let lo = _mm256_unpacklo_epi16(even, odd);
+        let hi = _mm256_unpackhi_epi16(even, odd);
+        _mm256_storeu_si256(
+            acc.add(k0).cast(),
+            _mm256_permute2x128_si256::<0x20>(lo, hi),
+        );
+        _mm256_storeu_si256(
+            acc.add(k0 + 16).cast(),
+            _mm256_permute2x128_si256::<0x31>(lo, hi),
+        );
+        k += 32;
+    }
+    mn.map(|v| {
+        let x = _mm_min_epu8(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
+        let x = _mm_min_epu8(x, _mm_srli_epi16::<8>(x));
+        let x = _mm_minpos_epu16(_mm_and_si128(x, _mm_set1_epi16(0xff)));
+        _mm_cvtsi128_si32(x) as u8
+    })
 }
 
 /// Whether path costs fit `u8`: a path cost is at most `OUTSIDE + P2`, and `m + P2` (the jump
@@ -316,6 +458,7 @@ fn u8_fits(lut: &[u16]) -> bool {
 /// `out_r[k] = c[k] + min(lp_r[k], lp_r[k +- 1] + p1, m_r + p2_r) - m_r` (`lp_r`, `out_r`: `n + 2`
 /// values with a pad at each end; `m_r` = min of `lp_r`; a path's first pixel has a zero
 /// `lp_r`, which gives `out_r = c`). Writes their sum to `acc` and returns their minima.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn step4<T: PathCost>(
     lp: [&[T]; 4],
@@ -323,10 +466,17 @@ fn step4<T: PathCost>(
     p2: [u16; 4],
     p1: u16,
     c: &[u8],
-    out: [&mut [T]; 4],
+    mut out: [&mut [T]; 4],
     acc: &mut [u16],
+    avx2: Option<Avx2>,
 ) -> [T; 4] {
     let n = c.len();
+    if let Some(avx2) = avx2 {
+        let lim: [T; 4] = std::array::from_fn(|r| T::of(m[r].wide() + p2[r]));
+        if let Some(mn) = T::step4_avx2(avx2, &lp, m, lim, T::of(p1), c, &mut out, acc) {
+            return mn;
+        }
+    }
     let acc = &mut acc[..n];
     let [o0, o1, o2, o3] = out;
     let (o0, o1, o2, o3) = (
@@ -409,6 +559,7 @@ fn pass_impl<T: PathCost>(
     forward: bool,
     row: &mut Vec<u16>,
     emit: &mut dyn FnMut(usize, &mut Vec<u16>),
+    avx2: Option<Avx2>,
 ) -> Result<()> {
     let stride = n + 2;
     let lut = p2_table(p);
@@ -466,7 +617,7 @@ fn pass_impl<T: PathCost>(
                 &mut c1[x * stride..(x + 1) * stride],
                 &mut c2[x * stride..(x + 1) * stride],
             ];
-            let mn = step4(lps, ms, p2s, p.p1, ci, outs, acc);
+            let mn = step4(lps, ms, p2s, p.p1, ci, outs, acc, avx2);
             hmin = mn[0];
             for r in 0..3 {
                 cur_min[r][x] = mn[r + 1];
@@ -482,9 +633,10 @@ fn pass_impl<T: PathCost>(
 }
 
 /// `fn $name`: [`pass_impl`] with `$t` path costs, compiled for the baseline and AVX2 (the
-/// per-level loop of the four paths vectorises).
+/// per-level loop of the four paths vectorises); `$avx2`: whether its hand-written AVX2 step
+/// is taken where the CPU has it.
 macro_rules! pass_with {
-    ($name:ident, $t:ty) => {
+    ($name:ident, $t:ty, $avx2:expr) => {
         simd_fn! {
             fn $name(
                 c: &[u8],
@@ -497,13 +649,13 @@ macro_rules! pass_with {
                 row: &mut Vec<u16>,
                 emit: &mut dyn FnMut(usize, &mut Vec<u16>),
             ) -> Result<()> {
-                pass_impl::<$t>(c, img, w, h, n, p, forward, row, emit)
+                pass_impl::<$t>(c, img, w, h, n, p, forward, row, emit, $avx2)
             }
         }
     };
 }
-pass_with!(pass_u8, u8);
-pass_with!(pass_u16, u16);
+pass_with!(pass_u8, u8, Avx2::detect());
+pass_with!(pass_u16, u16, None);
 
 simd_fn! {
     /// `a += b`, element-wise (one row of the two passes' sums).
@@ -1456,6 +1608,81 @@ mod tests {
         assert_eq!(pass_rows(true, true, &edge), pass_rows(false, true, &edge));
         let over = SgmParams { p2: 97, ..p };
         assert!(!u8_fits(&p2_table(&over)));
+    }
+
+    #[test]
+    fn the_avx2_path_step_gives_the_compilers_integers() {
+        // The hand-written AVX2 step against the portable loop, through whole passes in both
+        // directions (all eight paths), for every level count 1..=200 (below 32 the loop runs;
+        // above, the last block overlaps the one before), on census and random cost volumes,
+        // with P1 and P2 at their u8 extremes and gammas that take every P2 level or none.
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        };
+        let (w, h) = (13, 7);
+        let d = SgmParams::default();
+        let params = [
+            d,
+            SgmParams { p1: 1, p2: 2, ..d },
+            SgmParams {
+                p1: 1,
+                p2: 96,
+                gamma: 0.5,
+                ..d
+            },
+            SgmParams {
+                p1: 95,
+                p2: 96,
+                ..d
+            },
+            SgmParams {
+                p2: 96,
+                gamma: 1e6,
+                ..d
+            },
+        ];
+        let img: Vec<f32> = noise(w, h, 5)
+            .iter()
+            .zip(ramp(w, h, 0.0))
+            .map(|(a, b)| 0.5 * a + b * 0.5)
+            .collect();
+        let (cl, cr) = (
+            census(ImageView::new(w, h, &ramp(w, h, 0.0)).unwrap()).unwrap(),
+            census(ImageView::new(w, h, &ramp(w, h, 5.0)).unwrap()).unwrap(),
+        );
+        let mut s = 12345u32;
+        let mut rand = move || {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            s >> 8
+        };
+        let run = |c: &[u8], n: usize, p: &SgmParams, forward: bool, a: Option<Avx2>| {
+            let mut rows = Vec::new();
+            let mut emit = |y: usize, row: &mut Vec<u16>| rows.push((y, row.clone()));
+            let mut row = vec![0u16; w * n];
+            pass_impl::<u8>(c, &img, w, h, n, p, forward, &mut row, &mut emit, a).unwrap();
+            rows
+        };
+        for n in 1..=200 {
+            // Random costs, a tenth of them OUTSIDE (the largest a cost can be).
+            let random: Vec<u8> = (0..w * h * n)
+                .map(|_| match rand() % 10 {
+                    0 => OUTSIDE,
+                    _ => (rand() % (u32::from(OUTSIDE) + 1)) as u8,
+                })
+                .collect();
+            let censused = cost_volume(&cl, &cr, w, -3, n);
+            for c in [&random, &censused] {
+                for p in &params {
+                    assert!(u8_fits(&p2_table(p)));
+                    for forward in [true, false] {
+                        let want = run(c, n, p, forward, None);
+                        assert_eq!(want.len(), h);
+                        assert_eq!(run(c, n, p, forward, Some(avx2)), want, "{n} levels {p:?}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
