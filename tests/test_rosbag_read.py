@@ -1171,6 +1171,34 @@ def test_a_split_ros1_recording_whose_last_piece_is_unfinished_is_said(
         assert len(list(cam.frames())) == 15
 
 
+def test_another_recordings_unfinished_bag_beside_a_split_one_is_left_out(
+    cones: Any, tmp_path: Path
+) -> None:
+    """A folder of a finished split recording (rig_<time>_0.bag, rig_<time>_1.bag) beside the
+    .bag.active of another recording still under way there: 98b0543 refused the folder,
+    naming the other recording's file (10 pairs read before it). That file is no piece of
+    this recording: its 10 pairs are read; the recording's own unfinished piece is still
+    named."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    folder = tmp_path / "bags"
+    folder.mkdir()
+    for i in range(2):
+        stamps = [T0 + (5 * i + k) * PERIOD_NS for k in range(5)]
+        write_bag(folder / f"rig_2026-12-06-06-00-00_{i}.bag",
+                  [(s, small[0], s, small[1]) for s in stamps], flavour="ros1")  # fmt: skip
+    other = write_bag(tmp_path / "other_2026-12-06-07-00-00_0.bag",
+                      [(T0 + k * PERIOD_NS, small[0], T0 + k * PERIOD_NS, small[1])
+                       for k in range(5)], flavour="ros1")  # fmt: skip
+    other.rename(folder / f"{other.name}.active")
+    with BagCamera(folder) as cam:
+        assert len(list(cam.frames())) == 10 and cam.dropped == {"left": 0, "right": 0}
+    # the recording's own last piece unfinished: named, not the other recording's file
+    own = folder / "rig_2026-12-06-06-00-00_1.bag"
+    own.rename(folder / f"{own.name}.active")
+    with pytest.raises(ValueError, match=re.escape(f"{own}.active is a ROS 1 recording left")):
+        BagCamera(folder)
+
+
 def test_an_mcap_recording_left_unfinished_is_said_with_its_remedy(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

@@ -736,6 +736,28 @@ def _unfinished_mcap(path: Path) -> Path | None:
     return None
 
 
+_SPLIT_PIECE = re.compile(r"^(.*)_\d+\.bag(\.active)?$")
+
+
+def _active_pieces(folder: Path) -> list[Path]:
+    """The ``.bag.active`` files of ``folder`` that are pieces of the recording its ``.bag``
+    files hold (``NAME_N.bag`` beside ``NAME_M.bag.active``, ``rosbag record --split``), or all
+    of them when it holds no ``.bag``. Another recording's ``.bag.active`` (one still being
+    recorded into the same folder) is no piece of it: the finished recording was refused for
+    it, though its pieces read whole."""
+    active = sorted(folder.glob("*.bag.active"))
+    finished = sorted(folder.glob("*.bag"))
+    if not finished:
+        return active
+
+    def name(p: Path) -> str:
+        m = _SPLIT_PIECE.match(p.name)
+        return m.group(1) if m else p.name.removesuffix(".active").removesuffix(".bag")
+
+    names = {name(p) for p in finished}
+    return [p for p in active if name(p) in names]
+
+
 def _open_reader(path: Path) -> Any:
     """rosbags' reader of a ROS 1 or ROS 2 bag, opened. A ROS 2 bag recorded before Iron holds
     no message definitions: ``sensor_msgs`` are then read with Humble's (the same since)."""
@@ -752,7 +774,7 @@ def _open_reader(path: Path) -> Any:
     active = (
         [path]
         if path.name.endswith(".bag.active")
-        else sorted(path.glob("*.bag.active"))
+        else _active_pieces(path)
         if path.is_dir() and not (path / "metadata.yaml").is_file()
         else []
     )
