@@ -1107,6 +1107,19 @@ def test_a_bag_without_a_pair_says_how_far_apart_the_topics_stamps_are(
     )
 
 
+def test_the_no_pair_gap_is_never_said_in_exponent_form(cones: Any, tmp_path: Path) -> None:
+    """4c9f7bd said a gap under a second with ``.3g``: 999.7 ms read "+1e+03 ms" and 5 ns (a
+    ``max_skew_ms`` of 0) "-5e-06 ms". They are "+1000 ms" and "-5 ns" now."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    for gap, skew, said in ((999_700_000, None, "+1000 ms"), (-5, 0.0, "-5 ns")):
+        frames = [(T0 + k * PERIOD_NS + gap, small[0], T0 + k * PERIOD_NS, small[1])
+                  for k in range(10)]  # fmt: skip
+        bag = write_bag(tmp_path / f"gap{gap}", frames)
+        with BagCamera(bag, max_skew_ms=skew) as cam, pytest.raises(SourceError) as caught:
+            cam.read()
+        assert f": the first left stamp is {said} from the first right one (" in str(caught.value)
+
+
 def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

@@ -959,6 +959,20 @@ def is_bag(path: str | os.PathLike[str]) -> bool:
     return p.is_dir() and any(any(p.glob(f"*{ext}")) for ext in exts)
 
 
+def _gap_text(gap_ns: int) -> str:
+    """A stamp difference as the no-pair error says it: seconds to 3 decimals from a second,
+    3 significant digits of ms below (a 0.3 ms gap was "-0.000 s"), whole ns under a
+    microsecond. Never in exponent form: ``.3g`` said 999.7 ms as "+1e+03 ms" and 5 ns (a
+    ``max_skew_ms`` of 0) as "+5e-06 ms"."""
+    if abs(gap_ns) >= 10**9:
+        return f"{gap_ns / 1e9:+.3f} s"
+    if abs(gap_ns) < 1000:
+        return f"{gap_ns:+d} ns"
+    ms = gap_ns / 1e6
+    text = f"{ms:+.{max(0, 2 - math.floor(math.log10(abs(ms))))}f}"
+    return (text.rstrip("0").rstrip(".") if "." in text else text) + " ms"
+
+
 def _rate(count: int, reader: Any) -> float:
     """Messages per second of a topic over the bag's span (n messages span n - 1 periods)."""
     span_s = reader.duration / 1e9
@@ -1445,8 +1459,7 @@ class BagCamera(PairSource):
                 # frames on both sides and no pair said no why: two cameras stamping with two
                 # clocks (one its own, since boot) are seconds or years apart, which this shows.
                 # Under a second in ms: a 0.3 ms gap to a 0.1 ms max skew was "-0.000 s"
-                gap = firsts[0] - firsts[1]
-                said = f"{gap / 1e9:+.3f} s" if abs(gap) >= 10**9 else f"{gap / 1e6:+.3g} ms"
+                said = _gap_text(firsts[0] - firsts[1])
                 hint = (
                     f"; no left and right stamps within {self.max_skew_ms:.3g} ms of each other: "
                     f"the first left stamp is {said} from the first right one (cameras stamping "
