@@ -1205,6 +1205,13 @@ def test_another_recordings_unfinished_bag_beside_a_split_one_is_left_out(
     other.rename(folder / f"{other.name}.active")
     with BagCamera(folder) as cam:
         assert len(list(cam.frames())) == 10 and cam.dropped == {"left": 0, "right": 0}
+    # beside a ROS 2 bag's storage files without metadata.yaml (read from them) alike
+    ros2 = write_bag(tmp_path / "ros2", [(T0 + k * PERIOD_NS, small[0], T0 + k * PERIOD_NS,
+                                          small[1]) for k in range(7)])  # fmt: skip
+    (ros2 / "metadata.yaml").unlink()
+    (ros2 / f"{other.name}.active").write_bytes((folder / f"{other.name}.active").read_bytes())
+    with BagCamera(ros2) as cam:
+        assert len(list(cam.frames())) == 7
     # the recording's own last piece unfinished: named, not the other recording's file
     own = folder / "rig_2026-12-06-06-00-00_1.bag"
     own.rename(folder / f"{own.name}.active")

@@ -742,13 +742,15 @@ _SPLIT_PIECE = re.compile(r"^(.*)_\d+\.bag(\.active)?$")
 def _active_pieces(folder: Path) -> list[Path]:
     """The ``.bag.active`` files of ``folder`` that are pieces of the recording its ``.bag``
     files hold (``NAME_N.bag`` beside ``NAME_M.bag.active``, ``rosbag record --split``), or all
-    of them when it holds no ``.bag``. Another recording's ``.bag.active`` (one still being
-    recorded into the same folder) is no piece of it: the finished recording was refused for
-    it, though its pieces read whole."""
+    of them when it holds no bag files. Another recording's ``.bag.active`` (one still being
+    recorded into the same folder, beside ``.bag`` pieces or a ROS 2 bag's ``.db3`` / ``.mcap``
+    files) is no piece of it: the finished recording was refused for it, though it reads
+    whole."""
     active = sorted(folder.glob("*.bag.active"))
     finished = sorted(folder.glob("*.bag"))
     if not finished:
-        return active
+        ros2 = any(folder.glob("*.db3")) or any(folder.glob("*.mcap"))
+        return [] if ros2 else active
 
     def name(p: Path) -> str:
         m = _SPLIT_PIECE.match(p.name)
