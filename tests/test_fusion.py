@@ -889,6 +889,51 @@ def test_a_fraction_is_the_confidence_it_stands_for(kind: str) -> None:
     assert out[5, 4] == 12.0 and conf[5, 4] == 0.25 and out[0, 0] == 7.0 and conf[0, 0] == 0.75
 
 
+@pytest.mark.parametrize("kind", ["Fraction", "Decimal", "array"])
+def test_every_fusion_option_reads_a_number_as_the_confidences_do(kind: str) -> None:
+    """08d6931/15d043b read a Fraction or a Decimal as its float for the confidences only:
+    r_spatial, tau_dx, radius, edge_jump, ... refused them ("expected a finite number, got
+    Decimal('1.5')"), so a config read with parse_float=Decimal passed half its keys; and a
+    size-1 array passed the checks but was used raw afterwards, NumPy's bare "only
+    0-dimensional arrays can be converted" for r_spatial, speckle_area and the edge options
+    (in depth_map after every matcher had run). Each option now gives its plain value's
+    result."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    from stereovision.matching.fusion import DEFAULTS, DENSE_DEFAULTS
+
+    def given(v: float) -> Any:
+        if kind == "array":
+            return np.array([v])
+        return Fraction(v) if kind == "Fraction" else Decimal(repr(v))
+
+    sparse = {
+        "hopfield": _m([(5, 5, 10.4), (8, 5, 10.6), (12, 7, 14.0)]),
+        "mcgm": _m([(8, 6, 10.5)]),
+    }
+    want = fuse(_dense(10.0, 0.5), sparse)
+    assert len(want) == 3
+    for name, v in DEFAULTS.items():
+        if name == "mode":
+            continue
+        got = fuse(_dense(10.0, 0.5), sparse, **{name: given(v)})
+        np.testing.assert_array_equal(got.dispx, want.dispx, err_msg=name)
+        np.testing.assert_array_equal(got.count, want.count, err_msg=name)
+    d, c = _dense(5.0, 0.5)
+    d[2:6, 3:9] = np.nan
+    members = np.full((H, W), np.nan, np.float32)
+    members[4, 4] = 12.0
+    second = np.full((H, W), 7.0, np.float32)
+    guide = np.random.default_rng(0).random((H, W)).astype(np.float32)
+    kw: dict[str, Any] = {"second": second, "guide": guide}
+    want_d, want_c = fused_dense(d, c, members, **kw)
+    for name, v in DENSE_DEFAULTS.items():
+        got_d, got_c = fused_dense(d, c, members, **kw, **{name: given(float(v))})
+        np.testing.assert_array_equal(got_d, want_d, err_msg=name)
+        np.testing.assert_array_equal(got_c, want_c, err_msg=name)
+
+
 @pytest.mark.parametrize("name", ["fill_confidence", "second_confidence"])
 @pytest.mark.parametrize("bad", ["0.5", None])
 def test_dense_confidence_that_is_no_number_is_named(name: str, bad: object) -> None:

@@ -257,6 +257,23 @@ def _plain_real(value: Any) -> Any:
     return value
 
 
+def _plain_option(value: Any) -> Any:
+    """An option's number as :func:`fuse` and :func:`fused_dense` use it: a Fraction or a
+    Decimal as its float (:func:`_plain_real`), a size-1 integer or float array as its NumPy
+    scalar (its dtype kept, so a value taken before gives the same result), anything else as
+    it is.
+
+    :func:`finite_number` passes a size-1 array, which ``np.array([3])`` as ``edge_radius``
+    then made NumPy's bare "only 0-dimensional arrays can be converted" after every matcher
+    had run; and only the confidences read a Fraction or a Decimal, which ``r_spatial`` or
+    ``radius`` refused (one config read with ``parse_float=Decimal`` passed half its keys).
+    """
+    value = _plain_real(value)
+    if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
+        return value.reshape(())[()]
+    return value
+
+
 def _fuse_options(
     mode: str,
     r_spatial: Any,
@@ -264,18 +281,20 @@ def _fuse_options(
     tau_dy: Any,
     a_conf_min: Any,
     min_agree: Any,
-) -> tuple[Any, int]:
-    """Check :func:`fuse`'s options (:data:`DEFAULTS`' keys); ``(a_conf_min, min_agree)`` as
-    ``fuse`` uses them. :func:`fuse_pair` and ``depth_map`` check them before the channels run
-    (a bad one was said only after every matcher had run: 0.4 s on cones)."""
+) -> tuple[str, Any, Any, Any, Any, int]:
+    """Check :func:`fuse`'s options (:data:`DEFAULTS`' keys); all of them, in that order, as
+    ``fuse`` uses them (:func:`_plain_option`). :func:`fuse_pair` and ``depth_map`` check them
+    before the channels run (a bad one was said only after every matcher had run: 0.4 s on
+    cones)."""
     if mode not in ("vote", "intersection"):
         raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
+    r_spatial, tau_dx, tau_dy = (_plain_option(v) for v in (r_spatial, tau_dx, tau_dy))
     for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
         if finite_number(v, pname) <= 0:
             raise ValueError(f"{pname}: expected a positive number, got {v}")
     # NaN took no Gabor value without a word (every ``conf >= nan`` is False), a string or None
     # failed in NumPy's comparison naming no parameter
-    a_conf_min = _plain_real(a_conf_min)
+    a_conf_min = _plain_option(a_conf_min)
     if not 0 <= finite_number(a_conf_min, "a_conf_min") <= 1:
         raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
     # a string, None or NaN failed in a comparison or in range(), naming no parameter; a whole
@@ -290,7 +309,7 @@ def _fuse_options(
     min_agree = int(agree)
     if min_agree < 2:
         raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
-    return a_conf_min, min_agree
+    return mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
 
 
 def fuse(
@@ -343,7 +362,10 @@ def fuse(
     for name in sparse:
         if name not in CHANNEL_BITS or name == "gabor":
             raise ValueError(f"unknown sparse channel {name!r}: expected mcgm or hopfield")
-    a_conf_min, min_agree = _fuse_options(mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree)
+    # the checked values, not the raw ones: np.array([1.5]) passed the check and failed below
+    mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree = _fuse_options(
+        mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
+    )
 
     names: list[str] = []
     shape: tuple[int, int] | None = None
@@ -889,10 +911,18 @@ def _dense_options(
     edge_radius: Any,
     edge_ratio: Any,
     edge_jump: Any,
-) -> tuple[Any, Any]:
-    """Check :func:`fused_dense`'s options (:data:`DENSE_DEFAULTS`' keys, in its order);
-    ``(fill_confidence, second_confidence)`` as it uses them. ``depth_map`` checks them before
-    it matches (a bad one was said only after every matcher had run)."""
+) -> tuple[Any, ...]:
+    """Check :func:`fused_dense`'s options (:data:`DENSE_DEFAULTS`' keys, in its order); all
+    of them, in that order, as it uses them (:func:`_plain_option`). ``depth_map`` checks them
+    before it matches (a bad one was said only after every matcher had run)."""
+    radius, tau, fill_radius, fill_confidence, second_tol, second_confidence = (
+        _plain_option(v)
+        for v in (radius, tau, fill_radius, fill_confidence, second_tol, second_confidence)
+    )
+    occlusion_tau, speckle_area, speckle_diff, edge_radius, edge_ratio, edge_jump = (
+        _plain_option(v)
+        for v in (occlusion_tau, speckle_area, speckle_diff, edge_radius, edge_ratio, edge_jump)
+    )
     for name, v in (
         ("radius", radius),
         ("tau", tau),
@@ -911,13 +941,24 @@ def _dense_options(
     # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
     # or every pixel only the census map measured.
     # a string or None failed in the comparison, naming no parameter
-    fill_confidence = _plain_real(fill_confidence)
-    second_confidence = _plain_real(second_confidence)
     if not 0 < finite_number(fill_confidence, "fill_confidence") <= 1:
         raise ValueError(f"fill_confidence: expected a value in (0, 1], got {fill_confidence}")
     if not 0 < finite_number(second_confidence, "second_confidence") <= 1:
         raise ValueError(f"second_confidence: expected a value in (0, 1], got {second_confidence}")
-    return fill_confidence, second_confidence
+    return (
+        radius,
+        tau,
+        fill_radius,
+        fill_confidence,
+        second_tol,
+        second_confidence,
+        occlusion_tau,
+        speckle_area,
+        speckle_diff,
+        edge_radius,
+        edge_ratio,
+        edge_jump,
+    )
 
 
 def fused_dense(
@@ -1004,7 +1045,22 @@ def fused_dense(
     c = _check_map(confidence, "confidence", shape)
     a = _check_map(members, "members", shape)
     b = None if second is None else _check_map(second, "second", shape)
-    fill_confidence, second_confidence = _dense_options(
+    # the checked values, not the raw ones: np.array([3]) as edge_radius passed the check and
+    # failed in int() below
+    (
+        radius,
+        tau,
+        fill_radius,
+        fill_confidence,
+        second_tol,
+        second_confidence,
+        occlusion_tau,
+        speckle_area,
+        speckle_diff,
+        edge_radius,
+        edge_ratio,
+        edge_jump,
+    ) = _dense_options(
         radius,
         tau,
         fill_radius,
