@@ -1293,3 +1293,27 @@ def test_a_bad_fusion_value_is_said_before_the_matching(
     if name in DEFAULTS:
         with pytest.raises(ValueError, match=f"^{name}: expected "):
             fuse_pair(img, img, max_disparity=8, **bad)
+
+
+@pytest.mark.parametrize("channels", [("gabor",), (), "gabor,mcgm"])
+@pytest.mark.parametrize("census_members", [True, False])
+def test_fuse_pair_without_a_sparse_channel_is_refused_before_the_matching(
+    channels: Any, census_members: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """425ec60 refused these before the matching in depth_map only: match(method="fused") and
+    fuse_pair ran every channel (the census map too) before fuse's "at least one sparse
+    channel", () without the census map was ThreadPoolExecutor's "max_workers must be greater
+    than 0", and "gabor,mcgm" was read letter by letter ("unknown channel(s) [',', 'a', ...")."""
+    import stereovision.matching.gabor as gabor_mod
+    import stereovision.matching.sgm as sgm_mod
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    monkeypatch.setattr(gabor_mod, "gabor_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    with pytest.raises(ValueError, match=r"^channels: expected a"):
+        fuse_pair(img, img, max_disparity=8, channels=channels, census_members=census_members)
+    with pytest.raises(ValueError, match=r"^channels: expected a"):
+        sv_match(img, img, method="fused", max_disparity=8, channels=channels)

@@ -557,7 +557,8 @@ def fuse_pair(
     Raises
     ------
     ValueError
-        Bad images, an unknown channel or option.
+        Bad images, an unknown channel or option, a ``channels`` with no sparse channel or
+        given as one string.
     """
     from stereovision._validate import as_gray_float, check_pair
     from stereovision.matching.gabor import gabor_disparity
@@ -568,9 +569,18 @@ def fuse_pair(
     # fuse_pair's own keywords are valid too: a misspelt one lands in params
     own = ["channels", "remeasure_gabor", "check_members", "edge_members", "census_members"]
     refuse_unknown("fusion option", params, [*DEFAULTS, *own, "dense_sgm", "min_disparity"])
+    if isinstance(channels, (str, bytes)):  # "gabor,mcgm" was read letter by letter
+        raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}")
     bad = sorted(set(channels) - set(CHANNEL_BITS))
     if bad:
         raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")
+    if not set(channels) & {"mcgm", "hopfield"}:
+        # fuse refused it only after the channels had run (match(method="fused") on a whole
+        # pair), and () without the census map was ThreadPoolExecutor's "max_workers must be
+        # greater than 0"
+        raise ValueError(
+            f"channels: expected at least one sparse channel (mcgm or hopfield), got {channels!r}"
+        )
     _fuse_options(**{**DEFAULTS, **params})  # before the channels run, not after
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     rng: dict[str, Any] = {"max_disparity": max_disparity, "min_disparity": min_disparity}
