@@ -562,6 +562,8 @@ def test_every_type_error_of_depth_map_is_documented() -> None:
         "return_channels": None,
         "cloud": "yes",
         "semi_global": 1,
+        "check_members": "no",
+        "edge_members": None,
         "max_disparity": "32",
         "min_disparity": True,
         "progress": 3,

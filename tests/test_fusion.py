@@ -1317,3 +1317,35 @@ def test_fuse_pair_without_a_sparse_channel_is_refused_before_the_matching(
         fuse_pair(img, img, max_disparity=8, channels=channels, census_members=census_members)
     with pytest.raises(ValueError, match=r"^channels: expected a"):
         sv_match(img, img, method="fused", max_disparity=8, channels=channels)
+
+
+@pytest.mark.parametrize(
+    "switch", ["remeasure_gabor", "check_members", "edge_members", "census_members", "dense_sgm"]
+)
+@pytest.mark.parametrize("bad", ["no", None, 1])
+def test_a_fuse_pair_switch_that_is_no_bool_is_named(
+    switch: str, bad: object, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """c71ed42 refused depth_map(semi_global="no") (it ran the census map, None skipped it),
+    but fuse_pair's switches, two of which depth_map and match(method="fused") pass on, went
+    unchecked: check_members="no" ran the check and None skipped it without a word. Each is a
+    TypeError naming it now, before any channel runs (depth_map's before the rectification)."""
+    import stereovision.matching.gabor as gabor_mod
+    import stereovision.matching.sgm as sgm_mod
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    monkeypatch.setattr(gabor_mod, "gabor_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    want = f"^{switch}: expected True or False, got {bad!r}$"
+    with pytest.raises(TypeError, match=want):
+        fuse_pair(img, img, max_disparity=8, **{switch: bad})  # type: ignore[arg-type]
+    if switch in ("check_members", "edge_members"):
+        with pytest.raises(TypeError, match=want):
+            sv_match(img, img, method="fused", max_disparity=8, **{switch: bad})
+        stages: list[str] = []
+        with pytest.raises(TypeError, match=want):
+            sv_depth_map(img, img, max_disparity=8, progress=stages.append, **{switch: bad})
+        assert stages == []

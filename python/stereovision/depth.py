@@ -114,10 +114,11 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
             [*fusion.DEFAULTS, *own, *fusion.DENSE_DEFAULTS],
             "stereovision.matching.fusion.DEFAULTS and DENSE_DEFAULTS",
         )
-        semi_global = params.get("semi_global", True)
-        if not isinstance(semi_global, (bool, np.bool_)):
-            # as the other switches: "no" ran the census map, None skipped it
-            raise TypeError(f"semi_global: expected True or False, got {semi_global!r}")
+        for switch in ("semi_global", "check_members", "edge_members"):
+            flag = params.get(switch, True)
+            if not isinstance(flag, (bool, np.bool_)):
+                # as the other switches: "no" ran the census map or the check, None skipped it
+                raise TypeError(f"{switch}: expected True or False, got {flag!r}")
         fusion._fuse_options(**{**fusion.DEFAULTS, **_given(params, fusion.DEFAULTS)})
         if "channels" in params:
             _check_fused_channels(params["channels"])
@@ -1405,9 +1406,10 @@ def depth_map(
         10.0000001).
     TypeError
         A switch that is no bool: ``fill`` or ``refine`` (which also take None),
-        ``return_channels``, ``cloud`` or ``"fused"``'s ``semi_global`` (1 and 0 are refused
-        too); a ``max_disparity`` or ``min_disparity`` that is no number, a ``progress`` that is
-        not callable, or ``calibration=`` given in ``calib``'s place.
+        ``return_channels``, ``cloud`` or ``"fused"``'s ``semi_global``, ``check_members`` or
+        ``edge_members`` (1 and 0 are refused too); a ``max_disparity`` or ``min_disparity``
+        that is no number, a ``progress`` that is not callable, or ``calibration=`` given in
+        ``calib``'s place.
     MemoryError
         With ``method="fused"`` or ``"census"``, before the census semi-global map allocates
         more than the memory available (3 bytes per pixel and disparity level: about 14 GiB for

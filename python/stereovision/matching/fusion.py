@@ -559,6 +559,9 @@ def fuse_pair(
     ValueError
         Bad images, an unknown channel or option, a ``channels`` with no sparse channel or
         given as one string.
+    TypeError
+        A switch (``remeasure_gabor``, ``check_members``, ``edge_members``,
+        ``census_members``, ``dense_sgm``) that is not True or False.
     """
     from stereovision._validate import as_gray_float, check_pair
     from stereovision.matching.gabor import gabor_disparity
@@ -569,6 +572,16 @@ def fuse_pair(
     # fuse_pair's own keywords are valid too: a misspelt one lands in params
     own = ["channels", "remeasure_gabor", "check_members", "edge_members", "census_members"]
     refuse_unknown("fusion option", params, [*DEFAULTS, *own, "dense_sgm", "min_disparity"])
+    for name, flag in (
+        ("remeasure_gabor", remeasure_gabor),
+        ("check_members", check_members),
+        ("edge_members", edge_members),
+        ("census_members", census_members),
+        ("dense_sgm", dense_sgm),
+    ):
+        # as depth_map's switches: "no" (true) ran the check, None (false) skipped it
+        if not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"{name}: expected True or False, got {flag!r}")
     if isinstance(channels, (str, bytes)):  # "gabor,mcgm" was read letter by letter
         raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}")
     bad = sorted(set(channels) - set(CHANNEL_BITS))
