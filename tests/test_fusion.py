@@ -1349,3 +1349,43 @@ def test_a_fuse_pair_switch_that_is_no_bool_is_named(
         with pytest.raises(TypeError, match=want):
             sv_depth_map(img, img, max_disparity=8, progress=stages.append, **{switch: bad})
         assert stages == []
+
+
+@pytest.mark.parametrize(
+    ("channels", "min_agree"),
+    [(("gabor", "mcgm", "hopfield"), 4), (("gabor", "mcgm"), 3), (("mcgm",), 2)],
+)
+def test_a_vote_no_pixel_can_win_is_refused(
+    channels: tuple[str, ...], min_agree: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """min_agree above the channels taking part left range(n, min_agree - 1, -1) empty: fuse
+    returned no member without a word, match(method="fused", channels=("mcgm",)) zero matches
+    at the default min_agree after every channel had run, and depth_map(min_agree=4) a dense
+    map with no member. Each is refused, before any matcher runs; intersection mode (which
+    does not read min_agree) still takes it."""
+    import stereovision.matching.gabor as gabor_mod
+    import stereovision.matching.sgm as sgm_mod
+
+    sparse = {n: _m([(4, 4, 10.0)]) for n in channels if n != "gabor"}
+    dense = _dense(10.0) if "gabor" in channels else None
+    want = rf"^min_agree: {min_agree} channels must agree but {len(channels)} take part"
+    with pytest.raises(ValueError, match=want):
+        fuse(dense, sparse, min_agree=min_agree)
+    assert len(fuse(dense, sparse, min_agree=min_agree, mode="intersection")) == 1
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    monkeypatch.setattr(gabor_mod, "gabor_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    kw: dict[str, Any] = {"channels": channels, "min_agree": min_agree}
+    with pytest.raises(ValueError, match=want):
+        fuse_pair(img, img, max_disparity=8, **kw)
+    with pytest.raises(ValueError, match=want):
+        sv_match(img, img, method="fused", max_disparity=8, **kw)
+    if "gabor" in channels:
+        stages: list[str] = []
+        with pytest.raises(ValueError, match=want):
+            sv_depth_map(img, img, max_disparity=8, progress=stages.append, **kw)
+        assert stages == []

@@ -119,9 +119,13 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
             if not isinstance(flag, (bool, np.bool_)):
                 # as the other switches: "no" ran the census map or the check, None skipped it
                 raise TypeError(f"{switch}: expected True or False, got {flag!r}")
-        fusion._fuse_options(**{**fusion.DEFAULTS, **_given(params, fusion.DEFAULTS)})
+        mode, *_, agree = fusion._fuse_options(
+            **{**fusion.DEFAULTS, **_given(params, fusion.DEFAULTS)}
+        )
         if "channels" in params:
             _check_fused_channels(params["channels"])
+        # fuse_pair's default channels are all three
+        fusion._check_agree(mode, agree, params.get("channels", fusion.CHANNEL_BITS))
     else:
         refuse_unknown(
             "SGM option",

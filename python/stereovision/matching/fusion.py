@@ -22,7 +22,7 @@ import functools
 import itertools
 import numbers
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, TypedDict
@@ -312,6 +312,20 @@ def _fuse_options(
     return mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
 
 
+def _check_agree(mode: str, min_agree: int, channels: Iterable[str]) -> None:
+    """Refuse a vote no pixel can win: ``min_agree`` above the number of ``channels`` taking
+    part. ``range(n, min_agree - 1, -1)`` was then empty and :func:`fuse` returned no member
+    without a word (``min_agree=4`` of three channels; ``match(method="fused",
+    channels=("mcgm",))`` at the default 2), and ``depth_map`` a dense map with no member."""
+    names = [n for n in CHANNEL_BITS if n in set(channels)]
+    if mode == "vote" and min_agree > len(names):
+        raise ValueError(
+            f"min_agree: {min_agree} channels must agree but {len(names)} take part "
+            f"({', '.join(names)}), so no pixel could be a member: give more channels, a "
+            "smaller min_agree or mode='intersection'"
+        )
+
+
 def fuse(
     gabor: tuple[npt.ArrayLike, npt.ArrayLike] | None,
     sparse: Mapping[str, Matches],
@@ -353,7 +367,8 @@ def fuse(
     ValueError
         No sparse channel, an unknown channel name, maps of different sizes, a bad mode, a
         non-positive tolerance, an ``a_conf_min`` that is not a number in ``[0, 1]`` or a
-        ``min_agree`` that is not a whole number of at least 2.
+        ``min_agree`` that is not a whole number of at least 2 or, in vote mode, is more than
+        the channels given.
     """
     if mode not in ("vote", "intersection"):
         raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
@@ -366,6 +381,7 @@ def fuse(
     mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree = _fuse_options(
         mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
     )
+    _check_agree(mode, min_agree, [*sparse, *(["gabor"] if gabor is not None else [])])
 
     names: list[str] = []
     shape: tuple[int, int] | None = None
@@ -558,7 +574,7 @@ def fuse_pair(
     ------
     ValueError
         Bad images, an unknown channel or option, a ``channels`` with no sparse channel or
-        given as one string.
+        given as one string, a ``min_agree`` above the number of ``channels`` in vote mode.
     TypeError
         A switch (``remeasure_gabor``, ``check_members``, ``edge_members``,
         ``census_members``, ``dense_sgm``) that is not True or False.
@@ -594,7 +610,9 @@ def fuse_pair(
         raise ValueError(
             f"channels: expected at least one sparse channel (mcgm or hopfield), got {channels!r}"
         )
-    _fuse_options(**{**DEFAULTS, **params})  # before the channels run, not after
+    # before the channels run, not after
+    mode, *_, min_agree = _fuse_options(**{**DEFAULTS, **params})
+    _check_agree(mode, min_agree, channels)
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     rng: dict[str, Any] = {"max_disparity": max_disparity, "min_disparity": min_disparity}
     runs: dict[str, Callable[..., Any]] = {
