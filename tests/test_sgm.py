@@ -125,9 +125,15 @@ def test_bad_input() -> None:
         sgm_disparity(img, img, max_disparity=8, edge_margin=2**40)
     with pytest.raises(ValueError, match="max_disparity"):
         sgm_disparity(img, img, max_disparity=float("nan"))
-    for paths in (5, True, "3"):
-        with pytest.raises(ValueError, match="paths"):
+    for paths in (5, True, "3", np.array([5]), np.array([True])):
+        with pytest.raises(ValueError, match=r"^paths: expected 8 or 3"):
             sgm_disparity(img, img, max_disparity=8, paths=paths)
+    # a size-1 array is its count, as np.array(3) was (np.array([3]) passed the check and was
+    # NumPy's bare "only 0-dimensional arrays can be converted" in int(), via depth_map too)
+    want = sgm_disparity(img, np.roll(img, -3, axis=1), max_disparity=8, paths=3)
+    for paths in (np.array([3]), np.array(3), np.int64(3)):
+        got = sgm_disparity(img, np.roll(img, -3, axis=1), max_disparity=8, paths=paths)
+        np.testing.assert_array_equal(got, want)
     with pytest.raises(ValueError):
         sgm_disparity(img, img[:, :30], max_disparity=8)
 

@@ -219,7 +219,11 @@ def sgm_disparity(
             f"gamma: {p['gamma']!r} is beyond the kernel's 32-bit float range "
             f"(at most {_F32_MAX:.4g})"
         )
-    if isinstance(p["paths"], bool) or p["paths"] not in (3, 8):
+    if isinstance(p["paths"], np.ndarray) and p["paths"].size == 1:
+        # its value, as np.array(8) was taken: np.array([8]) passed "in (3, 8)" and then
+        # failed in int() as NumPy's "only 0-dimensional arrays can be converted", naming nothing
+        p["paths"] = p["paths"].reshape(())[()]
+    if isinstance(p["paths"], (bool, np.bool_)) or p["paths"] not in (3, 8):
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
