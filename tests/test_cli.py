@@ -2654,6 +2654,35 @@ def test_check_fix_in_a_folder_that_cannot_be_written_is_said_before_the_check(
     assert not any((tmp_path / "ro").iterdir())
 
 
+def test_check_fix_in_a_folder_that_is_a_file_says_so(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """check --fix notes/fixed.yaml, notes a file, said "directory notes does not exist" (it
+    does); now it is named a file, as --plot's folder is, before the check, exit 2."""
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    (tmp_path / "notes").write_text("kept")
+    rig = tmp_path / "notes" / "fixed.yaml"
+    calib = scene / "calib.txt"
+    assert main(["check", *pair, "--calib", str(calib), "--fix", str(rig)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: --fix {rig}: its folder {tmp_path / 'notes'}: is a file, "
+        "not a folder\n"
+    )
+    assert (tmp_path / "notes").read_text() == "kept"
+
+
 def test_rectify_refuses_a_folder_under_a_listed_output_before_the_work(
     data_dir: Path,
     tmp_path: Path,

@@ -963,6 +963,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         if fix.suffix.lower() not in (".yaml", ".yml", ".xml", ".json"):
             raise CliError(f"--fix {args.fix}: use a .yaml, .yml, .xml or .json file name")
         if str(fix.parent) and not fix.parent.is_dir():
+            if fix.parent.exists():  # a file: "does not exist" sent the user looking for it
+                raise CliError(
+                    f"--fix {args.fix}: its folder {fix.parent}: is a file, not a folder"
+                )
             raise FileNotFoundError(f"--fix {args.fix}: directory {fix.parent} does not exist")
         if fix.is_dir():  # else found when the corrected rig is saved, after the work
             raise CliError(f"--fix {args.fix}: is a folder; give a file name")
