@@ -2683,6 +2683,37 @@ def test_check_fix_in_a_folder_that_is_a_file_says_so(
     assert (tmp_path / "notes").read_text() == "kept"
 
 
+def test_check_fix_through_a_link_into_a_missing_folder_is_said_before_the_check(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """check --fix rig.yaml, rig.yaml a link into a folder that is gone: 3094d44 checked the
+    link's own folder only, so the pair was checked and the rig corrected before the save
+    failed; now one line first, exit 2, naming the link and its target's folder."""
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    rig = tmp_path / "rig.yaml"
+    target = tmp_path / "gone" / "rig.yaml"
+    rig.symlink_to(target)
+    calib = scene / "calib.txt"
+    assert main(["check", *pair, "--calib", str(calib), "--fix", str(rig)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: --fix {rig}: its folder {tmp_path}: rig.yaml is a link to "
+        f"{target}; cannot write {target}: directory {tmp_path / 'gone'} does not exist\n"
+    )
+    assert rig.is_symlink() and not (tmp_path / "gone").exists()
+
+
 def test_rectify_refuses_a_folder_under_a_listed_output_before_the_work(
     data_dir: Path,
     tmp_path: Path,

@@ -970,10 +970,12 @@ def cmd_check(args: argparse.Namespace) -> int:
             raise FileNotFoundError(f"--fix {args.fix}: directory {fix.parent} does not exist")
         if fix.is_dir():  # else found when the corrected rig is saved, after the work
             raise CliError(f"--fix {args.fix}: is a folder; give a file name")
-        from stereovision.io import check_output_folder
+        from stereovision.io import check_destinations, check_output_folder
 
         # a folder that cannot be written too: found only after the check and the correction
         check_output_folder(fix.parent, f"--fix {args.fix}: its folder")
+        # and a link, written through, into a missing or unwritable folder: the same
+        check_destinations(fix.parent, [fix.name], f"--fix {args.fix}: its folder")
     inputs = {"the left image": args.left, "the right image": args.right,
               "the calibration": args.calib}  # fmt: skip
     if args.plot:
