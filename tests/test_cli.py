@@ -2714,6 +2714,35 @@ def test_check_fix_through_a_link_into_a_missing_folder_is_said_before_the_check
     assert rig.is_symlink() and not (tmp_path / "gone").exists()
 
 
+def test_check_plot_through_a_link_into_a_missing_folder_is_said_before_the_check(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """check --plot p.png, p.png a link into a folder that is gone: the pair was checked and
+    drawn, then the save failed and the verdict was never printed; now one line first, exit 2."""
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    plot = tmp_path / "p.png"
+    target = tmp_path / "gone" / "p.png"
+    plot.symlink_to(target)
+    assert main(["check", *pair, "--plot", str(plot)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: --plot {plot}: its folder {tmp_path}: p.png is a link to "
+        f"{target}; cannot write {target}: directory {tmp_path / 'gone'} does not exist\n"
+    )
+    assert plot.is_symlink() and not (tmp_path / "gone").exists()
+
+
 def test_rectify_refuses_a_folder_under_a_listed_output_before_the_work(
     data_dir: Path,
     tmp_path: Path,

@@ -987,6 +987,10 @@ def cmd_check(args: argparse.Namespace) -> int:
             raise CliError(f"--plot {args.plot}: is a folder; give a file name")
         plot_dir = Path(args.plot).parent
         check_output_folder(plot_dir, f"--plot {args.plot}: its folder")
+        from stereovision.io import check_destinations
+
+        # a link is written through: its target's folder too (else found after the check)
+        check_destinations(plot_dir, [Path(args.plot).name], f"--plot {args.plot}: its folder")
     if fix is not None:  # the corrected calibration in place of the original lost it
         _refuse_an_input("--fix", fix, inputs)
     raw_left, raw_right = left, right
