@@ -934,6 +934,29 @@ def test_every_fusion_option_reads_a_number_as_the_confidences_do(kind: str) -> 
         np.testing.assert_array_equal(got_c, want_c, err_msg=name)
 
 
+def test_a_fusion_option_of_a_small_integer_dtype_gives_the_plain_numbers_maps() -> None:
+    """0bcf785 kept a size-1 array as the NumPy scalar of its dtype: np.array([16], np.uint8)
+    as r_spatial squared to 0 in uint8 (only the pixel itself searched: MCGM's (8, 6) missed
+    Hopfield's (8, 5)), np.array([1], np.uint8) as speckle_area was NumPy's "Python integer
+    600 out of bounds for uint8". Each now gives the plain number's result."""
+    sparse = {"hopfield": _m([(8, 5, 10.4), (12, 7, 14.0)]), "mcgm": _m([(8, 6, 10.5)])}
+    want = fuse(None, sparse, r_spatial=16)
+    assert len(want) == 2  # (8, 5) and (8, 6), each finding the other
+    for r in (np.array([16], np.uint8), np.uint8(16), np.float64(16.0)):
+        got = fuse(None, sparse, r_spatial=r)
+        np.testing.assert_array_equal(got.dispx, want.dispx, err_msg=repr(r))
+        np.testing.assert_array_equal(got.count, want.count, err_msg=repr(r))
+    d, c = _dense(5.0, 0.5)
+    d[2:4, 3:5] = 9.0  # a 4-pixel region: under 1 x 600 pixels, so dropped
+    members = np.full((H, W), np.nan, np.float32)
+    want_d, want_c = fused_dense(d, c, members, speckle_area=1)
+    assert np.isnan(want_d).all()
+    for a in (np.array([1], np.uint8), np.int8(1)):
+        got_d, got_c = fused_dense(d, c, members, speckle_area=a)
+        np.testing.assert_array_equal(got_d, want_d, err_msg=repr(a))
+        np.testing.assert_array_equal(got_c, want_c, err_msg=repr(a))
+
+
 @pytest.mark.parametrize("name", ["fill_confidence", "second_confidence"])
 @pytest.mark.parametrize("bad", ["0.5", None])
 def test_dense_confidence_that_is_no_number_is_named(name: str, bad: object) -> None:

@@ -259,9 +259,13 @@ def _plain_real(value: Any) -> Any:
 
 def _plain_option(value: Any) -> Any:
     """An option's number as :func:`fuse` and :func:`fused_dense` use it: a Fraction or a
-    Decimal as its float (:func:`_plain_real`), a size-1 integer or float array as its NumPy
-    scalar (its dtype kept, so a value taken before gives the same result), anything else as
-    it is.
+    Decimal as its float (:func:`_plain_real`), a NumPy integer or float scalar or size-1
+    array as the Python int or float of its value, anything else as it is.
+
+    Not the NumPy scalar of its dtype: ``np.array([16], np.uint8)`` as ``r_spatial`` squared
+    to 0 in uint8 (one offset searched instead of 797), ``np.array([1], np.uint8)`` as
+    ``speckle_area`` was NumPy's "Python integer 4800 out of bounds for uint8"; a Python
+    number gives the plain number's maps.
 
     :func:`finite_number` passes a size-1 array, which ``np.array([3])`` as ``edge_radius``
     then made NumPy's bare "only 0-dimensional arrays can be converted" after every matcher
@@ -270,7 +274,9 @@ def _plain_option(value: Any) -> Any:
     """
     value = _plain_real(value)
     if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
-        return value.reshape(())[()]
+        value = value.reshape(())[()]
+    if isinstance(value, (np.integer, np.floating)):
+        return value.item()
     return value
 
 
