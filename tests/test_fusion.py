@@ -1342,6 +1342,24 @@ def test_fuse_pair_without_a_sparse_channel_is_refused_before_the_matching(
         sv_match(img, img, method="fused", max_disparity=8, channels=channels)
 
 
+def test_fuse_pair_reads_channels_given_as_a_generator() -> None:
+    """886da87 read channels three times: a generator was used up by the unknown-name check
+    and then said to hold "no sparse channel" (before it, it ran the census map alone and
+    failed in fuse). It now gives the tuple's result; a channels that is no collection of
+    names is a ValueError naming it."""
+    rng = np.random.default_rng(1)
+    left = rng.random((40, 60)).astype(np.float32)
+    right = np.roll(left, -3, axis=1)
+    kw: dict[str, Any] = {"max_disparity": 8, "census_members": False, "check_members": False}
+    want = fuse_pair(left, right, channels=("mcgm", "hopfield"), **kw)
+    assert len(want) > 0
+    got = fuse_pair(left, right, channels=(c for c in ("mcgm", "hopfield")), **kw)
+    np.testing.assert_array_equal(got.dispx, want.dispx)
+    np.testing.assert_array_equal(got.sources, want.sources)
+    with pytest.raises(ValueError, match=r"^channels: expected a tuple of channel names"):
+        fuse_pair(left, right, channels=None, **kw)
+
+
 @pytest.mark.parametrize(
     "switch", ["remeasure_gabor", "check_members", "edge_members", "census_members", "dense_sgm"]
 )

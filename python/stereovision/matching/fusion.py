@@ -606,6 +606,11 @@ def fuse_pair(
             raise TypeError(f"{name}: expected True or False, got {flag!r}")
     if isinstance(channels, (str, bytes)):  # "gabor,mcgm" was read letter by letter
         raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}")
+    # once: a generator was used up by the first check, then said to hold no sparse channel
+    try:
+        channels = tuple(channels)
+    except TypeError:
+        raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}") from None
     bad = sorted(set(channels) - set(CHANNEL_BITS))
     if bad:
         raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")
