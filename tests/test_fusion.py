@@ -1360,6 +1360,28 @@ def test_fuse_pair_reads_channels_given_as_a_generator() -> None:
         fuse_pair(left, right, channels=None, **kw)
 
 
+@pytest.mark.parametrize("channels", [(["mcgm"],), ("gabor", 1, "x")])
+def test_fuse_pair_names_channels_that_are_no_names(
+    channels: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """fuse_pair checked the names with sorted(set(channels)): a list among them was Python's
+    bare "unhashable type: 'list'", a number beside a name "'<' not supported between
+    instances of 'str' and 'int'" (from match(method="fused") too). Each is now the unknown
+    channel ValueError, before any matcher runs."""
+    import stereovision.matching.sgm as sgm_mod
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    with pytest.raises(ValueError, match=r"^unknown channel\(s\) \[") as info:
+        fuse_pair(img, img, max_disparity=8, channels=channels)
+    assert "'gabor'" not in str(info.value).split(":")[0]
+    with pytest.raises(ValueError, match=r"^unknown channel\(s\) \["):
+        sv_match(img, img, method="fused", max_disparity=8, channels=channels)
+
+
 @pytest.mark.parametrize(
     "switch", ["remeasure_gabor", "check_members", "edge_members", "census_members", "dense_sgm"]
 )

@@ -611,9 +611,15 @@ def fuse_pair(
         channels = tuple(channels)
     except TypeError:
         raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}") from None
-    bad = sorted(set(channels) - set(CHANNEL_BITS))
+    # no set() or sorted() of the raw entries: a list among them was "unhashable type", a
+    # number beside a name "'<' not supported", naming nothing
+    bad: list[Any] = []
+    for c in channels:
+        if (not isinstance(c, str) or c not in CHANNEL_BITS) and c not in bad:
+            bad.append(c)
     if bad:
-        raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")
+        shown = sorted(bad, key=repr)
+        raise ValueError(f"unknown channel(s) {shown}: expected {sorted(CHANNEL_BITS)}")
     if not set(channels) & {"mcgm", "hopfield"}:
         # fuse refused it only after the channels had run (match(method="fused") on a whole
         # pair), and () without the census map was ThreadPoolExecutor's "max_workers must be
