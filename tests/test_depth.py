@@ -1250,6 +1250,16 @@ def test_a_hand_made_result_prints_its_depth_range_and_counts_a_zero_confidence_
     assert counts == {"pixels": 6, "disparity": 5, "depth": 3, "filled": 1, "dropped": 1}
 
 
+def test_a_result_prints_depths_past_999_5_m_in_whole_metres() -> None:
+    """``.3g`` said a depth of 2000 m as "2e+03 m"; past 999.5 it is whole metres, as the CLI's
+    ``depth`` summary and the overview's labels say it (below, three digits as before)."""
+    r = _hand_result()
+    far = dataclasses.replace(r, depth=r.depth * np.float32(400))  # 400, 800 and 2000 m
+    assert "; depth 400-2000 m (median 800 m) on 50.0 %; 0 points" in repr(far)
+    near = dataclasses.replace(r, depth=r.depth * np.float32(199.9))  # 999.5 m: whole
+    assert "; depth 200-1000 m (median 400 m) on 50.0 %" in repr(near)
+
+
 def test_depth_uses_doffs_and_points_use_fx_and_fy_and_rgb_colours() -> None:
     h, w, d = 96, 160, 6.5
     tex = _texture(h, w)

@@ -905,6 +905,12 @@ def pixels_shown(value: float) -> str:
     return too_large_for_float(value, why=False) or f"{value:.12g}"
 
 
+def figure_shown(value: float) -> str:
+    """A measured figure (a depth, a bar label) for a message: three significant digits, whole
+    units from 999.5 on, where ``.3g`` switched to exponent form ("2.27e+03 mm", "1e+03")."""
+    return f"{value:.3g}" if abs(value) < 999.5 else f"{value:.0f}"
+
+
 def unreachable_range(min_disparity: float, max_disparity: float, width: int) -> ValueError | None:
     """The error of a range no pixel of a ``width`` px wide pair can match in, or None.
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated, raise_terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import advice_for, first_line, internal_error
+from stereovision._validate import advice_for, figure_shown, first_line, internal_error
 
 EXIT_ERROR = 2
 EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
@@ -863,14 +863,8 @@ def _depth_range(depth: np.ndarray, unit: str) -> str:
     z = depth[np.isfinite(depth)] / UNIT_TO_METRES[unit]
     if not z.size:
         return "no depth"
-    lo, hi, mid = (_figure(float(v)) for v in (z.min(), z.max(), np.median(z)))
+    lo, hi, mid = (figure_shown(float(v)) for v in (z.min(), z.max(), np.median(z)))
     return f"depth {lo}-{hi} {unit} (median {mid} {unit})"
-
-
-def _figure(value: float) -> str:
-    """Three significant digits, whole units from 999.5 on: ``.3g`` wrote those in exponent
-    form (``--unit mm``: "depth 2.27e+03-2.92e+05 mm")."""
-    return f"{value:.3g}" if abs(value) < 999.5 else f"{value:.0f}"
 
 
 def _ground_outputs(

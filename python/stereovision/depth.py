@@ -32,6 +32,7 @@ from stereovision._validate import (
     as_gray_float,
     check_pair,
     crop_or_pad_hint,
+    figure_shown,
     finite_number,
     known_unit,
     pair_shape_error,
@@ -700,12 +701,13 @@ class DepthResult:
         ]
         if self.depth is not None:
             z = self.depth[np.isfinite(self.depth)]
-            parts.append(
-                f"depth {float(z.min()):.3g}-{float(z.max()):.3g} m (median "
-                f"{float(np.median(z)):.3g} m) on {100 * z.size / self.depth.size:.1f} %"
-                if z.size
-                else "no depth"
-            )
+            if z.size:
+                # whole metres from 999.5 m, as the CLI's summary: ".3g" said "2e+03 m"
+                lo, hi, mid = (figure_shown(float(v)) for v in (z.min(), z.max(), np.median(z)))
+                share = 100 * z.size / self.depth.size
+                parts.append(f"depth {lo}-{hi} m (median {mid} m) on {share:.1f} %")
+            else:
+                parts.append("no depth")
             parts.append(f"{len(self.points)} points")
         else:
             parts.append("no calibration: no depth")

@@ -23,6 +23,8 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import figure_shown
+
 #: Widest panel (px); a larger image is downscaled by one factor for every panel.
 PANEL_WIDTH = 640
 
@@ -145,11 +147,6 @@ class Overview:
     caption_boxes: dict[str, tuple[int, int, int, int]] = field(default_factory=dict)
 
 
-def _label(value: float) -> str:
-    # 999.5 and over: ``.3g`` rounds them to 1000 and writes "1e+03"
-    return f"{value:.3g}" if abs(value) < 999.5 else f"{value:.0f}"
-
-
 def _nice_values(lo: float, hi: float) -> list[float]:
     """1-2-5 steps of every decade between ``lo`` and ``hi`` (both > 0), ascending."""
     out: list[float] = []
@@ -217,7 +214,7 @@ def _place_ticks(
     for value, ty in sorted(inner, key=lambda t: t[1]):
         if ty - last_y < _TICK_SPACING or bottom - ty < _TICK_SPACING:
             continue
-        text = _label(value)
+        text = figure_shown(value)
         _, y0, _, y1 = _text_box(text, 0, ty)
         if any(y0 - _END_GAP < e1 and e0 < y1 + _END_GAP for _, e0, _, e1 in end_boxes):
             continue
@@ -258,7 +255,7 @@ def _bar(
 
 def _end_label(value: float, unit: str) -> str:
     """An end of a bar: its value as the ticks print theirs, and the unit (``"52.3 px"``)."""
-    return f"{_label(value)} {unit}" if unit else _label(value)
+    return f"{figure_shown(value)} {unit}" if unit else figure_shown(value)
 
 
 def cv2_text(text: str) -> str:
