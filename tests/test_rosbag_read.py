@@ -1120,6 +1120,22 @@ def test_the_no_pair_gap_is_never_said_in_exponent_form(cones: Any, tmp_path: Pa
         assert f": the first left stamp is {said} from the first right one (" in str(caught.value)
 
 
+def test_the_max_skew_is_never_said_in_exponent_form(cones: Any, tmp_path: Path) -> None:
+    """The no-pair error and ``describe`` said a max skew with ``.3g``: 1500 ms read "within
+    1.5e+03 ms" and 5e-06 ms "5e-06 ms". They are said as the gap is (``_gap_text``)."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    gap = 2 * 10**9
+    frames = [(T0 + k * PERIOD_NS + gap, small[0], T0 + k * PERIOD_NS, small[1])
+              for k in range(10)]  # fmt: skip
+    bag = write_bag(tmp_path / "far", frames)
+    for skew, said in ((1500, "1.500 s"), (5e-06, "5 ns"), (250, "250 ms")):
+        with BagCamera(bag, max_skew_ms=skew) as cam:
+            assert cam.describe().endswith(f"; max skew {said}")
+            with pytest.raises(SourceError) as caught:
+                cam.read()
+        assert f"; no left and right stamps within {said} of each other: " in str(caught.value)
+
+
 def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

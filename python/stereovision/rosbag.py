@@ -975,6 +975,14 @@ def _gap_text(gap_ns: int) -> str:
     return (text.rstrip("0").rstrip(".") if "." in text else text) + " ms"
 
 
+def _skew_text(tol_ns: float) -> str:
+    """The pairing tolerance as :func:`_gap_text` says a gap, without its sign: ``.3g`` said
+    a max skew of 1500 ms as "1.5e+03 ms" (now "1.500 s") and 5 ns as "5e-06 ms" (now "5 ns")."""
+    if not math.isfinite(tol_ns):  # the default of a bag without two stamps on a side
+        return f"{tol_ns} ms"
+    return _gap_text(round(tol_ns)).removeprefix("+")
+
+
 def _rate(count: int, reader: Any) -> float:
     """Messages per second of a topic over the bag's span (n messages span n - 1 periods)."""
     span_s = reader.duration / 1e9
@@ -1458,12 +1466,13 @@ class BagCamera(PairSource):
             firsts = self._first["left"][:1] + self._first["right"][:1]
             hint = ""
             if self.count == 0 and len(firsts) == 2:
+                tol = self._tol_ns if self._tol_ns is not None else math.inf
                 # frames on both sides and no pair said no why: two cameras stamping with two
                 # clocks (one its own, since boot) are seconds or years apart, which this shows.
                 # Under a second in ms: a 0.3 ms gap to a 0.1 ms max skew was "-0.000 s"
                 said = _gap_text(firsts[0] - firsts[1])
                 hint = (
-                    f"; no left and right stamps within {self.max_skew_ms:.3g} ms of each other: "
+                    f"; no left and right stamps within {_skew_text(tol)} of each other: "
                     f"the first left stamp is {said} from the first right one (cameras stamping "
                     "with different clocks?)"
                 )
@@ -1562,8 +1571,8 @@ class BagCamera(PairSource):
 
     def describe(self) -> str:
         """One line: the bag, its two topics with their size and rate, the pairing tolerance."""
-        tol = self.max_skew_ms
-        skew = "max skew: auto" if tol is None else f"max skew {tol:.3g} ms"
+        tol = self._tol_ns
+        skew = "max skew: auto" if tol is None else f"max skew {_skew_text(tol)}"
         return f"bag {self.path}; " + self._delivered(self.topics) + f"; {skew}"
 
     def summary(self) -> str:
