@@ -1998,6 +1998,30 @@ def test_a_resized_pair_keeps_the_recorded_frames_and_describe_says_the_toleranc
         assert cam.read().delivered is None
 
 
+@pytest.mark.parametrize("encoding", ["bgr8", "png"])
+def test_capture_from_bag_says_the_recorded_size_before_the_first_pair(
+    encoding: str, cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """``capture --from-bag``'s header is said before the first read, and said the image size
+    as "? @ 30 fps"; it is the first recorded frames' (a raw Image's fields, a compressed one
+    decoded), as a camera's is read back once opened. A topic without a frame leaves it out."""
+    small = cones.left[:48, :64], cones.right[:24, :32]
+    frames = [(T0 + k * PERIOD_NS, small[0], T0 + k * PERIOD_NS, small[1]) for k in range(3)]
+    bag = write_bag(tmp_path / "rig", frames, encoding=encoding)
+    with BagCamera(bag) as cam:
+        said = cam.describe()
+        assert f"; left {LEFT}: 64x48 @ 30 fps; right {RIGHT}: 32x24 @ 30 fps; " in said
+        assert cam.delivered_size == {}  # nothing delivered yet
+    code, out, err = run("capture", "--from-bag", str(bag), "-o", str(tmp_path / "pairs"))
+    assert code == 0, err
+    assert out.splitlines()[0] == (
+        f"bag {bag}; left {LEFT}: 64x48 @ 30 fps; right {RIGHT}: 32x24 @ 30 fps; max skew: auto"
+    )
+    with BagCamera(bag) as cam:
+        cam.topics = {"left": LEFT, "right": "/no/such/topic"}
+        assert "; right /no/such/topic: 30 fps; " in cam.describe()
+
+
 @PIPELINED
 def test_the_size_warnings_of_a_bag_point_at_the_callers_line(cones: Any, tmp_path: Path) -> None:
     """The dropped-size and resized-topic warnings had ``stacklevel=4``, right through

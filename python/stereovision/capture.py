@@ -1387,15 +1387,21 @@ class PairSource:
     delivered_size: dict[str, tuple[int, int]]
     delivered_fps: dict[str, float]
 
-    def _delivered(self, names: dict[str, str]) -> str:
-        """``left NAME: WxH @ F fps; right ...``: what each side delivered."""
+    def _delivered(
+        self, names: dict[str, str], sizes: dict[str, tuple[int, int]] | None = None
+    ) -> str:
+        """``left NAME: WxH @ F fps; right ...``: what each side delivered (``sizes``, by
+        default :attr:`delivered_size`). A size not known is left out (it was said "?")."""
+        sizes = self.delivered_size if sizes is None else sizes
         parts = []
         for side in ("left", "right"):
-            d = self.delivered_size.get(side)
-            got = f"{d[0]}x{d[1]}" if d else "?"
+            d = sizes.get(side)
             fps = self.delivered_fps.get(side, 0.0)
-            rate = f"@ {fps:.3g} fps" if fps > 0 else f"({_rate_words(fps)})"
-            parts.append(f"{side} {names[side]}: {got} {rate}")
+            if d:
+                rate = f"@ {fps:.3g} fps" if fps > 0 else f"({_rate_words(fps)})"
+                parts.append(f"{side} {names[side]}: {d[0]}x{d[1]} {rate}")
+            else:
+                parts.append(f"{side} {names[side]}: {_rate_words(fps)}")
         return "; ".join(parts)
 
     def read(self) -> StereoFrame:

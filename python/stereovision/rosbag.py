@@ -1573,7 +1573,35 @@ class BagCamera(PairSource):
         """One line: the bag, its two topics with their size and rate, the pairing tolerance."""
         tol = self._tol_ns
         skew = "max skew: auto" if tol is None else f"max skew {_skew_text(tol)}"
-        return f"bag {self.path}; " + self._delivered(self.topics) + f"; {skew}"
+        # before the first read (capture's header) the sizes are the first recorded frames':
+        # they were said "?", though a camera's or a file's are known once opened
+        sizes = dict(self.delivered_size)
+        for side in ("left", "right"):
+            if side not in sizes and (size := self._first_size(side)) is not None:
+                sizes[side] = size
+        return f"bag {self.path}; " + self._delivered(self.topics, sizes) + f"; {skew}"
+
+    def _first_size(self, side: str) -> tuple[int, int] | None:
+        """``(width, height)`` of the first frame of ``side``'s topic as recorded; None when
+        the bag is closed, the topic holds none or its first message cannot be read (the
+        reading then says why)."""
+        if self._reader is None:
+            return None
+        conns = [c for c in self._reader.connections if c.topic == self.topics[side]]
+        if not conns:  # (no connections would read every topic's messages)
+            return None
+        messages = self._reader.messages(connections=conns)
+        try:
+            conn, _, raw = next(messages)
+            msg = self._reader.deserialize(raw, conn.msgtype)
+            if not hasattr(msg, "format"):  # a raw Image says its size, no decoding needed
+                return (int(msg.width), int(msg.height)) if msg.width and msg.height else None
+            h, w = decode_image(msg).shape[:2]
+            return (w, h)
+        except Exception:  # rosbags' errors name no common base class; read() says them
+            return None
+        finally:
+            messages.close()
 
     def summary(self) -> str:
         """The bag's topics (type, messages, rate), which are the left and right images and
