@@ -1290,6 +1290,17 @@ def test_a_pfm_is_no_image(tmp_path: Path, channels: int) -> None:
     )
 
 
+def test_a_file_starting_pf_without_a_separator_is_not_called_a_pfm(tmp_path: Path) -> None:
+    """A PFM header is ``Pf`` or ``PF`` and a whitespace character: a text file that merely
+    starts with the letters (``PFX notes``) is not said to be a disparity map."""
+    for text in (b"PFX notes\n", b"Pf"):
+        path = tmp_path / "notes.png"
+        path.write_bytes(text)
+        with pytest.raises(ValueError, match=r"^cannot decode .*notes\.png as an image") as info:
+            imread(path)
+        assert "PFM" not in str(info.value)
+
+
 def test_a_video_is_named_whatever_the_case_of_its_suffix(tmp_path: Path) -> None:
     for name, says in (("CLIP.AVI", "it is a video"), ("run.Bag", "it is a ROS bag")):
         (tmp_path / name).write_bytes(b"\x00" * 64)

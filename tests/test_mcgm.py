@@ -873,6 +873,19 @@ def test_matches_repr_summarises_the_finite_values_and_counts_the_others() -> No
     assert repr(nothing) == "Matches(1 matches in 30x8; no finite disparity; no finite score)"
 
 
+def test_matches_repr_leaves_out_infinities_and_counts_each_field_apart() -> None:
+    """An infinite position is no finite disparity (a range to inf said nothing), and the
+    disparity's and the score's counts of values left out are each their own."""
+    m = sv.Matches(
+        xl=[11.0, np.inf, 12.0, -np.inf, 19.0], yl=[1.0] * 5, xr=[10.0] * 5, yr=[1.0] * 5,
+        score=[0.5, 0.6, np.inf, 0.7, 1.0], image_shape=(8, 30),
+    )  # fmt: skip
+    assert repr(m) == (
+        "Matches(5 matches in 30x8; disparity 1.00-9.00 px (median 2.00), 2 not finite; "
+        "score 0.5-1, 1 not finite)"
+    )
+
+
 def test_save_csv_that_fails_leaves_the_old_file_and_no_temporary(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
