@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
 import math
 import os
 import re
@@ -1956,6 +1957,33 @@ def test_a_stray_point_does_not_widen_the_view_of_a_cloud():
     # a cloud inside 60 degrees keeps them with a stray too
     narrow = np.vstack([pts * [0.5, 0.5, 1.0], [[100.0, 0.0, 10.0]]])
     assert fov(narrow) == pytest.approx(render.DEFAULT_FOV_DEG)
+
+
+def test_points_beside_or_behind_the_camera_do_not_widen_the_view_of_a_cloud():
+    """Only the points ahead (Z > 0) are fitted, as documented: a point in the camera's own
+    plane (Z = 0: an infinite angle, which no view brings in) counted in a small cloud's
+    percentile widened its view to MAX_FIT_FOV_DEG; a point behind it is left out too."""
+    rng = np.random.default_rng(3)
+    ahead = rng.uniform([-1.0, -1.0, 5.0], [1.0, 1.0, 6.0], (799, 3))  # well inside 60 degrees
+    for extra in ([1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [3.0, 3.0, -1.0]):
+        intr = render.cloud_view_intrinsics(np.vstack([ahead, [extra]]))
+        fov = math.degrees(2 * math.atan(300 / intr.f))
+        assert fov == pytest.approx(render.DEFAULT_FOV_DEG), extra
+
+
+def test_the_view_of_a_cloud_reaching_out_on_one_side_only_is_widened_for_it():
+    """The fit takes the points' angles either way off the axis: a cloud reaching out to the
+    left only, or below the axis only (a ground plane), is widened as one reaching right or up
+    is, and all of it but FIT_PERCENTILE's few (0.1 %) is in the picture."""
+    rng = np.random.default_rng(5)
+    wide = rng.uniform([0.0, 0.0, 5.0], [6.0, 1.0, 6.0], (2000, 3))  # past 37.5 degrees across
+    tall = rng.uniform([0.0, 0.0, 5.0], [1.0, 4.0, 6.0], (2000, 3))  # past 30 degrees down
+    for base, sign in itertools.product((wide, tall), ([1, 1, 1], [-1, 1, 1], [1, -1, 1])):
+        pts = base * sign
+        intr = render.cloud_view_intrinsics(pts)
+        assert math.degrees(2 * math.atan(300 / intr.f)) > render.DEFAULT_FOV_DEG + 5, sign
+        seen = render.points_in_view(pts, CameraControls(), (800, 600), intr)
+        assert seen >= len(pts) * render.FIT_PERCENTILE / 100, sign
 
 
 def test_a_cloud_millimetres_away_is_not_clipped_whole():
