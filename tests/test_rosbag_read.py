@@ -162,6 +162,12 @@ def test_compressed_images(cones: Any) -> None:
     _ok, jpg = cv2.imencode(".jpg", cv2.cvtColor(cones.left, cv2.COLOR_BGR2GRAY))
     assert decode_image(_Msg(format="mono8; jpeg compressed mono8", data=jpg.reshape(-1))).shape \
         == cones.left.shape  # fmt: skip
+    # only a one-channel encoding's conversion (a Bayer pattern's) is applied to a grey
+    # picture: one a colour format names (rgb8, yuv422) is grey, not cv2.cvtColor's error
+    grey = cv2.imdecode(jpg, cv2.IMREAD_GRAYSCALE)
+    for fmt in ("rgb8; jpeg compressed bgr8", "yuv422; jpeg compressed bgr8"):
+        out = decode_image(_Msg(format=fmt, data=jpg.reshape(-1)))
+        np.testing.assert_array_equal(out, cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR))
     with pytest.raises(ValueError, match="depth image"):
         decode_image(_Msg(format="16UC1; compressedDepth png", data=png.reshape(-1)))
     with pytest.raises(ValueError, match="does not decode"):
@@ -1105,6 +1111,13 @@ def test_a_bag_without_a_pair_says_how_far_apart_the_topics_stamps_are(
         "no left and right stamps within 0.1 ms of each other: the first left stamp is -0.3 ms "
         "from the first right one (cameras stamping with different clocks?)"
     )
+    # a gap of a second and more in seconds, from exactly 1 s (not "-1e+03 ms")
+    frames = [(T0 + k * PERIOD_NS, small[0], T0 + k * PERIOD_NS + 10**9, small[1])
+              for k in range(10)]  # fmt: skip
+    bag = write_bag(tmp_path / "second", frames)
+    with BagCamera(bag) as cam, pytest.raises(SourceError) as caught:
+        cam.read()
+    assert "the first left stamp is -1.000 s from the first right one" in str(caught.value)
 
 
 def test_the_no_pair_gap_is_never_said_in_exponent_form(cones: Any, tmp_path: Path) -> None:
@@ -1198,6 +1211,12 @@ def test_a_split_ros1_recording_whose_last_piece_is_unfinished_is_said(
     active.rename(split / "rig_2.bag")
     with BagCamera(split) as cam:
         assert len(list(cam.frames())) == 15
+    # a ROS 2 bag folder is read by its metadata.yaml: a stray .bag.active in it is not its
+    # recording (not refused as one)
+    ros2 = write_bag(tmp_path / "ros2", [(T0, small[0], T0, small[1])])
+    (ros2 / active.name).write_bytes((split / "rig_2.bag").read_bytes())
+    with BagCamera(ros2) as cam:
+        assert len(list(cam.frames())) == 1
 
 
 def test_another_recordings_unfinished_bag_beside_a_split_one_is_left_out(
