@@ -530,10 +530,13 @@ def test_fused_channels_without_the_gabor_channel_are_named() -> None:
     """depth_map(method="fused") takes fuse_pair's channels (c9f1031 named it), but its dense
     map is the Gabor map's: without "gabor" it failed as a bare KeyError 'gabor' after every
     channel had run, with no sparse one after them too, and "gabor,mcgm" was read letter by
-    letter. Each is refused before the rectification; a tuple, list or array of names works."""
+    letter. Each is refused before the rectification; a tuple, list or array of names works.
+    A one-pass iterator of names is refused too: its check would use it up before the run."""
     img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
     right = np.roll(img, -3, axis=1)
-    for bad in (("mcgm", "hopfield"), ("gabor",), "gabor,mcgm", ("gabor", "mcgm", "sgm"), [[1]]):
+    once = iter(("gabor", "mcgm"))
+    for bad in (("mcgm", "hopfield"), ("gabor",), "gabor,mcgm", ("gabor", "mcgm", "sgm"), [[1]],
+                once):  # fmt: skip
         stages: list[str] = []
         with pytest.raises(
             ValueError, match=r"^channels: depth_map\(method='fused'\) needs 'gabor'"

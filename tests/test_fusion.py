@@ -957,6 +957,23 @@ def test_a_fusion_option_of_a_small_integer_dtype_gives_the_plain_numbers_maps()
         np.testing.assert_array_equal(got_c, want_c, err_msg=repr(a))
 
 
+def test_a_fraction_or_decimal_no_float_holds_is_refused_by_its_name() -> None:
+    """A Fraction past a float's range (or a signalling Decimal NaN, which float() refuses) is
+    left as given for the check, which names the parameter: it is not read as some other
+    value and fused with."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    hop = {"hopfield": _m([(5, 5, 10.0)])}
+    for bad in (Fraction(10**400), -Fraction(10**400), Decimal("sNaN")):
+        with pytest.raises(ValueError, match=r"^a_conf_min: expected a finite number"):
+            fuse(_dense(10.0, 0.25), hop, a_conf_min=bad)  # type: ignore[arg-type]
+    d = np.full((H, W), np.nan, np.float32)
+    for name in ("fill_confidence", "second_confidence"):
+        with pytest.raises(ValueError, match=f"^{name}: expected a finite number"):
+            fused_dense(d, d, d, **{name: Fraction(10**400)})
+
+
 @pytest.mark.parametrize("name", ["fill_confidence", "second_confidence"])
 @pytest.mark.parametrize("bad", ["0.5", None])
 def test_dense_confidence_that_is_no_number_is_named(name: str, bad: object) -> None:

@@ -1163,9 +1163,12 @@ def test_a_ros1_recording_left_unfinished_is_said_with_its_remedy(
     active = tmp_path / "rig.bag.active"
     active.write_bytes(bytes(data))
     bag.unlink()
-    from stereovision.rosbag import is_bag
+    from stereovision.rosbag import bag_topics, is_bag
 
     assert is_bag(active)
+    # said as it is, not wrapped as "not a readable ROS 1 or ROS 2 bag"
+    with pytest.raises(ValueError, match=r"^\S*rig\.bag\.active is a ROS 1 recording left unf"):
+        bag_topics(active)
     said = (
         f"stereovision: error: {active} is a ROS 1 recording left unfinished (its recorder "
         f"stopped before writing the index): `rosbag reindex {active}` indexes it; then rename "
