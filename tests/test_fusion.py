@@ -1400,6 +1400,33 @@ def test_fuse_pair_names_channels_that_are_no_names(
 
 
 @pytest.mark.parametrize(
+    ("channels", "arrays"),
+    [
+        ((np.array(["mcgm", "gabor"]), "x"), 1),
+        (np.array([["mcgm", "gabor"], ["hopfield", "gabor"]]), 2),
+        ((np.array([1, 2]), np.array([3, 4])), 2),
+    ],
+)
+def test_fuse_pair_names_channels_that_are_arrays(
+    channels: Any, arrays: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """482acc9's name check compared each entry with those already found (``c not in bad``):
+    an array entry beside another non-name was NumPy's "The truth value of an array with more
+    than one element is ambiguous", naming nothing. Each is now the unknown channel error,
+    before any matcher runs."""
+    import stereovision.matching.sgm as sgm_mod
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    with pytest.raises(ValueError, match=r"^unknown channel\(s\) \[") as info:
+        fuse_pair(img, img, max_disparity=8, channels=channels)
+    assert str(info.value).count("array(") == arrays  # each entry said once
+
+
+@pytest.mark.parametrize(
     "switch", ["remeasure_gabor", "check_members", "edge_members", "census_members", "dense_sgm"]
 )
 @pytest.mark.parametrize("bad", ["no", None, 1])

@@ -613,9 +613,13 @@ def fuse_pair(
         raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}") from None
     # no set() or sorted() of the raw entries: a list among them was "unhashable type", a
     # number beside a name "'<' not supported", naming nothing
+    # told apart by repr: ``c not in bad`` compared an array entry with == ("truth value of
+    # an array ... is ambiguous", naming nothing)
     bad: list[Any] = []
+    seen: set[str] = set()
     for c in channels:
-        if (not isinstance(c, str) or c not in CHANNEL_BITS) and c not in bad:
+        if (not isinstance(c, str) or c not in CHANNEL_BITS) and repr(c) not in seen:
+            seen.add(repr(c))
             bad.append(c)
     if bad:
         shown = sorted(bad, key=repr)
