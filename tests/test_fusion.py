@@ -974,6 +974,21 @@ def test_a_fraction_or_decimal_no_float_holds_is_refused_by_its_name() -> None:
             fused_dense(d, d, d, **{name: Fraction(10**400)})
 
 
+@pytest.mark.parametrize("given", [np.timedelta64(16), np.timedelta64(16, "ns")])
+def test_a_fusion_option_given_as_a_timedelta_is_refused(given: Any) -> None:
+    """db08e0d read every np.integer with item(), and np.timedelta64 is one: 16 ns (or a
+    timedelta without unit) became the int 16 and was taken as r_spatial=16 (or speckle_area),
+    where it was refused as no number before. It is refused again, the value named as given."""
+    sparse = {"hopfield": _m([(8, 5, 10.4)]), "mcgm": _m([(8, 6, 10.5)])}
+    with pytest.raises(ValueError, match=r"^r_spatial: expected a finite number, got ") as info:
+        fuse(None, sparse, r_spatial=given)
+    assert repr(given) in str(info.value)
+    d, c = _dense(5.0, 0.5)
+    members = np.full((H, W), np.nan, np.float32)
+    with pytest.raises(ValueError, match=r"^speckle_area: expected a finite number, got "):
+        fused_dense(d, c, members, speckle_area=given)
+
+
 @pytest.mark.parametrize("name", ["fill_confidence", "second_confidence"])
 @pytest.mark.parametrize("bad", ["0.5", None])
 def test_dense_confidence_that_is_no_number_is_named(name: str, bad: object) -> None:

@@ -675,3 +675,15 @@ def test_real_array_reads_an_object_array_of_real_numbers_only() -> None:
         None,
     ):
         assert _real_array(bad) is None, bad
+
+
+@pytest.mark.parametrize("value", [np.timedelta64(16), np.timedelta64(16, "ns")])
+def test_a_timedelta_scalar_is_no_number(value: np.timedelta64) -> None:
+    """np.timedelta64 is an np.integer, so finite_number and positive_finite took 16 ns as the
+    number 16, where an array of timedeltas was refused as no number. The scalar is too."""
+    from stereovision._validate import finite_number, positive_finite
+
+    with pytest.raises(ValueError, match=r"^blur: expected a finite number, got np\.timedelta64"):
+        finite_number(value, "blur")
+    with pytest.raises(ValueError, match=r"^f: expected a positive finite number, got "):
+        positive_finite(value, "f")

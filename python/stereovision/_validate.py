@@ -674,7 +674,11 @@ def _real_scalar(value: object) -> float:
     array); a TypeError otherwise (a bool, a string, a list: a slider's ``[1.0]`` is no
     number). One rule for :func:`positive_finite` and :func:`finite_number` (the second refused
     ``np.array(3.0)`` and the first ``2**70``, each taken by the other)."""
-    if isinstance(value, (int, float, np.integer, np.floating)):  # 2**70: an object array
+    # np.timedelta64 is an np.integer: 16 ns was taken as the number 16, where an array of
+    # them (the kind check below) is refused
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, np.timedelta64
+    ):  # 2**70: an object array
         return float(value)
     if not isinstance(value, np.ndarray) or value.size != 1 or value.dtype.kind not in "iuf":
         raise TypeError(type(value).__name__)

@@ -275,7 +275,9 @@ def _plain_option(value: Any) -> Any:
     value = _plain_real(value)
     if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
         value = value.reshape(())[()]
-    if isinstance(value, (np.integer, np.floating)):
+    # by dtype kind, not np.integer: np.timedelta64 is one, and its item() made 16 ns a 16
+    # (accepted as r_spatial=16) and 16 s a datetime.timedelta (the error misnamed the value)
+    if isinstance(value, np.generic) and value.dtype.kind in "iuf":
         return value.item()
     return value
 
