@@ -1686,6 +1686,56 @@ mod tests {
     }
 
     #[test]
+    fn the_avx2_path_step_keeps_the_saturating_add_of_step4s_contract() {
+        // `step4` on its own, with path costs anywhere in u8 (up to the 255 pads) and any P1,
+        // P2 within its contract (`m_r` the minimum of `lp_r`, `m_r + p2_r` and every result
+        // below 256): `min(a, n) + p1` then passes 255, which a pass under `u8_fits` never
+        // reaches, and the hand-written step must saturate there like `PathCost::step`.
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        };
+        let mut s = 987_654_321u32;
+        let mut rand = move |below: u32| {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (s >> 8) % below
+        };
+        for n in (1..=130).chain([191, 200, 255, 256, 257]) {
+            for trial in 0..20 {
+                // Each path's costs between a floor and 255; some levels at 255.
+                let mut lp = [(); 4].map(|_| vec![u8::MAX; n + 2]);
+                for v in &mut lp {
+                    let floor = rand(256);
+                    for x in &mut v[1..n + 1] {
+                        *x = match rand(8) {
+                            0 => u8::MAX,
+                            _ => (floor + rand(256 - floor)) as u8,
+                        };
+                    }
+                }
+                let m: [u8; 4] = std::array::from_fn(|r| *lp[r].iter().min().unwrap());
+                let p2: [u16; 4] = std::array::from_fn(|r| rand(256 - u32::from(m[r])) as u16);
+                let p1 = if trial % 4 == 0 {
+                    255
+                } else {
+                    rand(256) as u16
+                };
+                let c_max = 255 - u32::from(*p2.iter().max().unwrap());
+                let c: Vec<u8> = (0..n).map(|_| rand(c_max + 1) as u8).collect();
+                let run = |a: Option<Avx2>| {
+                    let mut out = [(); 4].map(|_| vec![0u8; n + 2]);
+                    let mut acc = vec![0u16; n];
+                    let [o0, o1, o2, o3] = &mut out;
+                    let lps = [&lp[0][..], &lp[1][..], &lp[2][..], &lp[3][..]];
+                    let mn = step4(lps, m, p2, p1, &c, [o0, o1, o2, o3], &mut acc, a);
+                    (mn, out, acc)
+                };
+                assert_eq!(run(Some(avx2)), run(None), "{n} levels, trial {trial}");
+            }
+        }
+    }
+
+    #[test]
     fn three_paths_recover_a_shift_alike_on_any_thread_count_and_cost_width() {
         let (w, h) = (80, 40);
         let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 6.0));
