@@ -1511,3 +1511,16 @@ def test_a_vote_no_pixel_can_win_is_refused(
         with pytest.raises(ValueError, match=want):
             sv_depth_map(img, img, max_disparity=8, progress=stages.append, **kw)
         assert stages == []
+
+
+def test_an_r_spatial_past_its_bound_is_refused_at_once() -> None:
+    """fuse visits every offset within r_spatial: 1e6 px (or np.uint64's maximum, which
+    _plain_option reads as a huge int) ran for ever instead of failing. Past MAX_R_SPATIAL it is
+    refused before any search; the bound itself is taken."""
+    from stereovision.matching.fusion import MAX_R_SPATIAL
+
+    sparse = {"hopfield": _m([(8, 5, 10.4)]), "mcgm": _m([(8, 6, 10.5)])}
+    for bad in (1e6, np.uint64(2**64 - 1), MAX_R_SPATIAL + 0.5):
+        with pytest.raises(ValueError, match=r"^r_spatial: expected at most 64.0 px"):
+            fuse(None, sparse, r_spatial=bad)
+    assert len(fuse(None, sparse, r_spatial=MAX_R_SPATIAL)) == len(fuse(None, sparse, r_spatial=16))

@@ -139,6 +139,10 @@ class FusionResult:
         return len(self.matches)
 
 
+#: px: the largest ``r_spatial`` :func:`fuse` takes (12853 offsets; the default is 1.5).
+MAX_R_SPATIAL = 64.0
+
+
 def _radius_offsets(r: float) -> list[tuple[int, int]]:
     """Integer offsets ``(dy, dx)`` within ``r``, nearest first (ties in a fixed order)."""
     k = int(np.floor(r))
@@ -300,6 +304,13 @@ def _fuse_options(
     for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
         if finite_number(v, pname) <= 0:
             raise ValueError(f"{pname}: expected a positive number, got {v}")
+    # the search visits every offset within r (about 3.14 r^2 of them): 1e6 px, or a uint64's
+    # maximum, ran for ever instead of failing
+    if r_spatial > MAX_R_SPATIAL:
+        raise ValueError(
+            f"r_spatial: expected at most {MAX_R_SPATIAL} px (a sparse value this far is no "
+            f"longer at the pixel), got {r_spatial}"
+        )
     # NaN took no Gabor value without a word (every ``conf >= nan`` is False), a string or None
     # failed in NumPy's comparison naming no parameter
     a_conf_min = _plain_option(a_conf_min)
