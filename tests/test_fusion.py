@@ -1524,3 +1524,19 @@ def test_an_r_spatial_past_its_bound_is_refused_at_once() -> None:
         with pytest.raises(ValueError, match=r"^r_spatial: expected at most 64.0 px"):
             fuse(None, sparse, r_spatial=bad)
     assert len(fuse(None, sparse, r_spatial=MAX_R_SPATIAL)) == len(fuse(None, sparse, r_spatial=16))
+
+
+@pytest.mark.parametrize("given", [np.timedelta64(2), np.timedelta64(2, "ns")])
+def test_a_min_agree_given_as_a_timedelta_is_refused(given: Any) -> None:
+    """2ff768b refused a timedelta64 as r_spatial or speckle_area, but min_agree reads its
+    count by np.integer, which np.timedelta64 is: 2 ns was taken as 2 channels (an array of
+    them refused). It is refused, named as given, by fuse and before depth_map matches."""
+    sparse = {"hopfield": _m([(8, 5, 10.4)]), "mcgm": _m([(8, 6, 10.5)])}
+    with pytest.raises(ValueError, match=r"^min_agree: expected a whole number") as info:
+        fuse(None, sparse, min_agree=given)
+    assert repr(given) in str(info.value)
+    img = np.zeros((20, 30), np.float32)
+    stages: list[str] = []
+    with pytest.raises(ValueError, match=r"^min_agree: expected a whole number"):
+        sv_depth_map(img, img, max_disparity=8, progress=stages.append, min_agree=given)
+    assert stages == []

@@ -323,7 +323,10 @@ def _fuse_options(
         agree = agree.reshape(())[()]
     if isinstance(agree, (float, np.floating)) and float(agree).is_integer():
         agree = int(agree)
-    if isinstance(agree, (bool, np.bool_)) or not isinstance(agree, (int, np.integer)):
+    # np.timedelta64 is an np.integer: 2 ns was taken as 2 channels (an array of them refused)
+    if isinstance(agree, (bool, np.bool_, np.timedelta64)) or not isinstance(
+        agree, (int, np.integer)
+    ):
         raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
     min_agree = int(agree)
     if min_agree < 2:
