@@ -1540,3 +1540,17 @@ def test_a_min_agree_given_as_a_timedelta_is_refused(given: Any) -> None:
     with pytest.raises(ValueError, match=r"^min_agree: expected a whole number"):
         sv_depth_map(img, img, max_disparity=8, progress=stages.append, min_agree=given)
     assert stages == []
+
+
+def test_a_speckle_area_too_large_for_the_map_drops_every_region() -> None:
+    """speckle_area is a share of H * W, capped at the map's size before the kernel; 1e308
+    of the map is inf, and int(inf) was Python's bare OverflowError (after every matcher had
+    run, through depth_map). It now gives the capped area's map: every region is smaller."""
+    d, c = _dense(5.0, 0.5)
+    members = np.full((H, W), np.nan, np.float32)
+    want, want_c = fused_dense(d, c, members, speckle_area=2.0)
+    assert np.isnan(want).all()
+    for big in (1e308, 2**70, np.uint64(2**64 - 1)):
+        got, got_c = fused_dense(d, c, members, speckle_area=big)
+        np.testing.assert_array_equal(got, want)
+        np.testing.assert_array_equal(got_c, want_c)

@@ -1229,8 +1229,9 @@ def _drop_speckles(
     ``filterSpeckles`` rule, on the float disparities)."""
     from stereovision import _core
 
-    # Above the map's size every region is smaller: the cap keeps it in the kernel's integers.
-    size = min(int(area * out.size), out.size + 1)
+    # Above the map's size every region is smaller: the cap keeps it in the kernel's integers
+    # (capped before int(): 1e308 of the map is inf, OverflowError naming nothing)
+    size = int(min(area * out.size, out.size + 1))
     ok = np.isfinite(out)
     if size < 1 or not ok.any():
         return out, conf
