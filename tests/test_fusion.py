@@ -1554,3 +1554,25 @@ def test_a_speckle_area_too_large_for_the_map_drops_every_region() -> None:
         got, got_c = fused_dense(d, c, members, speckle_area=big)
         np.testing.assert_array_equal(got, want)
         np.testing.assert_array_equal(got_c, want_c)
+
+
+@pytest.mark.parametrize("name", ["edge_ratio", "edge_jump"])
+def test_an_edge_option_past_float32_is_named(name: str) -> None:
+    """The edge kernel takes edge_ratio and edge_jump as float32: 1e308 became inf there and
+    was refused after every matcher had run as "ratio: expected a non-negative number, got
+    inf", naming neither the option nor the value given. It is refused by its name before
+    depth_map matches; float32's largest value is taken."""
+    d, c = _dense(5.0, 0.5)
+    members = np.full((H, W), np.nan, np.float32)
+    guide = np.random.default_rng(0).random((H, W)).astype(np.float32)
+    f32_max = float(np.finfo(np.float32).max)
+    want = f"^{name}: expected at most 3.40282e\\+38 \\(float32\\), got 1e\\+308$"
+    with pytest.raises(ValueError, match=want):
+        fused_dense(d, c, members, guide=guide, **{name: 1e308})
+    img = np.zeros((20, 30), np.float32)
+    stages: list[str] = []
+    with pytest.raises(ValueError, match=want):
+        sv_depth_map(img, img, max_disparity=8, progress=stages.append, **{name: 1e308})
+    assert stages == []
+    got, _ = fused_dense(d, c, members, guide=guide, **{name: f32_max})
+    assert np.isfinite(got).any()

@@ -976,6 +976,10 @@ def _nearest_member(members: F32) -> tuple[F32, F32]:
     return values[lab].astype(np.float32), dist.astype(np.float32)
 
 
+#: the largest float32: the edge kernel's ``ratio`` and ``jump`` are float32.
+_F32_MAX = float(np.finfo(np.float32).max)
+
+
 def _dense_options(
     radius: Any,
     tau: Any,
@@ -1015,6 +1019,11 @@ def _dense_options(
     ):
         if finite_number(v, name) < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
+    # the edge kernel takes them as float32: 1e308 became inf there, refused after every
+    # matcher had run as "ratio: ... got inf", naming neither the option nor the value given
+    for name, v in (("edge_ratio", edge_ratio), ("edge_jump", edge_jump)):
+        if v > _F32_MAX:
+            raise ValueError(f"{name}: expected at most {_F32_MAX:.6g} (float32), got {v}")
     # Confidence 0 marks a filled disparity (DepthResult.depth_counts, point_image(filled=True)):
     # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
     # or every pixel only the census map measured.
@@ -1116,7 +1125,8 @@ def fused_dense(
     ------
     ValueError
         Maps of different shapes, a negative radius / tolerance, ``fill_confidence`` or
-        ``second_confidence`` not a number in (0, 1] (0 is the filled pixels' mark).
+        ``second_confidence`` not a number in (0, 1] (0 is the filled pixels' mark), an
+        ``edge_ratio`` or ``edge_jump`` past float32's largest value.
     """
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
