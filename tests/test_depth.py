@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+from collections.abc import Iterator
 from pathlib import Path
 
 import cv2
@@ -547,6 +548,23 @@ def test_fused_channels_without_the_gabor_channel_are_named() -> None:
     for good in (["gabor", "mcgm"], np.array(["gabor", "mcgm"]), iter(("gabor", "mcgm"))):
         got = sv.depth_map(img, right, max_disparity=8, channels=good).disparity
         np.testing.assert_array_equal(got, want)
+
+
+def test_fused_channels_given_as_an_iterable_that_is_no_collection_are_taken() -> None:
+    """10da932 read a one-pass iterator once, as fuse_pair does, but an iterable that is no
+    iterator and no collection (an object with __iter__ only) was still refused ("needs
+    'gabor'") though fuse_pair and match(method="fused") take it. It now gives the tuple's map."""
+
+    class Names:
+        def __iter__(self) -> Iterator[str]:
+            return iter(("gabor", "mcgm"))
+
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    right = np.roll(img, -3, axis=1)
+    want = sv.depth_map(img, right, max_disparity=8, channels=("gabor", "mcgm")).disparity
+    got = sv.depth_map(img, right, max_disparity=8, channels=Names()).disparity
+    assert np.isfinite(want).mean() > 0.9
+    np.testing.assert_array_equal(got, want)
 
 
 def test_every_type_error_of_depth_map_is_documented() -> None:

@@ -16,7 +16,7 @@ import functools
 import math
 import time
 import warnings
-from collections.abc import Callable, Collection, Iterable, Iterator
+from collections.abc import Callable, Collection, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
@@ -1448,9 +1448,11 @@ def depth_map(
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     if "calibration" in params:  # the result's field is .calibration; the argument is calib
         raise TypeError("depth_map: the calibration is the argument calib, not calibration")
-    if isinstance(params.get("channels"), Iterator):
-        # read a one-pass iterator once, as fuse_pair does: the checks would use it up
-        params["channels"] = tuple(params["channels"])
+    names = params.get("channels")
+    if isinstance(names, Iterable) and not isinstance(names, Collection):
+        # read once, as fuse_pair does: the checks would use up a one-pass iterator, and an
+        # iterable that is no collection (no len) was refused though fuse_pair and match take it
+        params["channels"] = tuple(names)
     _refuse_unknown_params(method, params)
     # The switches and the range are checked for their type first: "no" would be true, True
     # a disparity of 1, and "32" failed in NumPy's isfinite.
