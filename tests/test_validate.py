@@ -687,3 +687,19 @@ def test_a_timedelta_scalar_is_no_number(value: np.timedelta64) -> None:
         finite_number(value, "blur")
     with pytest.raises(ValueError, match=r"^f: expected a positive finite number, got "):
         positive_finite(value, "f")
+
+
+@pytest.mark.parametrize("value", [np.timedelta64(3), np.timedelta64(3, "ns")])
+def test_a_timedelta_scalar_is_no_count(value: np.timedelta64) -> None:
+    """2ff768b made finite_number refuse a timedelta64 scalar, but int_in_range (the counts:
+    hopfield's nms_half and tile, planes' min_size, synthetic's supersample...) read it by
+    np.integer, which np.timedelta64 is: 3 ns was the count 3. It is refused, named as given."""
+    from stereovision._validate import int_in_range
+    from stereovision.matching.hopfield import interest_points
+
+    with pytest.raises(ValueError, match=r"^n: expected an integer from 1 to 10, got ") as info:
+        int_in_range(value, "n", 1, 10)
+    assert str(info.value).endswith(f"got {value!r}")
+    img = np.zeros((20, 30), np.float32)
+    with pytest.raises(ValueError, match=r"^nms_half: expected an integer"):
+        interest_points(img, nms_half=value)

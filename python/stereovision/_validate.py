@@ -728,7 +728,8 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
         Naming ``name``, for a bool, a non-number, a non-integral or non-finite number, or one
         outside the range.
     """
-    ok = not isinstance(value, (bool, np.bool_))
+    # np.timedelta64 is an np.integer: 3 ns was the count 3 (finite_number refuses it)
+    ok = not isinstance(value, (bool, np.bool_, np.timedelta64))
     if ok and isinstance(value, (int, np.integer)):
         ok = lo <= int(value) <= hi  # exact: a float of 2**63 - 1 is 2**63
     elif ok and isinstance(value, (float, np.floating)):
