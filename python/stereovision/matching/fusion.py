@@ -372,7 +372,8 @@ def fuse(
         ``"vote"``: the largest pairwise-agreeing subset with at least ``min_agree`` members
         (ties: the smaller x spread); ``"intersection"``: every channel present and agreeing.
     r_spatial : float
-        A sparse channel's measurement within this distance (px) of a candidate counts there.
+        A sparse channel's measurement within this distance (px, at most 64) of a candidate
+        counts there.
     tau_dx, tau_dy : float
         Agreement tolerances (px) on x- and y-disparity.
     a_conf_min : float
@@ -388,7 +389,8 @@ def fuse(
     ------
     ValueError
         No sparse channel, an unknown channel name, maps of different sizes, a bad mode, a
-        non-positive tolerance, an ``a_conf_min`` that is not a number in ``[0, 1]`` or a
+        non-positive tolerance, an ``r_spatial`` past ``MAX_R_SPATIAL`` (64 px), an
+        ``a_conf_min`` that is not a number in ``[0, 1]`` or a
         ``min_agree`` that is not a whole number of at least 2 or, in vote mode, is more than
         the channels given.
     """
