@@ -921,3 +921,30 @@ def test_a_recording_announcing_fewer_frames_than_it_holds_never_reports_past_it
     assert frames == [(PROGRESS_FRAMES, i, 3) for i in (1, 2, 3)] + [
         (PROGRESS_FRAMES, i, 0) for i in (4, 5, 6)
     ]
+
+
+def test_the_rectified_pair_given_with_its_rectification_is_named_as_such(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`rectify` without --calib writes left_rect.png, right_rect.png and rectification.json;
+    `depth left_rect.png right_rect.png --rectification rectification.json` (the homographies
+    beside the pair they wrote) was refused as "left image is 484x419 px; this rectification is
+    for 612x459", naming no mix-up. The rectified pair's size is now said to be that, and what
+    to run instead; another size keeps the plain message."""
+    books = data_dir / "opencv_uncalibrated" / "books"
+    out = tmp_path / "rect"
+    assert main(["rectify", str(books / "left.jpg"), str(books / "right.jpg"), "-o", str(out)]) == 0
+    capsys.readouterr()
+    rect = ["--rectification", str(out / "rectification.json"), "-o", str(tmp_path / "d")]
+    assert main(["depth", str(out / "left_rect.png"), str(out / "right_rect.png"), *rect]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "stereovision: error: left image is 484x419 px, the rectified pair's size; this "
+        "rectification is for 612x459, the raw pair: match the rectified pair as it is (depth "
+        "without --rectification)"
+    )
+    assert not (tmp_path / "d").exists()
+    left = str(CONES / "left.png")
+    assert main(["depth", left, str(CONES / "right.png"), *rect]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "stereovision: error: left image is 450x375 px; this rectification is for 612x459"

@@ -359,17 +359,44 @@ class UncalibratedRectification:
             # OpenCV's own assertion ("ifunc != 0 in function 'remap'") of a bool or int64
             # array, or of a float16 image the package otherwise takes, said nothing of it
             arr = as_image_array(img, name)
-            if (arr.shape[1], arr.shape[0]) != self.input_size:
-                raise ValueError(
-                    f"{name} image is {arr.shape[1]}x{arr.shape[0]} px; this rectification is "
-                    f"for {self.input_size[0]}x{self.input_size[1]}"
-                )
+            self._check_input_size(name, arr.shape)
             work = arr
             if arr.dtype.kind == "f" and arr.dtype.itemsize not in (4, 8):  # float16, long double
                 work = arr.astype(np.float32 if arr.dtype.itemsize == 2 else np.float64)
             warped = np.asarray(cv2.warpPerspective(work, hom, self.size, flags=interpolation))
             out.append(warped if warped.dtype == arr.dtype else warped.astype(arr.dtype))
         return out[0], out[1]
+
+    def _check_input_size(self, name: str, shape: tuple[int, ...]) -> None:
+        """Refuse an image not of :attr:`input_size`, naming the mix-up of the rectified
+        pair's images (``left_rect.png``) for the raw pair they came from.
+
+        Parameters
+        ----------
+        name : str
+            ``"left"`` or ``"right"``, for the message.
+        shape : tuple of int
+            The image's shape, ``(H, W)`` or ``(H, W, C)``.
+
+        Raises
+        ------
+        ValueError
+            If ``shape`` is not of :attr:`input_size`.
+        """
+        w, h = shape[1], shape[0]
+        if (w, h) == self.input_size:
+            return
+        rectified = (w, h) == self.size  # `rectify`'s output, which a second warp would spoil
+        raise ValueError(
+            f"{name} image is {w}x{h} px"
+            + (", the rectified pair's size" if rectified else "")
+            + f"; this rectification is for {self.input_size[0]}x{self.input_size[1]}"
+            + (
+                ", the raw pair: match the rectified pair as it is (depth without --rectification)"
+                if rectified
+                else ""
+            )
+        )
 
     def rectify_points(self, points: npt.ArrayLike, side: str = "left") -> F64:
         """Input pixel positions of one image -> their positions in the rectified image.
@@ -436,11 +463,7 @@ class UncalibratedRectification:
         grays = []
         for name, img in (("left", left), ("right", right)):
             g = as_gray_uint8(img, name)
-            if (g.shape[1], g.shape[0]) != self.input_size:
-                raise ValueError(
-                    f"{name} image is {g.shape[1]}x{g.shape[0]} px; this rectification is for "
-                    f"{self.input_size[0]}x{self.input_size[1]}"
-                )
+            self._check_input_size(name, g.shape)
             grays.append(g)
         pl, dl = _features(grays[0])
         pr, dr = _features(grays[1])
