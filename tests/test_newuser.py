@@ -490,7 +490,7 @@ def test_a_board_square_given_in_mm_with_the_unit_left_at_metres_is_said(
     err = capsys.readouterr().err
     assert "--square 30 m is a 30 m board square" in err and "--unit mm" in err
     assert main(["board", "-o", str(tmp_path / "b.png"), "--square", "30", "--unit", "mm"]) == 0
-    assert "warning" not in capsys.readouterr().err
+    assert "board square" not in capsys.readouterr().err  # (it is said to outgrow A4, below)
     # --unit ft: 4 (1.22 m) was said "measured in mm or cm?", where 4 in is the likely square
     assert main(["board", "-o", str(tmp_path / "f.png"), "--square", "4", "--unit", "ft"]) == 2
     err = capsys.readouterr().err  # then refused: too large to print at 300 dpi
@@ -948,3 +948,37 @@ def test_the_rectified_pair_given_with_its_rectification_is_named_as_such(
     assert main(["depth", left, str(CONES / "right.png"), *rect]) == 2
     err = capsys.readouterr().err.strip()
     assert err == "stereovision: error: left image is 450x375 px; this rectification is for 612x459"
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        # the README's and robotics.md's ChArUco board: 12 x 9 squares of 30 mm with its margins
+        (
+            ["--board", "charuco", "--pattern", "10x7", "--square", "0.03", "--marker", "0.022"],
+            "360 x 270 mm, larger than A4 and US Letter paper",
+        ),
+        (["--square", "0.025"], "300 x 225 mm, larger than A4 and US Letter paper"),  # 9x6
+        (["--pattern", "11x6", "--square", "0.02"], "280 x 180 mm, larger than US Letter paper"),
+        (["--square", "0.02"], None),  # 240 x 180 mm
+        (["--pattern", "5x10", "--square", "0.02"], None),  # 160 x 260 mm: upright
+    ],
+)
+def test_a_board_larger_than_office_paper_is_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], said: str | None
+) -> None:
+    """`board` said "printed at 100 % scale it is 360.0 x 270.0 mm" of the README's ChArUco
+    board and nothing more: on A4 or US Letter a printer crops it or its fit-to-page shrinks the
+    squares below the --square that calibrate is then given. A page that outgrows a sheet is now
+    said in a warning (the board is written all the same); one that fits either way round is not."""
+    out = tmp_path / "b.png"
+    assert main(["board", "-o", str(out), *argv]) == 0
+    assert out.is_file()
+    err = capsys.readouterr().err
+    if said is None:
+        assert err == ""
+    else:
+        assert err == (
+            f"stereovision: warning: {out} is {said}: print it on a larger sheet (A3, tabloid) "
+            "or give a smaller --square (a printer's fit-to-page shrinks the squares)\n"
+        )

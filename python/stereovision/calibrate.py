@@ -3117,7 +3117,27 @@ def cmd_board(args: argparse.Namespace) -> int:
         f"{pix * mm:.2f} mm squares. Measure a square on the print and give that size to "
         "calibrate --square."
     )
+    # a page the usual printers cannot take at 100 % is shrunk by their fit-to-page, and the
+    # board then calibrates with squares smaller than the --square given (the README's 10x7
+    # ChArUco board of 30 mm squares is 360 x 270 mm with its margins)
+    too_big = [
+        name
+        for name, (a, b) in _PAPER_MM.items()
+        if not ((w * mm <= a and h * mm <= b) or (w * mm <= b and h * mm <= a))
+    ]
+    if too_big:
+        warnings.warn(
+            f"{out} is {w * mm:.0f} x {h * mm:.0f} mm, larger than {' and '.join(too_big)} paper: "
+            "print it on a larger sheet (A3, tabloid) or give a smaller --square (a printer's "
+            "fit-to-page shrinks the squares)",
+            UserWarning,
+            stacklevel=2,
+        )
     return 0
+
+
+#: Sheets (mm, either way round) that ``board`` says its page outgrows: the usual office printers'.
+_PAPER_MM = {"A4": (210.0, 297.0), "US Letter": (215.9, 279.4)}
 
 
 def _add_board_options(p: argparse.ArgumentParser) -> None:
