@@ -277,6 +277,34 @@ def test_no_calibration_no_cloud(result, tmp_path):
     assert np.isnan(data["depth_sigma"]).all()
 
 
+def test_every_writer_needing_a_calibration_says_to_pass_calib(result, tmp_path):
+    """to_ply, points, filtered and export's writers said the result had no calibration but
+    not what to do, where require_depth() says to pass calib=: all now give its hint."""
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
+    hint = "; pass calib=Calibration.from_file(...)"
+    calls = {
+        "point cloud": (
+            lambda: bare.to_ply(tmp_path / "c.ply"),
+            lambda: export.write_cloud_ply(tmp_path / "c.ply", bare),
+            lambda: export.write_pcd(tmp_path / "c.pcd", bare),
+        ),
+        "3-D points": (lambda: bare.point_image(),),
+        "depth to filter": (lambda: bare.filtered(max_depth=2.0),),
+        "depth": (lambda: export.write_depth_png(tmp_path / "d.png", bare),),
+    }
+    for what, funcs in calls.items():
+        for func in funcs:
+            with pytest.raises(ValueError) as err:
+                func()
+            said = str(err.value)
+            assert said.startswith(f"no {what}: depth_map was called without a calibration")
+            assert said.endswith(hint), said
+    with pytest.raises(ValueError) as err:
+        export.export_result(bare, tmp_path / "out", ("ply",))
+    assert f"{hint}; formats ['ply'] need one" in str(err.value)
+    assert not (tmp_path / "out").exists() and not list(tmp_path.iterdir())
+
+
 def test_load_cloud_errors(tmp_path):
     fake = tmp_path / "fake.ply"
     fake.write_bytes(b"\x89PNG not a ply")

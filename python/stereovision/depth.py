@@ -855,7 +855,7 @@ class DepthResult:
             # "no" (true) gave the filled pixels, None (false) left them out, without a word
             raise TypeError(f"filled: expected True or False, got {filled!r}")
         if self.depth is None or self.calibration is None:
-            raise ValueError("no 3-D points: depth_map was called without a calibration")
+            raise ValueError(_NO_DEPTH.format(what="3-D points"))
         pts = self.calibration.reproject(self.disparity)
         keep = np.isfinite(self.depth)
         lim = self.limits
@@ -909,7 +909,7 @@ class DepthResult:
             number (``min_depth`` may be 0).
         """
         if self.depth is None:
-            raise ValueError("no depth to filter: depth_map was called without a calibration")
+            raise ValueError(_NO_DEPTH.format(what="depth to filter"))
         limits = {
             "min_depth": min_depth,
             "max_depth": max_depth,
@@ -992,7 +992,7 @@ class DepthResult:
         from stereovision.io import write_ply
 
         if self.depth is None:
-            raise ValueError("no point cloud: depth_map was called without a calibration")
+            raise ValueError(_NO_DEPTH.format(what="point cloud"))
         if Path(path).suffix.lower() != ".ply":
             raise ValueError(
                 f"{path}: to_ply writes a .ply file (export.write_pcd writes .pcd, "

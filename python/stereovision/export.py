@@ -43,7 +43,7 @@ from stereovision._validate import (
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
-from stereovision.depth import DepthResult
+from stereovision.depth import _NO_DEPTH, DepthResult
 from stereovision.io import (
     _ascii_table,
     _through_links,
@@ -99,7 +99,7 @@ _ZIP_MAGIC = b"PK\x03\x04"
 
 def _require_metric(result: DepthResult) -> None:
     if result.depth is None or result.calibration is None:
-        raise ValueError("no point cloud: depth_map was called without a calibration")
+        raise ValueError(_NO_DEPTH.format(what="point cloud"))
 
 
 def organised_points(
@@ -932,7 +932,7 @@ def write_depth_png(
 
     if isinstance(depth, DepthResult):
         if depth.depth is None:
-            raise ValueError("no depth: depth_map was called without a calibration")
+            raise ValueError(_NO_DEPTH.format(what="depth"))
         return _png16(path, _scaled_u16(depth.depth, scale, "depth"), "depth")
     return _png16(path, _scaled_u16(depth, scale, "depth"), "depth")
 
@@ -1091,8 +1091,8 @@ def export_result(
     metric = [f for f in formats if f in _METRIC_FORMATS]
     if metric and (result.depth is None or result.calibration is None):
         raise ValueError(
-            f"no depth: depth_map was called without a calibration; formats {metric} need "
-            "one (npz and disp16 do not); nothing was written"
+            _NO_DEPTH.format(what="depth") + f"; formats {metric} need one (npz and disp16 "
+            "do not); nothing was written"
         )
     out = Path(directory)
     for fmt in formats:  # a folder in the way, refused before the formats before it are written
