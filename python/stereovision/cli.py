@@ -833,7 +833,9 @@ def _depth_coverage(res: Any) -> str:
 
     ``depth on 83.8 % of the pixels (disparity on 100.0 %): none on 27278 filled (16.2 %,
     guesses, not measured) nor on 0 measured (0.0 %) within sigma_d of infinite depth``: the depth
-    map's holes where the disparity map has none, said with their reason.
+    map's holes where the disparity map has none, said with their reason. A reason with no
+    pixel is left out (it read "none on 0 filled (0.0 %, ...) nor on 0 measured (0.0 %)"), and
+    with neither the line says every pixel with a disparity has a depth.
     """
     c = res.depth_counts()
 
@@ -841,11 +843,15 @@ def _depth_coverage(res: Any) -> str:
         return f"{100 * c[key] / max(c['pixels'], 1):.1f} %"
 
     why = "outside the limits or within" if res.limits else "within"
-    return (
-        f"depth on {pct('depth')} of the pixels (disparity on {pct('disparity')}): none on "
-        f"{c['filled']} filled ({pct('filled')}, guesses, not measured) nor on "
-        f"{c['dropped']} measured ({pct('dropped')}) {why} sigma_d of infinite depth"
-    )
+    head = f"depth on {pct('depth')} of the pixels (disparity on {pct('disparity')})"
+    parts = []
+    if c["filled"]:
+        parts.append(f"{c['filled']} filled ({pct('filled')}, guesses, not measured)")
+    if c["dropped"]:
+        parts.append(f"{c['dropped']} measured ({pct('dropped')}) {why} sigma_d of infinite depth")
+    if not parts:
+        return f"{head}: every pixel with a disparity has one"
+    return f"{head}: none on " + " nor on ".join(parts)
 
 
 def _length(metres: float, unit: str, digits: int) -> str:
