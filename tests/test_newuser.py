@@ -62,6 +62,47 @@ def test_depth_without_calib_says_disparity_only(
     assert " points, " in first and "disparity only" not in first
 
 
+def test_a_max_depth_that_leaves_no_depth_names_the_nearest(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``depth --max-depth 2`` on the sample said "no depth, 0 points" without saying why: it
+    now names the limit and the nearest depth there was (cones' nearest is 2.07 m)."""
+    argv = ["depth", str(CONES / "left.png"), str(CONES / "right.png")]
+    argv += ["--calib", str(CONES / "calib.txt")]
+    assert main([*argv, "-o", str(tmp_path / "all")]) == 0
+    nearest = float(np.nanmin(np.load(tmp_path / "all" / "depth.npy")))
+    assert 2.0 < nearest < 2.1
+    capsys.readouterr()
+    assert main([*argv, "--max-depth", "2", "-o", str(tmp_path / "cut")]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    said = f", no depth within --max-depth 2 m (the nearest is {nearest:.3g} m), 0 points, "
+    assert said in first, first
+    assert not np.isfinite(np.load(tmp_path / "cut" / "depth.npy")).any()
+    # a limit that keeps some depth: the depth range as before
+    assert main([*argv, "--max-depth", "2.1", "-o", str(tmp_path / "some")]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert f", depth {nearest:.3g}-" in first and "within --max-depth" not in first
+
+
+def test_the_nearest_beyond_max_depth_is_shown_beyond_it() -> None:
+    """A nearest depth that three digits round onto the limit gets the digits to read past it;
+    depths kept, none to begin with, or ones --max-sigma took (within reach): nothing said."""
+    from stereovision.cli import _beyond_max_depth
+
+    nan = np.float32(np.nan)
+    none = np.full((1, 2), nan, np.float32)
+    before = np.array([[2.0004, nan]], np.float32)
+    said = _beyond_max_depth(none, before, 2.0)
+    assert said == f"no depth within --max-depth 2 m (the nearest is {float(before[0, 0]):.7g} m)"
+    assert said.endswith("(the nearest is 2.0004 m)")
+    assert _beyond_max_depth(none, np.array([[3.5, 9.0]], np.float32), 2.0) == (
+        "no depth within --max-depth 2 m (the nearest is 3.5 m)"
+    )
+    assert _beyond_max_depth(before, before, 2.0) is None  # depth kept
+    assert _beyond_max_depth(none, none, 2.0) is None  # no depth before the limit either
+    assert _beyond_max_depth(none, np.array([[1.5, nan]], np.float32), 2.0) is None
+
+
 @pytest.mark.parametrize("value", ["0", "-5", "1.5", "abc"])
 def test_max_disparity_refused_in_the_options_words(
     value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]

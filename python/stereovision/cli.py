@@ -304,6 +304,7 @@ def depth_outputs(
     name: str = "pair",
     unit: str = "m",
     removed: list[Path] | None = None,
+    unfiltered: list[Any] | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -353,6 +354,9 @@ def depth_outputs(
         options' (``max_depth``, ``max_sigma``, ``voxel``, ``grid``: metres).
     removed : list, optional
         Receives the earlier run's files that were removed, not rewritten by this run.
+    unfiltered : list, optional
+        Receives the result as matched, before ``max_depth`` and ``max_sigma`` (when given):
+        the summary names its nearest depth when ``max_depth`` leaves none.
 
     Returns
     -------
@@ -391,6 +395,8 @@ def depth_outputs(
     kw: dict[str, Any] = {} if method is None else {"method": method}
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     if max_depth is not None or max_sigma is not None:
+        if unfiltered is not None:
+            unfiltered.append(res)
         res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
     # Every file is written into a hidden folder inside out_dir first and moved in only when
     # all are there: an error or interrupt in a later writer left the new disparity files
@@ -786,6 +792,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         )
     counts: dict[str, int] = {}
     removed: list[Path] = []
+    unfiltered: list[Any] = []
     res, written = depth_outputs(
         left,
         right,
@@ -805,12 +812,18 @@ def cmd_depth(args: argparse.Namespace) -> int:
         name=_pair_name(args.left),
         unit=unit,
         removed=removed,
+        unfiltered=unfiltered,
     )
     cloud = (
         f"{_depth_range(res.depth, unit)}, {len(res.points)} points"
         if res.depth is not None
         else "disparity only (no depth or cloud without --calib)"
     )
+    if res.depth is not None and args.max_depth is not None and unfiltered:
+        # "no depth, 0 points" did not say that --max-depth took it all, nor how far to go
+        beyond = _beyond_max_depth(res.depth, unfiltered[0].depth, args.max_depth)
+        if beyond is not None:
+            cloud = f"{beyond}, {len(res.points)} points"
     if args.voxel is not None and "cloud.ply" in written:
         # the cloud.ply of --voxel holds fewer points than the result: "N points" read as its
         # (the count comes from the writer: the file was read back whole to count its points)
@@ -859,6 +872,21 @@ def _length(metres: float, unit: str, digits: int) -> str:
     from stereovision.calibration import UNIT_TO_METRES
 
     return f"{metres / UNIT_TO_METRES[unit]:.{digits}f} {unit}"
+
+
+def _beyond_max_depth(depth: np.ndarray, before: np.ndarray, max_depth: float) -> str | None:
+    """``no depth within --max-depth 2 m (the nearest is 2.07 m)`` when ``--max-depth`` left
+    no depth of the ones there were (``before``, metres); None otherwise. In metres, as the
+    option is, with the digits it takes to read the nearest as beyond the limit."""
+    if np.isfinite(depth).any() or not np.isfinite(before).any():
+        return None
+    nearest = float(np.nanmin(before))
+    if nearest <= max_depth:  # --max-sigma took the depths within reach
+        return None
+    shown = figure_shown(nearest)
+    if float(shown) <= max_depth:  # 2.0004 shown as "2" read as within --max-depth 2
+        shown = f"{nearest:.7g}"
+    return f"no depth within --max-depth {max_depth:g} m (the nearest is {shown} m)"
 
 
 def _depth_range(depth: np.ndarray, unit: str) -> str:
