@@ -318,17 +318,14 @@ def _fuse_options(
         raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
     # a string, None or NaN failed in a comparison or in range(), naming no parameter; a whole
     # number given as 2.0 or a size-1 array (a value read from one) is its count
-    agree = _plain_real(min_agree)
-    if isinstance(agree, np.ndarray) and agree.size == 1 and agree.dtype.kind in "iuf":
-        agree = agree.reshape(())[()]
-    if isinstance(agree, (float, np.floating)) and float(agree).is_integer():
+    # (_plain_option leaves a bool, np.bool_ or np.timedelta64 -- an np.integer: 2 ns was taken
+    # as 2 channels -- as it is, so they are refused below)
+    agree = _plain_option(min_agree)
+    if isinstance(agree, float) and agree.is_integer():
         agree = int(agree)
-    # np.timedelta64 is an np.integer: 2 ns was taken as 2 channels (an array of them refused)
-    if isinstance(agree, (bool, np.bool_, np.timedelta64)) or not isinstance(
-        agree, (int, np.integer)
-    ):
+    if isinstance(agree, bool) or not isinstance(agree, int):
         raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
-    min_agree = int(agree)
+    min_agree = agree
     if min_agree < 2:
         raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
     return mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
