@@ -393,6 +393,23 @@ def test_k_beyond_64_bits() -> None:
         TemporalFilter(k=10**400)
 
 
+@pytest.mark.parametrize("k", [1e38, 2**130, 1e300])
+def test_a_k_past_float32_averages_as_a_large_one(data_dir: Path, k: float) -> None:
+    """The kernel takes ``k * sigma`` as float32: a k the constructor accepts (1e38, 2**130,
+    1e300) made it +inf there, and the second noisy pair raised "invalid parameter `ks`",
+    a name the caller never gave. Such a k restarts no pixel, as k = 1e4 does: the same frames
+    out, bit for bit."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(3)
+    pairs = [(noisy(sc.left, 8.0, rng), noisy(sc.right, 8.0, rng)) for _ in range(4)]
+    big, ref = TemporalFilter(k=k), TemporalFilter(k=1e4)
+    for left, right in pairs:
+        got, want = big(left, right), ref(left, right)
+        assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+    assert big.sigma > 3.0 and big.restarts == ref.restarts == 0
+    assert big.mean_frames() == ref.mean_frames() == 4.0
+
+
 @pytest.mark.parametrize("shape", [(1, 1), (1, 64), (2, 2), (64, 2), (2, 8, 3)])
 def test_frames_too_small_name_the_pair_and_the_size_needed(shape: tuple[int, ...]) -> None:
     """Frames under 3 x 3 px were refused in noise_sigma's words ("image: expected an (H, W) or

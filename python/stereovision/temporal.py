@@ -72,6 +72,9 @@ _GAIN_TOL = 0.002
 _SATURATED = 250
 #: Gains outside this range are not a light's change but another view.
 _GAIN_RANGE = (0.5, 2.0)
+#: Cap of the per-pixel restart threshold ``k * sigma`` (grey levels): past any grey
+#: difference, and within float32, the kernel's type.
+_KS_MAX = 1e6
 
 
 def _brightness_change(
@@ -396,12 +399,14 @@ class TemporalFilter:
             if np.median(np.abs(blurred)) > MOTION_MARGIN * expected:
                 self.restarts += 1
                 return self._restart(imgs)
+        # The kernel takes the threshold as float32: a k the constructor accepts (1e38, 2**130)
+        # times the noise was +inf there, refused as "ks" on the second pair. Any threshold
+        # over a grey difference's largest (255) restarts no pixel, so it is capped.
+        ks = min(self.k * self.sigma, _KS_MAX)
         out = []
         for img, d, m in zip(imgs, diffs, self._means, strict=True):
             # In place: m.mean and m.count are updated.
-            avg = _core.temporal_running_mean(
-                img, m.mean, m.count, d, self.k * self.sigma, self.max_frames
-            )
+            avg = _core.temporal_running_mean(img, m.mean, m.count, d, ks, self.max_frames)
             out.append(avg)
         return out[0], out[1]
 
