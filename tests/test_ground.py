@@ -335,6 +335,33 @@ def test_a_floor_seen_along_a_line_is_no_plane() -> None:
     assert plane.pitch_deg == pytest.approx(8.0, abs=1e-6)
 
 
+def test_a_floor_along_a_line_is_said_to_be_one() -> None:
+    """``depth --ground`` and Find floor said of a floor seen along a line "no near-level plane
+    holds 3 % of the pixels", where the plane through it held all of them: the fit had refused
+    it for its spread. The line names that reason and the spread measured and needed (a share
+    of the 360 px side); a map of a wall keeps the 3 % line."""
+    from stereovision.ground import _no_floor_line
+
+    w, h = 800, 360
+    k = [[F, 0, 399.5], [0, F, 179.5], [0, 0, 1]]
+    rig = Calibration(
+        K1=k, D1=np.zeros(5), K2=k, D2=np.zeros(5), R=np.eye(3), T=[-0.12, 0, 0],
+        image_size=(w, h), rectified=True,
+    )  # fmt: skip
+    floor = _exact_floor(rig)
+    line = np.full_like(floor, np.nan)
+    line[300] = floor[300]
+    assert fit_ground_plane(line, rig) is None
+    assert _no_floor_line(line, rig) == (
+        "ground plane: none found (the likeliest floor's pixels lie along a line, 0.0 px "
+        "across where a fit needs 3.6 px)"
+    )
+    wall = np.full((h, w), 20.0)
+    assert _no_floor_line(wall, rig) == (
+        "ground plane: none found (no near-level plane holds 3 % of the pixels)"
+    )
+
+
 def test_support_refuses_a_map_of_another_size() -> None:
     """support() on the plane's own map: all of it; on a map of another size the plane's pixel
     coefficients mean other pixels: it returned a share (0.0 on the half-size map: "the floor

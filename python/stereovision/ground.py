@@ -595,6 +595,18 @@ def fit_ground_plane(
         If ``disparity`` is not 2-D or its size is not the calibration's, or a parameter is out
         of range.
     """
+    return _fit_ground(disparity, calib, inlier_px, max_tilt_deg, seed)[0]
+
+
+def _fit_ground(
+    disparity: npt.ArrayLike,
+    calib: Calibration,
+    inlier_px: float | None = None,
+    max_tilt_deg: float = MAX_TILT_DEG,
+    seed: int = 0,
+) -> tuple[GroundPlane | None, str]:
+    """:func:`fit_ground_plane`'s plane, and when there is none the line saying why
+    (:func:`_no_floor_line`); "" with a plane."""
     _require_type(calib, "Calibration", "calib")
     from stereovision._validate import check_index_range, not_a_result, positive_finite
 
@@ -621,8 +633,12 @@ def fit_ground_plane(
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
     rig = _rig(calib)
     known = np.isfinite(disp) & (disp + rig[4] > 0)
-    if int(known.sum()) < MIN_PIXELS:
-        return None
+    n_known = int(known.sum())
+    if n_known < MIN_PIXELS:
+        return None, (
+            f"ground plane: none found ({n_known} pixels have a disparity; a fit needs "
+            f"{MIN_PIXELS})"
+        )
     vv, uu = np.nonzero(known)
     u, v, d = uu.astype(np.float64), vv.astype(np.float64), disp[known]
     design = np.column_stack([u, v, np.ones_like(u)])
@@ -671,9 +687,13 @@ def fit_ground_plane(
                 continue
             j, k = near_rng.choice(near, 2, replace=False)
             score([i, j, k])
+    no_plane = (
+        f"ground plane: none found (no near-level plane holds {100 * MIN_INLIER_SHARE:.0f} % "
+        "of the pixels)"
+    )
     best = _select_floor(hypotheses, a_s, d_s, pts_s, rig, tol, cos_max, below_weight)
     if best is None:
-        return None
+        return None, no_plane
     # least squares on all pixels (those near the plane: it moves little from the sample's)
     near_px = np.abs(design @ best - d) < 4 * tol
     coef = _refine(best, design[near_px], d[near_px], tol, rig, cos_max)[0]
@@ -681,9 +701,13 @@ def fit_ground_plane(
     share = float(inl.mean())
     normal, height = _plane_3d(coef, rig)
     if share < MIN_INLIER_SHARE or not math.isfinite(height):
-        return None
-    if _narrowest_spread(u[inl], v[inl]) < MIN_SPREAD_SHARE * min(disp.shape):
-        return None  # pixels along a line: the plane turns freely about it
+        return None, no_plane
+    spread, needed = _narrowest_spread(u[inl], v[inl]), MIN_SPREAD_SHARE * min(disp.shape)
+    if spread < needed:  # pixels along a line: the plane turns freely about it
+        return None, (
+            f"ground plane: none found (the likeliest floor's pixels lie along a line, "
+            f"{spread:.1f} px across where a fit needs {needed:.1f} px)"
+        )
     mask = np.zeros(disp.shape, bool)
     mask[vv[inl], uu[inl]] = True
     resid = design[inl] @ coef - d[inl]
@@ -694,7 +718,7 @@ def fit_ground_plane(
     short = design @ coef - d  # > 0: farther along its ray than the floor
     band = min(tol, BELOW_SIGMAS * rms)
     below = float(np.mean((pts @ normal + height < -BELOW_M) & (short > band)))
-    return GroundPlane(
+    plane = GroundPlane(
         normal=normal,
         height=height,
         disparity_plane=(float(coef[0]), float(coef[1]), float(coef[2])),
@@ -703,26 +727,19 @@ def fit_ground_plane(
         rms_px=rms,
         below_share=below,
     )
+    return plane, ""
 
 
 def _no_floor_line(disparity: npt.ArrayLike, calib: Calibration) -> str:
-    """The line for a map :func:`fit_ground_plane` found no floor in, with the reason that holds.
-
-    Under :data:`MIN_PIXELS` disparities the fit is not tried, and "no near-level plane holds
-    3 %" named a reason that was not the one; the pixels are counted as the fit counts them
-    (finite, in front of the camera). ``depth --ground`` and the GUI's Find floor say it.
+    """The line for a map :func:`fit_ground_plane` (default parameters) found no floor in, with
+    the reason that holds: under :data:`MIN_PIXELS` disparities (finite, in front of the
+    camera) no fit is tried; else no near-level plane held :data:`MIN_INLIER_SHARE` of them, or
+    the best one's pixels lay along a line (:data:`MIN_SPREAD_SHARE`). ``depth --ground`` and
+    the GUI's Find floor say it. The fit is run again (the same seed: the same outcome); it
+    costs a fit only where none was found.
     """
-    disp = np.asarray(disparity, np.float64)
-    with np.errstate(invalid="ignore"):
-        known = int(np.count_nonzero(np.isfinite(disp) & (disp + _rig(calib)[4] > 0)))
-    if known < MIN_PIXELS:
-        return (
-            f"ground plane: none found ({known} pixels have a disparity; a fit needs {MIN_PIXELS})"
-        )
-    return (
-        f"ground plane: none found (no near-level plane holds {100 * MIN_INLIER_SHARE:.0f} % "
-        "of the pixels)"
-    )
+    plane, why = _fit_ground(disparity, calib)
+    return why if plane is None else ""
 
 
 def _number(value: object, name: str) -> float:

@@ -682,7 +682,8 @@ def _length(metres: float, unit: str) -> str:
 
 
 #: What :func:`floor_text` says of no floor without the depth result to say why (Find floor
-#: gives it: too few disparities for a fit, or no near-level plane holding the floor's share).
+#: gives it: too few disparities for a fit, no near-level plane holding the floor's share, or
+#: the likeliest floor's pixels along a line).
 NO_FLOOR = "ground plane: none found"
 #: The heights above the floor (metres) that Find floor paints as obstacles.
 OBSTACLE_HEIGHTS = (0.15, 2.0)
@@ -707,8 +708,9 @@ def floor_caption(unit: str = "m") -> str:
 def floor_text(plane: Any, unit: str = "m", result: Any = None) -> str:
     """Find floor's line for a ground plane, its height in ``unit``: ``GroundPlane.describe(unit)``,
     numbers kept with their units. For None (none found) the reason that holds for ``result``'s
-    disparity map, as ``depth --ground`` says it: too few disparities for a fit to be tried, or
-    no near-level plane holding the floor's share (:data:`NO_FLOOR` without a result)."""
+    disparity map, as ``depth --ground`` says it: too few disparities for a fit to be tried,
+    no near-level plane holding the floor's share, or the likeliest floor's pixels along a line
+    (:data:`NO_FLOOR` without a result)."""
     if plane is None:
         if result is None:
             return NO_FLOOR
