@@ -1369,6 +1369,25 @@ def test_occupancy_grid_extent_height_band_and_size() -> None:
         occupancy_grid(box, plane, resolution=0.1, lateral=(-500, 500))
 
 
+@pytest.mark.parametrize(
+    ("forward", "res", "cols"), [((0.0, 2.1), 0.3, 7), ((0.0, 4.9), 0.7, 7), ((0.0, 1.0), 0.3, 4)]
+)
+def test_an_extent_of_whole_cells_has_no_extra_column(
+    forward: tuple[float, float], res: float, cols: int
+) -> None:
+    """2.1 m of 0.3 m cells is 7 columns (and 4.9 m of 0.7 m, 7): the quotient's rounding
+    (7.000000000000001) gave 8, a column past the extent asked for (a map.png reaching 2.4 m);
+    1 m of 0.3 m cells is still 4. A point 0.05 m short of the far end lies in the last
+    column."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    box = _camera_points([(forward[1] - 0.05, 0.0, 0.5)] * 3)
+    grid = occupancy_grid(box, plane, resolution=res, forward=forward, lateral=(-0.3, 0.3))
+    assert grid.data.shape[1] == cols
+    assert grid.data[:, -1].max() == 100
+
+
 def test_laser_scan_beam_count_and_range_min() -> None:
     """-0.3 to 0.3 rad by 0.1 rad is 7 beams (0.6 / 0.1 is 5.999999999999999 in floats: 6
     beams, angle_max 0.2); points nearer than range_min are dropped: the hand-placed beam's

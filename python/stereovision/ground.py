@@ -947,6 +947,14 @@ class OccupancyGrid:
         return png, yml
 
 
+def _cells(extent: float, res: float) -> int:
+    """Cells of side ``res`` covering ``extent`` (metres): a whole number of them when the
+    quotient is one but for rounding (2.1 m / 0.3 m is 7.000000000000001, and ``ceil`` added
+    an eighth column past the extent asked for)."""
+    q = extent / res
+    return round(q) if math.isclose(q, round(q), rel_tol=1e-9) else math.ceil(q)
+
+
 def floor_frame(plane: GroundPlane) -> F64:
     """``(3, 3)`` rows: the floor frame's ``x`` (forward), ``y`` (left), ``z`` (up) axes in the
     camera frame (REP 103).
@@ -1024,7 +1032,7 @@ def occupancy_grid(
         raise ValueError(f"forward: expected (near, far) with far > near, got {forward!r}")
     if not (math.isfinite(y0) and math.isfinite(y1) and y1 > y0):
         raise ValueError(f"lateral: expected (right, left) with left > right, got {lateral!r}")
-    cols, rows = math.ceil((x1 - x0) / res), math.ceil((y1 - y0) / res)
+    cols, rows = _cells(x1 - x0, res), _cells(y1 - y0, res)
     if cols > 4096 or rows > 4096:
         raise ValueError(f"resolution: a {cols} x {rows} grid is over 4096 cells a side")
     lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
