@@ -9,6 +9,7 @@ import math
 import re
 import subprocess
 import sys
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -1437,6 +1438,22 @@ def test_a_bad_seed_is_named(seed: object) -> None:
         ValueError, match=re.escape(f"seed: expected an integer >= 0, got {seed!r}")
     ):
         fit_ground_plane(_floor_disparity(12.0, FLAT), RIG, seed=seed)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("seed", [np.int64(2**63 - 1), np.uint64(2**64 - 1)])
+def test_the_largest_numpy_seeds_are_their_values(seed: np.integer) -> None:
+    """A floor under a fifth of the pixels takes the second search, seeded ``seed + 1``: of
+    np.int64(2**63 - 1) that wrapped to a negative seed and NumPy raised "expected
+    non-negative integer" (naming no argument), of np.uint64(2**64 - 1) to seed 0 with an
+    overflow warning. Both now give the plane of the same seed as a Python int."""
+    disp = np.random.default_rng(0).uniform(1.0, 40.0, (SIZE[1], SIZE[0]))
+    disp[300:] = _exact_floor(RIG)[300:]  # a band of floor under a sea of noise: 17 %
+    want = fit_ground_plane(disp, RIG, seed=int(seed))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = fit_ground_plane(disp, RIG, seed=seed)
+    assert got is not None and want is not None
+    assert got.disparity_plane == want.disparity_plane
 
 
 @pytest.mark.parametrize(

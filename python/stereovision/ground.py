@@ -673,7 +673,9 @@ def _fit_ground(
     for _ in range(RANSAC_ITERATIONS):
         best_count = max(best_count, score(rng.choice(len(d_s), 3, replace=False)))
     if best_count < LOCAL_SHARE * len(d_s):
-        near_rng = np.random.default_rng(seed + 1)
+        # a Python int: np.int64(2**63 - 1) + 1 wrapped to a negative seed (NumPy's "expected
+        # non-negative integer", naming no argument), np.uint64's largest to 0 with a warning
+        near_rng = np.random.default_rng(int(seed) + 1)
         # the sample's pixels by cell of a LOCAL_WINDOW x LOCAL_WINDOW grid over the image
         gx = np.minimum((a_s[:, 0] * LOCAL_WINDOW / disp.shape[1]).astype(int), LOCAL_WINDOW - 1)
         gy = np.minimum((a_s[:, 1] * LOCAL_WINDOW / disp.shape[0]).astype(int), LOCAL_WINDOW - 1)
