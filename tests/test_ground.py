@@ -1124,6 +1124,20 @@ def test_occupancy_grid_files_as_map_server_reads_them(tmp_path: Path) -> None:
     assert (float(fields["occupied_thresh"]), float(fields["free_thresh"])) == (0.65, 0.196)
 
 
+def test_a_grid_of_numpy_scalars_saves_plain_numbers(tmp_path: Path) -> None:
+    """An OccupancyGrid made by hand with NumPy scalars (a resolution or origin computed with
+    NumPy) wrote their reprs into map.yaml: 'resolution: np.float64(0.05)' and 'origin:
+    [np.float64(1.5), ...]', which map_server cannot read. The YAML holds plain numbers."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(
+        np.zeros((2, 3), np.int8), np.float64(0.05), (np.float64(1.5), np.float64(-0.05))
+    )
+    fields = dict(line.split(": ", 1) for line in grid.save(tmp_path)[1].read_text().splitlines())
+    assert fields["resolution"] == "0.05"
+    assert fields["origin"] == "[1.5, -0.05, 0.0]"
+
+
 def _camera_points(floor_xyh: list[tuple[float, float, float]]) -> np.ndarray:
     """Points given on _level_floor's floor frame (x forward, y left, height) in the camera
     frame (X right, Y down, Z forward; the camera 1 m above the floor)."""

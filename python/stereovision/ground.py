@@ -938,9 +938,11 @@ class OccupancyGrid:
         ok, buf = cv2.imencode(".png", self.image())
         if not ok:
             raise RuntimeError("could not encode the occupancy grid as PNG")
+        # float(): a NumPy scalar's repr is "np.float64(0.05)", which map_server cannot read
+        res, x0, y0 = (float(v) for v in (self.resolution, *self.origin))
         text = (
-            f"image: {png.name}\nmode: trinary\nresolution: {self.resolution!r}\n"
-            f"origin: [{self.origin[0]!r}, {self.origin[1]!r}, 0.0]\nnegate: 0\n"
+            f"image: {png.name}\nmode: trinary\nresolution: {res!r}\n"
+            f"origin: [{x0!r}, {y0!r}, 0.0]\nnegate: 0\n"
             "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
         )
         from stereovision.io import write_together
