@@ -1138,6 +1138,21 @@ def test_a_grid_of_numpy_scalars_saves_plain_numbers(tmp_path: Path) -> None:
     assert fields["origin"] == "[1.5, -0.05, 0.0]"
 
 
+def test_a_plane_of_float32_figures_is_json_ready() -> None:
+    """GroundPlane.as_dict() is "JSON-ready", but of a plane made by hand of float32 figures
+    (read back from a float32 array) it handed json.dumps float32 values: TypeError 'Object of
+    type float32 is not JSON serializable'. The figures are Python floats of the same values."""
+    f32 = np.float32
+    plane = GroundPlane(
+        normal=np.array([0.0, -1.0, 0.0], np.float32), height=f32(1.25),
+        disparity_plane=(f32(0.0), f32(0.5), f32(-60.0)), inliers=np.zeros((2, 2), bool),
+        inlier_share=f32(0.5), rms_px=f32(0.25), below_share=f32(0.0),
+    )  # fmt: skip
+    back = json.loads(json.dumps(plane.as_dict()))
+    assert back["height_m"] == 1.25 and back["disparity_plane"] == [0.0, 0.5, -60.0]
+    assert (back["inlier_share"], back["rms_px"], back["below_share"]) == (0.5, 0.25, 0.0)
+
+
 def _camera_points(floor_xyh: list[tuple[float, float, float]]) -> np.ndarray:
     """Points given on _level_floor's floor frame (x forward, y left, height) in the camera
     frame (X right, Y down, Z forward; the camera 1 m above the floor)."""

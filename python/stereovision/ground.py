@@ -311,15 +311,16 @@ class GroundPlane:
             ``normal``, ``height_m``, ``pitch_deg``, ``roll_deg``, ``disparity_plane``,
             ``inlier_share``, ``rms_px``, ``below_share`` and ``camera_in_floor`` (4 x 4 rows).
         """
+        # float(): a plane made by hand of float32 figures went to json.dumps as a TypeError
         return {
             "normal": [float(v) for v in self.normal],
-            "height_m": self.height,
+            "height_m": float(self.height),
             "pitch_deg": self.pitch_deg,
             "roll_deg": self.roll_deg,
-            "disparity_plane": list(self.disparity_plane),
-            "inlier_share": self.inlier_share,
-            "rms_px": self.rms_px,
-            "below_share": self.below_share,
+            "disparity_plane": [float(v) for v in self.disparity_plane],
+            "inlier_share": float(self.inlier_share),
+            "rms_px": float(self.rms_px),
+            "below_share": float(self.below_share),
             "camera_in_floor": self.camera_in_floor().tolist(),
         }
 
