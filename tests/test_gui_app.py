@@ -1554,7 +1554,23 @@ def test_find_floor_says_why_no_floor_was_found(data_dir):
     res = app.view.result
     disparity = res.disparity.copy()
     res.disparity[:] = np.nan  # nothing matched: no fit is tried
-    _run(app, app.find_floor)
+    import threading
+
+    from stereovision import ground
+
+    fit, threads = ground._fit_ground, []
+
+    def spy(*args, **kwargs):
+        threads.append(threading.current_thread())
+        return fit(*args, **kwargs)
+
+    ground._fit_ground = spy
+    try:
+        _run(app, app.find_floor)
+    finally:
+        ground._fit_ground = fit
+    # the line saying why runs the fit again: in the executor too, never on the page's loop
+    assert len(threads) == 2 and threading.main_thread() not in threads
     assert app.state.error == ""
     assert app.state.floor_label == (
         f"ground plane: none found (0 pixels have a disparity; a fit needs {MIN_PIXELS})"

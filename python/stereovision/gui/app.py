@@ -2715,11 +2715,14 @@ class StereoApp:
                 self.state.floor_label = f"finding the floor needs a calibration ({why})"
             return
 
-        def run() -> tuple[Any, str]:
-            return floor_view(res)
+        def run() -> tuple[Any, str, str]:
+            plane, url = floor_view(res)
+            # why none: its line runs the fit again (ground._no_floor_line), so here, not on
+            # the page's loop
+            return plane, url, floor_text(None, "m", res) if plane is None else ""
 
         try:
-            plane, url = await asyncio.get_running_loop().run_in_executor(self._executor, run)
+            plane, url, why = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError) as exc:
             if self.view is view and self._page_before is None:
                 self._fail(exc)
@@ -2731,7 +2734,7 @@ class StereoApp:
         self._done()
         view.floor = plane
         with self.state:
-            self.state.floor_label = floor_text(plane, self._unit, res)
+            self.state.floor_label = why if plane is None else floor_text(plane, self._unit, res)
             self.state.img_floor = url
 
     def save_clicked(self, folder: str | None = None) -> None:
