@@ -393,6 +393,18 @@ def test_k_beyond_64_bits() -> None:
         TemporalFilter(k=10**400)
 
 
+def test_filters_compare_and_hash_by_identity() -> None:
+    """Two filters that had each seen a pair: ``a == b`` compared their running means' arrays
+    and raised NumPy's 'truth value of an array ... is ambiguous', and a filter could not go in
+    a set or key a dict. A filter is equal to itself only, and hashable."""
+    img = np.random.default_rng(0).integers(0, 255, (20, 20), dtype=np.uint8)
+    a, b = TemporalFilter(), TemporalFilter()
+    a(img, img)
+    b(img, img)
+    assert a == a and a != b
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2
+
+
 @pytest.mark.parametrize("k", [1e38, 2**130, 1e300])
 def test_a_k_past_float32_averages_as_a_large_one(data_dir: Path, k: float) -> None:
     """The kernel takes ``k * sigma`` as float32: a k the constructor accepts (1e38, 2**130,

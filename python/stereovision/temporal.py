@@ -220,7 +220,10 @@ class _Mean:
     count: npt.NDArray[np.uint8]
 
 
-@dataclass
+# eq=False: == and hash by identity. The generated == compared the running means' arrays and
+# raised NumPy's "truth value of an array ... is ambiguous" once a pair was seen (and left the
+# filter unhashable).
+@dataclass(eq=False)
 class TemporalFilter:
     """Running mean of a still stereo rig's frames (see the module doc); call it on each pair.
 
