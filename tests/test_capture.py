@@ -2877,6 +2877,36 @@ def test_capture_refuses_a_count_or_every_below_one(tmp_path: Path) -> None:
     assert not (tmp_path / "pairs").exists()
 
 
+def test_capture_refuses_a_count_or_every_that_is_no_whole_number(tmp_path: Path) -> None:
+    """count=2.5 saved 3 pairs, count=nan none ("count reached", at once), count=True one;
+    every=nan saved no pair to the end of the source, every=2.5 every fifth. Each is refused
+    before any read; a whole float (3.0) is still its integer."""
+    nan = float("nan")
+    for kw, said in (
+        ({"count": 2.5}, "count: expected a positive number of pairs, got 2.5"),
+        ({"count": nan}, "count: expected a positive number of pairs, got nan"),
+        (
+            {"count": np.float64(nan)},
+            "count: expected a positive number of pairs, got np.float64(nan)",
+        ),
+        ({"count": True}, "count: expected a positive number of pairs, got True"),
+        ({"count": "2"}, "count: expected a positive number of pairs, got '2'"),
+        ({"every": 2.5}, "every: expected a positive integer, got 2.5"),
+        ({"every": nan}, "every: expected a positive integer, got nan"),
+        ({"every": np.True_}, "every: expected a positive integer, got np.True_"),
+        ({"every": "2"}, "every: expected a positive integer, got '2'"),
+    ):
+        with StereoCamera(_FakeCap("L", [], frames=6), _FakeCap("R", [], frames=6)) as cam:
+            with pytest.raises(ValueError) as err:
+                capture(cam, tmp_path / "pairs", **kw)  # type: ignore[arg-type]
+            assert str(err.value) == said and cam.count == 0  # nothing read
+    assert not (tmp_path / "pairs").exists()
+    with StereoCamera(_FakeCap("L", [], frames=6), _FakeCap("R", [], frames=6)) as cam:
+        res = capture(cam, tmp_path / "pairs", count=3.0, every=2.0)  # type: ignore[arg-type]
+    assert [p[0].name for p in res.saved] == ["left_0001.png", "left_0002.png", "left_0003.png"]
+    assert res.frames_read == 5  # pairs 0, 2 and 4
+
+
 def test_source_errors_keep_their_attributes_when_reworded_or_pickled() -> None:
     import pickle
 

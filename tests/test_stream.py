@@ -1696,8 +1696,31 @@ def _frame(index: int, t_left: float | None = None, t_right: float | None = None
 
 def test_run_stream_refuses_no_frames() -> None:
     """frames=0 (nothing to do) is a usage error, as a negative count is."""
-    with pytest.raises(ValueError, match="frames: expected a positive number, got 0"):
+    with pytest.raises(ValueError, match="frames: expected a positive number of pairs, got 0"):
         run_stream(_FakeRig([_frame(0)]), max_disparity=8, frames=0)  # type: ignore[arg-type]
+
+
+def test_run_stream_refuses_counts_that_are_no_whole_number() -> None:
+    """frames=nan matched no pair and said "end of stream", frames=2.5 matched 3 and
+    frames=True one; check_every=2.5 checked pairs 0, 5, 10. Each is refused before any grab
+    now; a whole float (2.0) is still its integer."""
+    nan = float("nan")
+    for kw, said in (
+        ({"frames": nan}, "frames: expected a positive number of pairs, got nan"),
+        ({"frames": 2.5}, "frames: expected a positive number of pairs, got 2.5"),
+        ({"frames": True}, "frames: expected a positive number of pairs, got True"),
+        ({"frames": "2"}, "frames: expected a positive number of pairs, got '2'"),
+        ({"check_every": 2.5}, "check_every: expected a positive number of pairs, got 2.5"),
+        ({"check_every": nan}, "check_every: expected a positive number of pairs, got nan"),
+        ({"ground_every": 2.5}, "ground_every: expected a positive number of pairs, got 2.5"),
+    ):
+        rig = _FakeRig([_frame(i) for i in range(4)])
+        with pytest.raises(ValueError) as err:
+            run_stream(rig, max_disparity=8, check=False, **kw)  # type: ignore[arg-type]
+        assert str(err.value) == said and rig.count == 0
+    rig = _FakeRig([_frame(i) for i in range(4)])
+    rep = run_stream(rig, max_disparity=8, pipelined=False, check=False, frames=2.0)  # type: ignore[arg-type]
+    assert (rep.frames, rep.ended, rig.count) == (2, "frames", 2)
 
 
 def test_a_first_pair_that_does_not_decode_is_a_value_error() -> None:

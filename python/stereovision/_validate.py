@@ -43,6 +43,7 @@ __all__ = [
     "float_sized",
     "int_in_range",
     "positive_finite",
+    "positive_whole",
     "xy_points",
 ]
 
@@ -739,6 +740,41 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
         ok = False
     if not ok:
         raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {_shown(value)}")
+    return int(value)  # type: ignore[call-overload]
+
+
+def positive_whole(value: object, name: str, expected: str = "a positive integer") -> int:
+    """``value`` as an ``int`` above 0: an integer (not a bool) or a finite whole float
+    (``3.0``).
+
+    Parameters
+    ----------
+    value : object
+        The count given (pairs to take, a period in pairs).
+    name : str
+        Its keyword, named in the error.
+    expected : str
+        What it should be, in the error's words (``"a positive number of pairs"``).
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError
+        ``"NAME: expected EXPECTED, got VALUE"`` for a bool, a non-number, a NaN, an infinity,
+        a fraction (2.5 pairs were taken as 3, NaN as none) or a number below 1.
+    """
+    ok = not isinstance(value, (bool, np.bool_, np.timedelta64))
+    if ok and isinstance(value, (int, np.integer)):
+        ok = int(value) > 0
+    elif ok and isinstance(value, (float, np.floating)):
+        ok = bool(math.isfinite(value) and value == math.floor(value) and value > 0)
+    else:
+        ok = False
+    if not ok:
+        raise ValueError(f"{name}: expected {expected}, got {_shown(value)}")
     return int(value)  # type: ignore[call-overload]
 
 

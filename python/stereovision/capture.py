@@ -55,7 +55,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import renamed_keyword, source_warning
+from stereovision._validate import positive_whole, renamed_keyword, source_warning
 from stereovision.calibrate import (
     DEFAULT_READ_TIMEOUT,
     POSE_PARAM_NAMES,
@@ -2780,10 +2780,10 @@ def capture(
     PermissionError
         If ``directory`` cannot be written.
     """
-    if count is not None and count <= 0:
-        raise ValueError(f"count: expected a positive number of pairs, got {count!r}")
-    if every <= 0:
-        raise ValueError(f"every: expected a positive integer, got {every!r}")
+    # 2.5 saved 3 pairs and NaN none ("count reached"); every=NaN saved none to the end
+    if count is not None:
+        count = positive_whole(count, "count", "a positive number of pairs")
+    every = positive_whole(every, "every")
     check_read_timeout(read_timeout)
     if chessboard and charuco is not None:
         raise ValueError("chessboard and charuco: give one calibration target, not both")

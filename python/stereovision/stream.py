@@ -39,7 +39,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import HELD_WARNINGS, first_line, user_stacklevel
+from stereovision._validate import HELD_WARNINGS, first_line, positive_whole, user_stacklevel
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
@@ -867,8 +867,9 @@ def run_stream(
     """
     from stereovision.depth import METHODS, depth_map, estimate_max_disparity
 
-    if frames is not None and frames <= 0:
-        raise ValueError(f"frames: expected a positive number, got {frames}")
+    # NaN matched no pair ("end of stream"), 2.5 three and True one
+    if frames is not None:
+        frames = positive_whole(frames, "frames", "a positive number of pairs")
     check_read_timeout(read_timeout)
     if homographies is not None:
         if calib is not None:
@@ -879,13 +880,10 @@ def run_stream(
     # usage errors before the first grab (the read ahead below takes a pair off the camera)
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
-    if check_every is not None and (isinstance(check_every, bool) or check_every <= 0):
-        raise ValueError(f"check_every: expected a positive number of pairs, got {check_every}")
+    if check_every is not None:  # 2.5 checked pairs 0, 5, 10
+        check_every = positive_whole(check_every, "check_every", "a positive number of pairs")
     if ground_every is not None:
-        if isinstance(ground_every, bool) or ground_every <= 0:
-            raise ValueError(
-                f"ground_every: expected a positive number of pairs, got {ground_every}"
-            )
+        ground_every = positive_whole(ground_every, "ground_every", "a positive number of pairs")
         if calib is None:
             raise ValueError("ground_every: the floor is found in metres; give a calibration")
     stopped: str | None = None  # Ctrl-C or SIGTERM while the first pair was read ahead
