@@ -2214,6 +2214,38 @@ def test_the_live_view_is_given_every_pair(
     assert "serving the live view on http://127.0.0.1:" in capsys.readouterr().err
 
 
+def test_the_view_shows_a_left_image_with_alpha_or_of_16_bits() -> None:
+    """An image sequence of PNGs with alpha (a renderer's) or of 16 bits, or a mono16 bag,
+    hands the stream such left images: the view's hstack with the 3-channel colour map raised
+    in the server's thread (the client's connection closed without a response, a traceback on
+    stderr, for every frame), and a 16-bit image was clipped to white in the JPEG. Each is
+    shown as the 8-bit BGR image it stands for now (16 bits divided by 257)."""
+    from stereovision.stream import _compose
+
+    disp = np.full((4, 4), 8.0, np.float32)
+    colour = _compose(np.zeros((4, 4, 3), np.uint8), disp, 16.0)[:, 4:]
+    for left, shown in (
+        (np.full((4, 4, 4), (30, 120, 200, 0), np.uint8), (30, 120, 200)),
+        (np.full((4, 4, 3), (30 * 257, 120 * 257, 200 * 257), np.uint16), (30, 120, 200)),
+        (np.full((4, 4), 120 * 257, np.uint16), (120, 120, 120)),
+        (np.full((4, 4, 1), 120, np.uint8), (120, 120, 120)),
+        (np.full((4, 4, 3), (0.5, 0.0, 1.0), np.float32), (128, 0, 255)),  # floats in [0, 1]
+    ):
+        img = _compose(left, disp, 16.0)
+        assert img.dtype == np.uint8 and img.shape == (4, 8, 3)
+        assert (img[:, :4] == shown).all() and (img[:, 4:] == colour).all()
+    srv = FrameServer("127.0.0.1", 0)
+    try:
+        left = np.full((48, 64, 4), (30, 120, 200, 0), np.uint8)
+        srv.update(left, np.full((48, 64), 8.0, np.float32), 16.0)
+        status, ctype, body = _get(srv.url + "frame.jpg")
+        assert status == 200 and ctype == "image/jpeg"
+        img = cv2.imdecode(np.frombuffer(body, np.uint8), cv2.IMREAD_COLOR)
+        assert np.abs(img[8:40, 8:56].astype(int) - (30, 120, 200)).max() < 12
+    finally:
+        srv.close()
+
+
 def test_the_view_colours_the_whole_range_and_waits_for_a_new_frame() -> None:
     """A disparity at or above the top of the range is the colour map's end, not black; a
     client that has the latest frame waits for the next one (None and its own number after

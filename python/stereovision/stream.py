@@ -261,7 +261,22 @@ def _compose(left: np.ndarray, disparity: np.ndarray, max_disparity: float) -> n
     u8 = np.clip(np.nan_to_num(disparity, nan=0.0) * (255.0 / max(max_disparity, 1.0)), 0, 255)
     colour = cv2.applyColorMap(u8.astype(np.uint8), cv2.COLORMAP_TURBO)
     colour[~finite] = 0
-    return np.hstack([left, colour])
+    return np.hstack([_view_bgr(left), colour])
+
+
+def _view_bgr(img: np.ndarray) -> np.ndarray:
+    """``img`` as the 8-bit BGR image the JPEG view shows: an image sequence's PNGs with alpha
+    or of 16 bits (a mono16 bag's too) reach the stream as they are, and their hstack with the
+    colour map raised in the server's thread (alpha), or the JPEG clipped them to white."""
+    if img.dtype == np.uint16:  # 0-65535 as 0-255, rounded, as as_bgr_uint8 does
+        img = ((img.astype(np.uint32) + 128) // 257).astype(np.uint8)
+    elif img.dtype != np.uint8:  # floats in [0, 1]
+        img = np.clip(np.rint(np.nan_to_num(img * 255.0)), 0, 255).astype(np.uint8)
+    if img.ndim == 2:
+        img = img[:, :, None]
+    if img.shape[2] == 1:
+        return np.repeat(img, 3, axis=2)
+    return img[:, :, :3]  # BGRA: without its alpha
 
 
 class FrameServer:
