@@ -1102,6 +1102,36 @@ def board_videos(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     return left, right
 
 
+def test_a_16_bit_or_alpha_sequence_is_searched_for_the_board(tmp_path: Path) -> None:
+    """An image sequence is read as its files are (16-bit PNGs of a machine-vision camera stay
+    16-bit): the chessboard mode's live detection gave them to findChessboardCorners, whose
+    cv2.error came out raw ("internal error ... please report this" from the CLI). They are
+    searched as 8-bit grey now, as calibrate and the ChArUco mode search them."""
+    board = _board(POSE_A, 0, False)
+    want = detect_board_live(board, (9, 6))
+    assert want is not None
+    grey = cv2.cvtColor(board, cv2.COLOR_BGR2GRAY)
+    for img in (
+        board.astype(np.uint16) * 257,
+        grey.astype(np.uint16) * 257,
+        grey[:, :, None],
+        cv2.cvtColor(board, cv2.COLOR_BGR2BGRA),
+    ):
+        got = detect_board_live(img, (9, 6))
+        assert got is not None and np.abs(got - want).max() < 0.5
+    d = tmp_path / "seq"
+    d.mkdir()
+    for i, pose in enumerate((POSE_A, POSE_B)):
+        for side, right in (("left", False), ("right", True)):
+            img = cv2.cvtColor(_board(pose, i, right), cv2.COLOR_BGR2GRAY).astype(np.uint16)
+            assert cv2.imwrite(str(d / f"{side}_{i:03d}.png"), img * 257)
+    with StereoCamera(str(d / "left_%03d.png"), str(d / "right_%03d.png")) as cam:
+        res = capture(cam, tmp_path / "pairs", chessboard=(9, 6))
+    assert len(res.saved) == 2 and res.ended == "end of stream"
+    saved = cv2.imread(str(res.saved[1][0]), cv2.IMREAD_UNCHANGED)
+    assert saved.dtype == np.uint16  # saved as delivered
+
+
 def test_test_poses_are_distinct_enough() -> None:
     """The video's design: A, B, C, D seen whole by both cameras (the stamp included), pairwise
     further apart than the ROS threshold."""

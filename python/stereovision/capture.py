@@ -2510,13 +2510,24 @@ def save_pair(
 def detect_board_live(image: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | None:
     """Fast board detection for a live stream (scaled to <= :data:`DETECT_MAX_WIDTH`).
 
+    Parameters
+    ----------
+    image : numpy.ndarray
+        Grey, BGR or BGRA; ``uint8``, ``uint16`` or float in [0, 1] (searched as 8-bit grey).
+    pattern : tuple of int
+        Inner corners ``(cols, rows)``.
+
     Returns
     -------
     numpy.ndarray or None
         ``(cols * rows, 2)`` corners in full-resolution pixels (about 1 px accurate: for choosing
         views, not for calibrating), or None.
     """
-    gray = np.asarray(image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY))
+    from stereovision._validate import as_gray_uint8
+
+    # 8-bit grey, as calibrate and the ChArUco mode search: an image sequence's 16-bit PNGs
+    # came as they are, and findChessboardCorners' cv2.error on them came out raw
+    gray = as_gray_uint8(image, "image")
     scale = min(1.0, DETECT_MAX_WIDTH / gray.shape[1])
     small = gray
     if scale < 1.0:
