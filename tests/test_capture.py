@@ -1132,6 +1132,26 @@ def test_a_16_bit_or_alpha_sequence_is_searched_for_the_board(tmp_path: Path) ->
     assert saved.dtype == np.uint16  # saved as delivered
 
 
+def test_a_sequence_with_alpha_is_delivered_as_bgr(tmp_path: Path) -> None:
+    """An image sequence is read as its files are: PNGs with alpha (a renderer's) came as
+    4-channel frames where a pair's frames are BGR, which a right sequence without alpha (or a
+    one-channel image) could not be paired with: ``--temporal`` refused "left and right differ
+    in shape: (40, 60, 4) and (40, 60, 3)", and capture saved 4-channel images. Alpha is
+    dropped now, as a grey frame is made BGR; the pixels are kept."""
+    d = tmp_path / "seq"
+    d.mkdir()
+    for i in range(3):
+        bgr = _numbered(i, (60, 40))
+        assert cv2.imwrite(str(d / f"left_{i:03d}.png"), cv2.cvtColor(bgr, cv2.COLOR_BGR2BGRA))
+        assert cv2.imwrite(str(d / f"right_{i:03d}.png"), bgr)
+    with StereoCamera(str(d / "left_%03d.png"), str(d / "right_%03d.png")) as cam:
+        pairs = list(cam.frames())
+    assert len(pairs) == 3
+    for i, fr in enumerate(pairs):
+        assert fr.left.shape == fr.right.shape == (40, 60, 3)
+        assert (fr.left == _numbered(i, (60, 40))).all() and (fr.left == fr.right).all()
+
+
 def test_test_poses_are_distinct_enough() -> None:
     """The video's design: A, B, C, D seen whole by both cameras (the stamp included), pairwise
     further apart than the ROS threshold."""

@@ -377,7 +377,8 @@ class StereoFrame:
     Attributes
     ----------
     left, right : numpy.ndarray
-        The frames (BGR ``uint8``, resized to the camera's output size if needed).
+        The frames (BGR ``uint8``, resized to the camera's output size if needed; an image
+        sequence's 16-bit images stay ``uint16``).
     t_left, t_right : float
         Host time (``time.monotonic()``, seconds) at which each grab returned.
     index : int
@@ -1926,8 +1927,10 @@ class StereoCamera(PairSource):
             ok, img = got[side]
             if not ok or img is None:
                 raise self._fail(side, "could not decode a frame")
-            if img.ndim == 2:
+            if img.ndim == 2 or img.shape[2] == 1:
                 img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+            elif img.shape[2] == 4:  # an image sequence's PNGs with alpha: BGR as the rest
+                img = cv2.cvtColor(img, cv2.COLOR_BGRA2BGR)
             delivered[side] = img
             frames[side] = self._fit(side, img)
         resized = any(frames[side] is not delivered[side] for side in frames)
