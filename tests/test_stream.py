@@ -1723,6 +1723,24 @@ def test_run_stream_refuses_counts_that_are_no_whole_number() -> None:
     assert (rep.frames, rep.ended, rig.count) == (2, "frames", 2)
 
 
+def test_run_stream_refuses_a_report_period_that_is_no_number_of_seconds() -> None:
+    """report_period="1" raised TypeError from the loop once the first pair was matched (a pair
+    taken off the camera); NaN gave no report but the last, -1 one per pair as 0 does. Each is
+    refused before any grab now; 0 (a report per pair) and inf (the last alone) still work."""
+    for period in (float("nan"), -1, "1", True, None):
+        rig = _FakeRig([_frame(i) for i in range(3)])
+        with pytest.raises(ValueError) as err:
+            run_stream(rig, max_disparity=8, pipelined=False, check=False, report_period=period)  # type: ignore[arg-type]
+        assert str(err.value) == (
+            f"report_period: expected a number of seconds >= 0, got {period!r}"
+        )
+        assert rig.count == 0
+    for period, reports in ((0.0, 3), (float("inf"), 1)):
+        rig = _FakeRig([_frame(i) for i in range(3)])
+        rep = run_stream(rig, max_disparity=8, pipelined=False, check=False, report_period=period)  # type: ignore[arg-type]
+        assert (rep.frames, len(rep.reports)) == (3, reports)
+
+
 def test_a_first_pair_that_does_not_decode_is_a_value_error() -> None:
     """A recording's first frame that does not decode raises its ValueError as it is; only a
     later one becomes the source failing (SourceError, the stream's summary)."""

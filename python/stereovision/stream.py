@@ -827,7 +827,7 @@ def run_stream(
         stamps step by its frame period), not when its depth was done (a live frame's latency
         later): the time to stamp messages for TF and odometry with.
     report_period : float
-        Seconds between reports.
+        Seconds between reports (0: one per pair; inf: the last, partial one alone).
     check : bool
         Check that the first (rectified) pair's features lie on common rows
         (:func:`~stereovision.rectification_check.check_rectification`, 35-480 ms) and warn
@@ -886,6 +886,13 @@ def run_stream(
     if frames is not None:
         frames = positive_whole(frames, "frames", "a positive number of pairs")
     check_read_timeout(read_timeout)
+    # "1" raised TypeError in the loop after a pair was taken; NaN gave no report but the last
+    if (
+        isinstance(report_period, (bool, np.bool_))
+        or not isinstance(report_period, (int, float, np.integer, np.floating))
+        or not report_period >= 0
+    ):
+        raise ValueError(f"report_period: expected a number of seconds >= 0, got {report_period!r}")
     if homographies is not None:
         if calib is not None:
             raise ValueError("homographies and calib: give one way to rectify the pairs")
