@@ -2957,6 +2957,27 @@ def test_capture_refuses_a_count_or_every_that_is_no_whole_number(tmp_path: Path
     assert res.frames_read == 5  # pairs 0, 2 and 4
 
 
+def test_an_integer_beyond_a_float_is_refused_by_name(tmp_path: Path) -> None:
+    """A Python int beyond a float's range (10**400) as a size side, a timeout or a rate
+    raised math.isfinite's OverflowError ("int too large to convert to float"), naming
+    nothing; each is refused as too large for what it is now, before any open."""
+    from stereovision.capture import check_read_timeout
+
+    big = 10**400
+    with pytest.raises(ValueError, match=r"^image_size: at most 16384 px per side, got 1000"):
+        parse_size((big, 480), "image_size")
+    for name in ("read_timeout", "open_timeout"):
+        with pytest.raises(
+            ValueError, match=rf"^{name}: expected at most [\d.e+]+ seconds .*got 1000"
+        ):
+            check_read_timeout(big, name)  # type: ignore[arg-type]
+    missing = str(tmp_path / "none.avi")  # refused before the open: no FileNotFoundError
+    with pytest.raises(ValueError, match=r"^fps: an integer of 401 digits is beyond a float's"):
+        StereoCamera(missing, missing, fps=big)
+    with pytest.raises(ValueError, match=r"^open_timeout: expected at most"):
+        StereoCamera(missing, missing, open_timeout=big)
+
+
 def test_source_errors_keep_their_attributes_when_reworded_or_pickled() -> None:
     import pickle
 

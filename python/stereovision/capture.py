@@ -55,7 +55,12 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import positive_whole, renamed_keyword, source_warning
+from stereovision._validate import (
+    float_sized,
+    positive_whole,
+    renamed_keyword,
+    source_warning,
+)
 from stereovision.calibrate import (
     DEFAULT_READ_TIMEOUT,
     POSE_PARAM_NAMES,
@@ -309,8 +314,8 @@ def parse_size(text: str | tuple[int, int] | None, name: str = "size") -> tuple[
         whole = len(items) == 2 and all(
             not isinstance(v, (bool, np.bool_))
             and isinstance(v, (int, float, np.integer, np.floating))
-            and math.isfinite(v)
-            and float(v).is_integer()
+            # an int as it is: math.isfinite(10**400) raised OverflowError, naming nothing
+            and (isinstance(v, (int, np.integer)) or (math.isfinite(v) and float(v).is_integer()))
             for v in items
         )
         vals = (int(items[0]), int(items[1])) if whole else (0, 0)
@@ -583,7 +588,9 @@ def check_read_timeout(timeout: float | None, name: str = "read_timeout") -> Non
     # inf (meant as no limit) passed, then overflowed the wait ("timestamp out of range for
     # platform time_t"); True passed as 1 s
     if timeout is not None and (
-        isinstance(timeout, (bool, np.bool_)) or not (timeout > 0 and math.isfinite(timeout))
+        isinstance(timeout, (bool, np.bool_))
+        # an int as it is: math.isfinite(10**400) raised OverflowError (said below as too long)
+        or not (timeout > 0 and (isinstance(timeout, (int, np.integer)) or math.isfinite(timeout)))
     ):
         raise ValueError(
             f"{name}: expected a positive number of seconds (None: no limit), got {timeout!r}"
@@ -1555,6 +1562,7 @@ class StereoCamera(PairSource):
         self.sources = {"left": left, "right": right}
         self.requested_size = parse_size(image_size, "image_size")
         # True was taken as 1 fps, and "30" gave math's TypeError
+        float_sized(fps, "fps")  # 10**400: math.isfinite's OverflowError, naming nothing
         if fps is not None and (
             isinstance(fps, (bool, np.bool_))
             or not isinstance(fps, (int, float, np.integer, np.floating))
