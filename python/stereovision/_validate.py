@@ -217,6 +217,14 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
 #: read the float grey image, all of its bits.
 LOW_UINT16_MAX = 4096
 
+#: The error of a depth-only request on a result computed without a calibration, ``{what}``
+#: naming what was asked for: :class:`~stereovision.depth.DepthResult`'s and the exporters'
+#: (:mod:`stereovision.export`) say it alike, with the same hint.
+NO_DEPTH = (
+    "no {what}: depth_map was called without a calibration (or with an "
+    "UncalibratedRectification, which has no metric scale); pass calib=Calibration.from_file(...)"
+)
+
 #: Library warnings' and errors' advice in the words of where they are shown: the Python API's,
 #: as raised (an array to scale, ``calib=``), the command line's (files and options; cli.py's
 #: warning hook and error line) and the GUI page's (its fields and buttons). :func:`advice_for`

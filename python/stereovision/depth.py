@@ -27,6 +27,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     ADVICE,
+    NO_DEPTH,
     _real_array,
     as_bgr_uint8,
     as_gray_float,
@@ -522,12 +523,6 @@ def _coarse_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float |
     return float(np.percentile(d, _AUTO_COARSE_PERCENTILE)) * s
 
 
-_NO_DEPTH = (
-    "no {what}: depth_map was called without a calibration (or with an "
-    "UncalibratedRectification, which has no metric scale); pass calib=Calibration.from_file(...)"
-)
-
-
 class DepthChannels(ChannelOutputs, total=False):
     """Each channel's own output, :attr:`DepthResult.channels` (``return_channels=True``).
 
@@ -735,7 +730,7 @@ class DepthResult:
             A result without depth (no calibration).
         """
         if self.depth is None:
-            raise ValueError(_NO_DEPTH.format(what="depth"))
+            raise ValueError(NO_DEPTH.format(what="depth"))
         return self.depth
 
     def require_depth_sigma(self) -> npt.NDArray[np.float32]:
@@ -752,7 +747,7 @@ class DepthResult:
             A result without depth (no calibration).
         """
         if self.depth_sigma is None:
-            raise ValueError(_NO_DEPTH.format(what="depth uncertainty"))
+            raise ValueError(NO_DEPTH.format(what="depth uncertainty"))
         return self.depth_sigma
 
     def depth_in(self, unit: str = "m") -> npt.NDArray[np.float32]:
@@ -855,7 +850,7 @@ class DepthResult:
             # "no" (true) gave the filled pixels, None (false) left them out, without a word
             raise TypeError(f"filled: expected True or False, got {filled!r}")
         if self.depth is None or self.calibration is None:
-            raise ValueError(_NO_DEPTH.format(what="3-D points"))
+            raise ValueError(NO_DEPTH.format(what="3-D points"))
         pts = self.calibration.reproject(self.disparity)
         keep = np.isfinite(self.depth)
         lim = self.limits
@@ -909,7 +904,7 @@ class DepthResult:
             number (``min_depth`` may be 0).
         """
         if self.depth is None:
-            raise ValueError(_NO_DEPTH.format(what="depth to filter"))
+            raise ValueError(NO_DEPTH.format(what="depth to filter"))
         limits = {
             "min_depth": min_depth,
             "max_depth": max_depth,
@@ -992,7 +987,7 @@ class DepthResult:
         from stereovision.io import write_ply
 
         if self.depth is None:
-            raise ValueError(_NO_DEPTH.format(what="point cloud"))
+            raise ValueError(NO_DEPTH.format(what="point cloud"))
         if Path(path).suffix.lower() != ".ply":
             raise ValueError(
                 f"{path}: to_ply writes a .ply file (export.write_pcd writes .pcd, "

@@ -35,6 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    NO_DEPTH,
     check_index_range,
     not_a_result,
     number_shown,
@@ -43,7 +44,7 @@ from stereovision._validate import (
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
-from stereovision.depth import _NO_DEPTH, DepthResult
+from stereovision.depth import DepthResult
 from stereovision.io import (
     _ascii_table,
     _through_links,
@@ -99,7 +100,7 @@ _ZIP_MAGIC = b"PK\x03\x04"
 
 def _require_metric(result: DepthResult) -> None:
     if result.depth is None or result.calibration is None:
-        raise ValueError(_NO_DEPTH.format(what="point cloud"))
+        raise ValueError(NO_DEPTH.format(what="point cloud"))
 
 
 def organised_points(
@@ -932,7 +933,7 @@ def write_depth_png(
 
     if isinstance(depth, DepthResult):
         if depth.depth is None:
-            raise ValueError(_NO_DEPTH.format(what="depth"))
+            raise ValueError(NO_DEPTH.format(what="depth"))
         return _png16(path, _scaled_u16(depth.depth, scale, "depth"), "depth")
     return _png16(path, _scaled_u16(depth, scale, "depth"), "depth")
 
@@ -1091,7 +1092,7 @@ def export_result(
     metric = [f for f in formats if f in _METRIC_FORMATS]
     if metric and (result.depth is None or result.calibration is None):
         raise ValueError(
-            _NO_DEPTH.format(what="depth") + f"; formats {metric} need one (npz and disp16 "
+            NO_DEPTH.format(what="depth") + f"; formats {metric} need one (npz and disp16 "
             "do not); nothing was written"
         )
     out = Path(directory)
