@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import gc
 import io
 import json
 import logging
@@ -16,6 +17,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, cast
@@ -772,6 +774,54 @@ def test_batch_reports_an_image_without_its_pair(
         f"image(s) without the other of their pair, e.g. no x_right.png beside "
         f"{root / 'c/x_left.png'}"
     )
+
+
+def _holding(needle: bytes) -> int:
+    """How many containers Python tracks hold a bytes-like value with ``needle`` in it."""
+    gc.collect()
+    found = 0
+    for obj in gc.get_objects():
+        if isinstance(obj, dict):
+            values: Any = obj.values()
+        elif isinstance(obj, (list, tuple, deque)):
+            values = obj
+        else:
+            continue
+        with contextlib.suppress(Exception):  # a container changed by another thread
+            for v in list(values):
+                if isinstance(v, (bytes, bytearray, memoryview)) and len(v) >= len(needle):
+                    found += needle in bytes(v)
+    return found
+
+
+def test_batch_keeps_no_copy_of_finished_pairs_inputs(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Dask's client logged its last 1000 messages under 1 MB, each submitted pair's image
+    bytes in them (and its LocalCluster's scheduler its tasks): the client grew by the pairs'
+    size, 62 MB over 90 Tsukuba pairs (flat with the fix). Once the last pair is written, the
+    first pair's left image is held nowhere."""
+    import stereovision.batch as batch
+
+    root = tmp_path / "in"
+    names = [f"seq/{i}_left.png" for i in range(5)] + [f"seq/{i}_right.png" for i in range(5)]
+    _tiny(root, data_dir, *names)
+    for i in range(5):  # each pair's images their own bytes
+        img = cv2.imread(str(root / f"seq/{i}_left.png"))
+        img[0, : i + 1] = 0
+        cv2.imwrite(str(root / f"seq/{i}_left.png"), img)
+    first = (root / "seq/0_left.png").read_bytes()
+    held: list[int] = []
+    commit = batch._commit_pair
+
+    def counting(out: Path, name: str, *args: Any) -> Path:
+        if name == "seq/4":
+            held.append(_holding(first))
+        return commit(out, name, *args)
+
+    monkeypatch.setattr(batch, "_commit_pair", counting)
+    res = batch.run_batch(root, tmp_path / "out", workers=1, progress=False)
+    assert len(res.processed) == 5 and held == [0]
 
 
 def test_batch_progress_lines_when_stderr_is_not_a_terminal(

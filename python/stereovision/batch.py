@@ -1187,7 +1187,13 @@ class _Dask:
             self.client = Client(self.cluster)
             self.desc = f"LocalCluster({workers} worker processes)"
 
-        with HeldInterrupts():
+        import dask
+
+        # Dask's client (and a LocalCluster's scheduler, in this process) log their last 1000
+        # messages under 1 MB for debugging, each submitted pair's image bytes with them: the
+        # client grew by the pairs' size (0.7 MB a pair of 384x288 PNGs, 21 MB over 30), up to
+        # a GB over a night's run. Read when they start, so set only for that.
+        with HeldInterrupts(), dask.config.set({"distributed.admin.low-level-log-length": 0}):
             if scheduler is not None:
                 connect()
             else:
