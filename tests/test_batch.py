@@ -1794,6 +1794,35 @@ def test_a_redo_without_calib_removes_the_stale_depth_files_but_not_a_link(
     assert (pair / "depth.png").is_symlink() and mine.is_file()
 
 
+def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair done before whose cloud.ply had gone (deleted, lost in a copy) was skipped as done
+    on a rerun (only disparity.pfm was looked for): its cloud was never written again. It is
+    done again, said in one line; a pair with all its outputs is still skipped."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "seq/0000_left.png", "seq/0000_right.png")
+    _tiny(src, data_dir, "seq/0001_left.png", "seq/0001_right.png")
+    Calibration.ideal((96, 64), 60.0, 0.1).save(tmp_path / "rig.yaml")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    args += ["--calib", str(tmp_path / "rig.yaml")]
+    assert main(args) == 0
+    cloud = out / "seq/0000/cloud.ply"
+    points = read_ply(cloud)[0]
+    cloud.unlink()
+    capsys.readouterr()
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("1 processed, 1 skipped (done before), 0 failed")
+    assert _not_progress(captured.err) == [
+        "1 pair(s) done before miss some of their outputs (e.g. seq/0000: cloud.ply); they are "
+        "done again"
+    ]
+    np.testing.assert_array_equal(read_ply(cloud)[0], points)
+    s = _summary(out)["pairs"]
+    assert (s["seq/0000"]["this_run"], s["seq/0001"]["this_run"]) == ("processed", "skipped")
+
+
 def test_a_changed_pair_is_redone_from_another_working_directory(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -11,12 +11,13 @@ tenth of the time for a large one).
 
 A re-run skips the pairs the summary records as done whose inputs (size, modification time; for
 a time alone that differs, the content: a copy without timestamps) and options are unchanged and
-whose folder still exists, without starting a cluster when nothing is
-left to do. A pair that fails (an unreadable image, sizes that differ, ...) is recorded with its
-error and the others go on; a re-run tries it again once its files (or the options) change, or
-with ``retry_failed``. Ctrl-C (or SIGTERM, for the CLI) cancels what is running, keeps
-everything already written and marks the summary as interrupted; the LocalCluster's worker
-processes do not take Ctrl-C themselves (they block SIGINT): the client stops them.
+whose outputs are all still in its folder (one missing some is done again), without starting a
+cluster when nothing is left to do. A pair that fails (an unreadable image, sizes that differ,
+...) is recorded with its error and the others go on; a re-run tries it again once its files
+(or the options) change, or with ``retry_failed``. Ctrl-C (or SIGTERM, for the CLI) cancels
+what is running, keeps everything already written and marks the summary as interrupted; the
+LocalCluster's worker processes do not take Ctrl-C themselves (they block SIGINT): the client
+stops them.
 """
 
 from __future__ import annotations
@@ -1083,12 +1084,22 @@ def _skip(
     name: str,
     retry_failed: bool,
 ) -> bool:
-    """Done with the same inputs and options (and its folder is there), or failed on them."""
+    """Done with the same inputs and options (and its outputs are there), or failed on them."""
     if entry is None or not _unchanged(entry, fp, opts):
         return False
     if entry.get("status") == "done":
-        return (out / name / "disparity.pfm").is_file()
+        return not _outputs_missing(entry, out, name)
     return entry.get("status") == "failed" and not retry_failed
+
+
+def _outputs_missing(entry: dict[str, Any], out: Path, name: str) -> list[str]:
+    """The outputs ``entry`` (a done pair's record) lists that are not files in its folder
+    (``disparity.pfm``, written for every pair, for a record that lists none). Only
+    disparity.pfm was looked for: a pair whose cloud.ply had gone was skipped as done, its
+    cloud never written again."""
+    listed = entry.get("outputs")
+    names = [str(f) for f in listed] if isinstance(listed, list) and listed else ["disparity.pfm"]
+    return [f for f in names if not (out / name / f).is_file()]
 
 
 def _in_thread_without_sigint(fn: Callable[[], None]) -> None:
@@ -1447,6 +1458,7 @@ def run_batch(
         skipped: list[str] = []
         failed_before: list[str] = []
         redone: list[str] = []
+        incomplete: list[tuple[str, list[str]]] = []  # done as now, some outputs gone: (name, them)
         changes: set[str] = set()
         others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
         foreign: Path | None = None  # a file under an output name no run recorded writing
@@ -1497,9 +1509,12 @@ def run_batch(
                 and entry.get("status") == "done"
                 and entry.get("fingerprint") == fp
                 and (out / job.name / "disparity.pfm").is_file()
-            ):  # done on the same images, with other options: its outputs are replaced
-                redone.append(job.name)
-                changes.update(_changes(entry.get("options") or {}, opts))
+            ):
+                if entry.get("options") != opts:  # with other options: its outputs are replaced
+                    redone.append(job.name)
+                    changes.update(_changes(entry.get("options") or {}, opts))
+                else:  # as it was, but some of its outputs are gone: written again
+                    incomplete.append((job.name, _outputs_missing(entry, out, job.name)))
             if entry is not None and isinstance(entry.get("outputs"), list):
                 previous[job.name] = [str(f) for f in entry["outputs"]]
             summary.pairs[job.name] = {
@@ -1546,6 +1561,12 @@ def run_batch(
             log(
                 f"{len(redone)} pair(s) were done with other options ({'; '.join(shown)}); they "
                 "are redone and their outputs replaced"
+            )
+        if incomplete and log is not None:
+            name, gone_files = incomplete[0]
+            log(
+                f"{len(incomplete)} pair(s) done before miss some of their outputs (e.g. {name}: "
+                f"{', '.join(gone_files)}); they are done again"
             )
         processed: list[str] = []
         failed: list[str] = []
