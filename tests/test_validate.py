@@ -3,7 +3,11 @@ ValueError and never another exception type)."""
 
 from __future__ import annotations
 
+import re
+from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -19,6 +23,7 @@ from stereovision._validate import (
     as_gray_float,
     as_gray_uint8,
     check_pair,
+    int_in_range,
     positive_finite,
 )
 
@@ -703,3 +708,89 @@ def test_a_timedelta_scalar_is_no_count(value: np.timedelta64) -> None:
     img = np.zeros((20, 30), np.float32)
     with pytest.raises(ValueError, match=r"^nms_half: expected an integer"):
         interest_points(img, nms_half=value)
+
+
+def _entry_points() -> dict[str, Any]:
+    """Entry points whose number or count checks predate the shared rule (NOT_NUMBERS), each
+    called with one value in the checked place."""
+    from stereovision import bench, evaluate, refine
+    from stereovision.matching import gabor, hopfield, mcgm, sgm
+    from stereovision.matching.fusion import _fuse_options
+
+    rng = np.random.default_rng(0)
+    left = rng.random((24, 40), dtype=np.float32)
+    right = np.roll(left, -2, axis=1)
+    disp = np.full((24, 40), 2.0, np.float32)
+    z = np.full((6, 6), 2.0)
+    return {
+        "interest rel_threshold": lambda v: hopfield.interest_points(left, rel_threshold=v),
+        "interest floor_rel": lambda v: hopfield.interest_points(left, floor_rel=v),
+        "hopfield max_disparity": lambda v: hopfield.hopfield_match(left, right, max_disparity=v),
+        "hopfield k_cand": lambda v: hopfield.hopfield_match(
+            left, right, max_disparity=8, k_cand=v
+        ),
+        "hopfield A": lambda v: hopfield.hopfield_match(left, right, max_disparity=8, A=v),
+        "mcgm max_disparity": lambda v: mcgm.mcgm_match(left, right, max_disparity=v),
+        "refine win_radius": lambda v: refine.refine_disparity(
+            left, right, disp, max_disparity=8, win_radius=v
+        ),
+        "refine step": lambda v: refine.refine_disparity(
+            left, right, disp, max_disparity=8, step=v
+        ),
+        "gabor iters_per_level": lambda v: gabor.gabor_disparity(
+            left, right, max_disparity=8, iters_per_level=v
+        ),
+        "sgm p1": lambda v: sgm.sgm_disparity(left, right, max_disparity=8, p1=v),
+        "sgm max_disparity": lambda v: sgm.sgm_disparity(left, right, max_disparity=v),
+        "fuse min_agree": lambda v: _fuse_options("vote", 3, 1, 1, 0.5, v),
+        "table1 seed": lambda v: evaluate.table1_report(z, z, seed=v),
+        "table1 n_points": lambda v: evaluate.table1_report(z, z, n_points=v),
+        "bench runs": lambda v: bench._check_runs(v, "runs"),
+    }
+
+
+@pytest.mark.parametrize("value", [np.timedelta64(3), np.timedelta64(5), True, np.True_], ids=repr)
+@pytest.mark.parametrize("entry", sorted(_entry_points()))
+def test_no_entry_point_takes_a_bool_or_a_timedelta_as_a_number(entry: str, value: object) -> None:
+    """One rule (NOT_NUMBERS): 3 ns was the count 3, a range of 3 px or the seed 3 in some
+    checks, True the threshold 1.0 or the weight 1; all are refused naming the parameter."""
+    name = entry.split()[1]
+    with pytest.raises(ValueError, match=rf"^{name}\b.*got {re.escape(repr(value))}"):
+        _entry_points()[entry](value)
+
+
+@pytest.mark.parametrize(
+    "value", [3.0, np.float32(3), np.int64(3), Fraction(3), Decimal("3"), np.array([3])], ids=repr
+)
+def test_every_count_takes_the_whole_numbers_min_agree_takes(value: object) -> None:
+    """gabor's and sgm's counts refused 3.0, Fraction(3) and a size-1 array where fuse's
+    min_agree took them: all read them as 3 now (whole_value), with the results of 3."""
+    from stereovision.matching import gabor, sgm
+    from stereovision.matching.fusion import _fuse_options
+
+    rng = np.random.default_rng(1)
+    left = rng.random((24, 40), dtype=np.float32)
+    right = np.roll(left, -2, axis=1)
+    assert _fuse_options("vote", 3, 1, 1, 0.5, value)[-1] == 3
+    assert int_in_range(value, "n", 0, 9) == 3
+    want = gabor.gabor_disparity(left, right, max_disparity=8, iters_per_level=3).disparity
+    got = gabor.gabor_disparity(left, right, max_disparity=8, iters_per_level=value).disparity
+    np.testing.assert_array_equal(got, want)
+    want = sgm.sgm_disparity(left, right, max_disparity=8, p1=3)
+    np.testing.assert_array_equal(sgm.sgm_disparity(left, right, max_disparity=8, p1=value), want)
+
+
+@pytest.mark.parametrize("value", [2.5, "3", None, np.array([3, 3]), Fraction(5, 2)], ids=repr)
+def test_every_count_refuses_what_min_agree_refuses(value: object) -> None:
+    from stereovision.matching import gabor, sgm
+    from stereovision.matching.fusion import _fuse_options
+
+    left = np.zeros((8, 16), np.float32)
+    with pytest.raises(ValueError, match=r"^min_agree"):
+        _fuse_options("vote", 3, 1, 1, 0.5, value)
+    with pytest.raises(ValueError, match=r"^n: expected an integer"):
+        int_in_range(value, "n", 0, 9)
+    with pytest.raises(ValueError, match=r"^iters_per_level"):
+        gabor.gabor_disparity(left, left, max_disparity=8, iters_per_level=value)
+    with pytest.raises(ValueError, match=r"^p1"):
+        sgm.sgm_disparity(left, left, max_disparity=8, p1=value)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextvars
 import dataclasses
+import decimal
 import functools
 import inspect
 import math
@@ -22,7 +23,7 @@ import re
 import sys
 import warnings
 from collections.abc import Callable, Iterable
-from typing import Any, TypeVar, cast
+from typing import Any, TypeGuard, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -677,17 +678,99 @@ def _real_array(a: object) -> np.ndarray | None:
     return None
 
 
+#: What Python or NumPy count as numbers but no parameter takes as one: a bool (an int: True
+#: was a count of 1), an np.bool_, and an np.timedelta64 (an np.integer and a numbers.Integral:
+#: 3 ns was a count of 3). Every check of a number or a count refuses them (:func:`real_number`,
+#: :func:`whole_value`).
+NOT_NUMBERS: tuple[type, ...] = (bool, np.bool_, np.timedelta64)
+
+
+def real_number(value: object) -> TypeGuard[int | float | np.integer[Any] | np.floating[Any]]:
+    """Whether ``value`` is one real number: a Python or NumPy int or float, none of
+    :data:`NOT_NUMBERS`.
+
+    Examples
+    --------
+    >>> real_number(np.float32(0.5)), real_number(True), real_number(np.timedelta64(3))
+    (True, False, False)
+    """
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, NOT_NUMBERS
+    )
+
+
+def _plain_real(value: Any) -> Any:
+    """A real number that is no Python or NumPy number (a :class:`fractions.Fraction`, a
+    :class:`decimal.Decimal`) as its float, anything else as it is.
+
+    :func:`finite_number` refuses them as "no finite number", where ``fuse`` and
+    ``fused_dense`` had compared them as the numbers they are; read as its float each gives the
+    plain float's result, as :func:`stereovision.matching.gabor.gabor_disparity` reads them. A
+    value too large for a float is left for ``finite_number`` to refuse, naming the parameter.
+    """
+    real = isinstance(value, (numbers.Real, decimal.Decimal))
+    if real and not isinstance(value, (int, float, np.generic)):
+        try:
+            return float(value)
+        except (OverflowError, ValueError):
+            return value
+    return value
+
+
+def _plain_option(value: Any) -> Any:
+    """An option's number as :func:`fuse` and :func:`fused_dense` use it: a Fraction or a
+    Decimal as its float (:func:`_plain_real`), a NumPy integer or float scalar or size-1
+    array as the Python int or float of its value, anything else as it is.
+
+    Not the NumPy scalar of its dtype: ``np.array([16], np.uint8)`` as ``r_spatial`` squared
+    to 0 in uint8 (one offset searched instead of 797), ``np.array([1], np.uint8)`` as
+    ``speckle_area`` was NumPy's "Python integer 4800 out of bounds for uint8"; a Python
+    number gives the plain number's maps.
+
+    :func:`finite_number` passes a size-1 array, which ``np.array([3])`` as ``edge_radius``
+    then made NumPy's bare "only 0-dimensional arrays can be converted" after every matcher
+    had run; and only the confidences read a Fraction or a Decimal, which ``r_spatial`` or
+    ``radius`` refused (one config read with ``parse_float=Decimal`` passed half its keys).
+    """
+    value = _plain_real(value)
+    if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
+        value = value.reshape(())[()]
+    # by dtype kind, not np.integer: np.timedelta64 is one, and its item() made 16 ns a 16
+    # (accepted as r_spatial=16) and 16 s a datetime.timedelta (the error misnamed the value)
+    if isinstance(value, np.generic) and value.dtype.kind in "iuf":
+        return value.item()
+    return value
+
+
+def whole_value(value: object) -> int | None:
+    """``value`` as a Python int when it is a whole number, else None: one rule for every
+    count (``min_agree``'s, :func:`int_in_range`'s, the matchers' counts).
+
+    A whole number is an int or a NumPy integer, or a finite integral float, Fraction or
+    Decimal (``3.0``, ``np.float32(2)``, ``Fraction(2)``: a value read from a config or a
+    computation), or a size-1 array of one (a value read from an array) -- never one of
+    :data:`NOT_NUMBERS`.
+
+    Examples
+    --------
+    >>> whole_value(3.0), whole_value(np.array([2])), whole_value(2.5), whole_value(True)
+    (3, 2, None, None)
+    """
+    plain = _plain_option(value)
+    if isinstance(plain, float) and math.isfinite(plain) and plain.is_integer():
+        return int(plain)
+    if isinstance(plain, int) and not isinstance(plain, bool):
+        return plain
+    return None
+
+
 def _real_scalar(value: object) -> float:
     """``value`` as a float when it is one real number: a Python or NumPy int or float, or a
     size-1 NumPy array of them (``np.array(3.0)``, ``np.array([3.0])``: a value read from an
     array); a TypeError otherwise (a bool, a string, a list: a slider's ``[1.0]`` is no
     number). One rule for :func:`positive_finite` and :func:`finite_number` (the second refused
     ``np.array(3.0)`` and the first ``2**70``, each taken by the other)."""
-    # np.timedelta64 is an np.integer: 16 ns was taken as the number 16, where an array of
-    # them (the kind check below) is refused
-    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, np.timedelta64
-    ):  # 2**70: an object array
+    if isinstance(value, bool) or real_number(value):  # 2**70: an object array
         return float(value)
     if not isinstance(value, np.ndarray) or value.size != 1 or value.dtype.kind not in "iuf":
         raise TypeError(type(value).__name__)
@@ -729,7 +812,8 @@ def positive_finite(value: object, name: str) -> float:
 
 
 def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
-    """``value`` as an ``int`` within ``[lo, hi]`` (an integral float is accepted).
+    """``value`` as an ``int`` within ``[lo, hi]`` (a whole number as :func:`whole_value` reads
+    it: an integral float, Fraction or Decimal, or a size-1 array of one, is accepted).
 
     Raises
     ------
@@ -737,18 +821,10 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
         Naming ``name``, for a bool, a non-number, a non-integral or non-finite number, or one
         outside the range.
     """
-    # np.timedelta64 is an np.integer: 3 ns was the count 3 (finite_number refuses it)
-    ok = not isinstance(value, (bool, np.bool_, np.timedelta64))
-    if ok and isinstance(value, (int, np.integer)):
-        ok = lo <= int(value) <= hi  # exact: a float of 2**63 - 1 is 2**63
-    elif ok and isinstance(value, (float, np.floating)):
-        v = float(value)
-        ok = math.isfinite(v) and v == int(v) and lo <= int(v) <= hi
-    else:
-        ok = False
-    if not ok:
+    whole = whole_value(value)  # the one rule of a count (a bool, np.timedelta64: no count)
+    if whole is None or not lo <= whole <= hi:  # exact: a float of 2**63 - 1 is 2**63
         raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {_shown(value)}")
-    return int(value)  # type: ignore[call-overload]
+    return whole
 
 
 def positive_whole(value: object, name: str, expected: str = "a positive integer") -> int:

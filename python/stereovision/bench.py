@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from stereovision._jsonout import json_line
+from stereovision._validate import NOT_NUMBERS
 
 __all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table", "sparse_name"]
 
@@ -133,7 +134,7 @@ def sparse_name(method: str) -> str:
 
 def _runs_rule(runs: object) -> str:
     # an integer as its number (NumPy 2's repr said np.int64(4)); anything else as Python shows it
-    exact = isinstance(runs, (int, np.integer)) and not isinstance(runs, bool)
+    exact = isinstance(runs, (int, np.integer)) and not isinstance(runs, NOT_NUMBERS)
     shown = str(runs) if exact else repr(runs)
     return f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {shown}"
 
@@ -141,7 +142,7 @@ def _runs_rule(runs: object) -> str:
 def _check_runs(runs: object, name: str) -> None:
     """Refuse a ``runs`` that is no integer (5.5 and NaN passed ``runs < 5`` and failed in
     ``range`` after every warm-up) or below :data:`MIN_RUNS`, naming ``name``."""
-    if isinstance(runs, (bool, np.bool_)) or not isinstance(runs, (int, np.integer)):
+    if not isinstance(runs, (int, np.integer)) or isinstance(runs, NOT_NUMBERS):  # 5 ns
         raise ValueError(f"{name}: expected an integer, {_runs_rule(runs)}")
     if runs < MIN_RUNS:
         raise ValueError(f"{name}: {_runs_rule(runs)}")

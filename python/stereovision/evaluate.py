@@ -23,9 +23,11 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    NOT_NUMBERS,
     check_index_range,
     known_unit,
     number_shown,
+    real_number,
     renamed_keyword,
     too_large_for_float,
 )
@@ -159,9 +161,7 @@ class DenseMetrics:
 
 def _real(value: object) -> bool:
     """Whether ``value`` is a real number (a bool is not one, nor a numeric string)."""
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, (bool, np.bool_)
-    )
+    return real_number(value)  # 3 ns is none either
 
 
 def _positive_finite(value: object) -> bool:
@@ -523,13 +523,13 @@ def table1_report(
     if points is None:
         # NumPy's messages named neither (n_points NaN: "negative dimensions are not allowed",
         # seed -5: "expected non-negative integer"), and n_points 2.5 or True was taken
-        if isinstance(n_points, (bool, np.bool_)) or not isinstance(n_points, (int, np.integer)):
+        if not isinstance(n_points, (int, np.integer)) or isinstance(n_points, NOT_NUMBERS):
             raise ValueError(f"n_points must be an integer >= 1, got {n_points!r}")
         if n_points < 1:
             raise ValueError(f"n_points must be >= 1, got {n_points}")
         if seed is not None and (
-            isinstance(seed, (bool, np.bool_))
-            or not isinstance(seed, (int, np.integer))
+            not isinstance(seed, (int, np.integer))
+            or isinstance(seed, NOT_NUMBERS)  # True, or 3 ns seeded as 3
             or seed < 0
         ):
             raise ValueError(f"seed must be an integer >= 0 or None, got {seed!r}")

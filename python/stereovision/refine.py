@@ -30,6 +30,7 @@ from stereovision._validate import (
     check_unit_range,
     disparity_range,
     number_shown,
+    real_number,
     refuse_unknown,
 )
 
@@ -90,7 +91,7 @@ _FLOAT_KEYS = (
 def _number(v: object, name: str, whole: bool = False) -> float:
     """A real parameter value (a non-negative whole number when ``whole``), else ValueError
     naming it."""
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+    if not real_number(v):  # a bool, or 3 ns taken as 3
         raise ValueError(f"{name} must be a number, got {v!r}")
     try:
         out = float(v)

@@ -17,10 +17,8 @@ channels themselves are the Rust kernels.
 
 from __future__ import annotations
 
-import decimal
 import functools
 import itertools
-import numbers
 import time
 from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -30,7 +28,13 @@ from typing import Any, TypedDict
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import _real_array, finite_number, refuse_unknown
+from stereovision._validate import (
+    _plain_option,
+    _real_array,
+    finite_number,
+    refuse_unknown,
+    whole_value,
+)
 from stereovision.matches import Matches
 
 # at run time too, so that typing.get_type_hints resolves ChannelOutputs (and DepthChannels)
@@ -243,49 +247,6 @@ def remeasure(
     return np.where(np.isfinite(r.disparity), r.disparity, d).astype(np.float32)
 
 
-def _plain_real(value: Any) -> Any:
-    """A real number that is no Python or NumPy number (a :class:`fractions.Fraction`, a
-    :class:`decimal.Decimal`) as its float, anything else as it is.
-
-    :func:`finite_number` refuses them as "no finite number", where ``fuse`` and
-    ``fused_dense`` had compared them as the numbers they are; read as its float each gives the
-    plain float's result, as :func:`stereovision.matching.gabor.gabor_disparity` reads them. A
-    value too large for a float is left for ``finite_number`` to refuse, naming the parameter.
-    """
-    real = isinstance(value, (numbers.Real, decimal.Decimal))
-    if real and not isinstance(value, (int, float, np.generic)):
-        try:
-            return float(value)
-        except (OverflowError, ValueError):
-            return value
-    return value
-
-
-def _plain_option(value: Any) -> Any:
-    """An option's number as :func:`fuse` and :func:`fused_dense` use it: a Fraction or a
-    Decimal as its float (:func:`_plain_real`), a NumPy integer or float scalar or size-1
-    array as the Python int or float of its value, anything else as it is.
-
-    Not the NumPy scalar of its dtype: ``np.array([16], np.uint8)`` as ``r_spatial`` squared
-    to 0 in uint8 (one offset searched instead of 797), ``np.array([1], np.uint8)`` as
-    ``speckle_area`` was NumPy's "Python integer 4800 out of bounds for uint8"; a Python
-    number gives the plain number's maps.
-
-    :func:`finite_number` passes a size-1 array, which ``np.array([3])`` as ``edge_radius``
-    then made NumPy's bare "only 0-dimensional arrays can be converted" after every matcher
-    had run; and only the confidences read a Fraction or a Decimal, which ``r_spatial`` or
-    ``radius`` refused (one config read with ``parse_float=Decimal`` passed half its keys).
-    """
-    value = _plain_real(value)
-    if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
-        value = value.reshape(())[()]
-    # by dtype kind, not np.integer: np.timedelta64 is one, and its item() made 16 ns a 16
-    # (accepted as r_spatial=16) and 16 s a datetime.timedelta (the error misnamed the value)
-    if isinstance(value, np.generic) and value.dtype.kind in "iuf":
-        return value.item()
-    return value
-
-
 def _fuse_options(
     mode: str,
     r_spatial: Any,
@@ -318,12 +279,10 @@ def _fuse_options(
         raise ValueError(f"a_conf_min: expected a confidence in [0, 1], got {a_conf_min}")
     # a string, None or NaN failed in a comparison or in range(), naming no parameter; a whole
     # number given as 2.0 or a size-1 array (a value read from one) is its count
-    # (_plain_option leaves a bool, np.bool_ or np.timedelta64 -- an np.integer: 2 ns was taken
-    # as 2 channels -- as it is, so they are refused below)
-    agree = _plain_option(min_agree)
-    if isinstance(agree, float) and agree.is_integer():
-        agree = int(agree)
-    if isinstance(agree, bool) or not isinstance(agree, int):
+    # (whole_value, the library's one rule of a count: a bool or an np.timedelta64 -- an
+    # np.integer: 2 ns was taken as 2 channels -- is none)
+    agree = whole_value(min_agree)
+    if agree is None:
         raise ValueError(f"min_agree: expected a whole number of channels, got {min_agree!r}")
     min_agree = agree
     if min_agree < 2:

@@ -21,13 +21,16 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    NOT_NUMBERS,
     check_index_range,
     check_unit_range,
     disparity_range,
     float_sized,
+    real_number,
     refuse_unknown,
     refuse_unreachable_range,
     renamed_keyword,
+    whole_value,
 )
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
@@ -183,7 +186,7 @@ def gabor_disparity(
             # "must be real number, not str", naming no parameter; True was a value of 1. A
             # Decimal (no numbers.Real) is a number the binding reads, as it did before.
             if not (value is None and default is None) and (
-                isinstance(value, (bool, np.bool_))
+                isinstance(value, NOT_NUMBERS)  # True was 1, 3 ns the binding's TypeError
                 or not isinstance(value, (numbers.Real, decimal.Decimal))
             ):
                 raise ValueError(f"{name}: expected a number, got {value!r}")
@@ -197,8 +200,12 @@ def gabor_disparity(
         v = kw[name]
         if v is None and name == "n_levels":
             continue
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v < 2**31:
+        # the library's one rule of a count (whole_value, as fuse's min_agree): 3.0 or
+        # Fraction(3) was refused here and taken there, 3 ns was the binding's TypeError
+        whole = whole_value(v)
+        if whole is None or not 0 <= whole < 2**31:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+        kw[name] = whole
     # Older kernels checked both radii in one test and named research_radius for either.
     if kw["search_pool_radius"] > 16:
         raise ValueError(
@@ -209,7 +216,7 @@ def gabor_disparity(
     if (
         isinstance(orient, str)
         or not isinstance(orient, (Sequence, np.ndarray))
-        or not all(isinstance(t, (int, float, np.integer, np.floating)) for t in orient)
+        or not all(real_number(t) for t in orient)
     ):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
     kw["orientations_deg"] = [float(float_sized(t, "orientations_deg")) for t in orient]

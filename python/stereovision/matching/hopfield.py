@@ -24,11 +24,13 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    NOT_NUMBERS,
     as_gray_float,
     check_pair,
     float_sized,
     int_in_range,
     luma_weights,
+    real_number,
     refuse_unknown,
     refuse_unreachable_range,
     too_large_for_float,
@@ -151,7 +153,7 @@ def interest_points(
     img = as_gray_float(image, "image")
     for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
         # a string or None reached float(): its message named no parameter
-        number = isinstance(float_sized(v, name), (int, float, np.integer, np.floating))
+        number = real_number(float_sized(v, name))  # True was 1.0, 0 ns was 0.0
         if not (number and 0.0 <= float(v) <= 1.0):  # type: ignore[arg-type]
             raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
     # Sizes beyond the image act as the image: the cap keeps them within the kernel's integers.
@@ -189,10 +191,15 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
         "Hopfield parameter", params, DEFAULTS, "stereovision.matching.hopfield.DEFAULTS"
     )
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
-            if isinstance(v, (float, np.floating)) and np.isfinite(v) and v >= 0:
-                continue
+        # real_number: 3 ns was a range of 3 px
+        finite = not isinstance(v, (float, np.floating)) or math.isfinite(v)  # 10**400 is
+        if not real_number(v) or not finite or v < 0:
             raise ValueError(f"{name} must be a non-negative number of pixels, got {_shown(v)}")
+    # the kernel read True as 1 (A=True, k_cand=True), 3 ns as 3; a switch's True is its own
+    for name, v in params.items():
+        number = isinstance(DEFAULTS[name], (int, float)) and not isinstance(DEFAULTS[name], bool)
+        if number and isinstance(v, NOT_NUMBERS):
+            raise ValueError(f"{name}: expected a number, got {v!r}")
     # The kernel clips the range to the image; the clip here keeps it within its integers (2**70
     # was the binding's "OverflowError: int too big to convert").
     big = 2**31 - 1

@@ -27,9 +27,11 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    NOT_NUMBERS,
     as_gray_float,
     check_pair,
     float_sized,
+    real_number,
     refuse_unknown,
     refuse_unreachable_range,
     too_large_for_float,
@@ -172,7 +174,7 @@ class ChannelCurves:
         IndexError
             If ``k`` is outside ``-n_segments <= k < n_segments``.
         """
-        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+        if not isinstance(k, (int, np.integer)) or isinstance(k, NOT_NUMBERS):
             raise TypeError(f"k: expected an integer segment index, got {type(k).__name__} {k!r}")
         n = self.n_segments
         if not -n <= k < n:
@@ -197,9 +199,7 @@ def _sigmas(sig: object) -> list[float]:
     else:
         items = [sig]
     for s in items:
-        if isinstance(s, (bool, np.bool_)) or not isinstance(
-            s, (int, float, np.integer, np.floating)
-        ):
+        if not real_number(s):
             raise ValueError(
                 f"sigmas: expected a number of pixels or a list of them, got {reprlib.repr(sig)}"
             )
@@ -216,8 +216,7 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     refuse_unknown("MCGM parameter", params, DEFAULTS, "stereovision.matching.mcgm.DEFAULTS")
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if (
-            isinstance(v, bool)
-            or not isinstance(v, (int, float, np.integer, np.floating))
+            not real_number(v)  # a bool, 3 ns
             or (isinstance(v, (float, np.floating)) and not math.isfinite(v))
             or v < 0
         ):

@@ -31,10 +31,12 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    NOT_NUMBERS,
     check_index_range,
     finite_number,
     float_sized,
     int_in_range,
+    real_number,
     renamed_keyword,
 )
 
@@ -150,9 +152,7 @@ def _real(value: object, name: str) -> object:
     """``value`` unchanged after a ``ValueError`` naming ``name`` unless it is a real number (not
     a bool; infinities are the caller's to judge). A string or None reached ``float()`` or the
     binding and came back as "could not convert string to float" or a TypeError naming nothing."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(
-        value, (int, float, np.integer, np.floating)
-    ):
+    if not real_number(value):  # a bool, or 3 ns taken as 3
         raise ValueError(f"{name}: expected a number, got {value!r}")
     return float_sized(value, name)
 
@@ -247,7 +247,7 @@ def plane_fill(
             f" numbers them, got {int(raw.min())} .. {int(raw.max())}"
         )
     lab = np.ascontiguousarray(raw, dtype=np.uint32)
-    if isinstance(min_pixels, bool) or not isinstance(min_pixels, (int, np.integer)):
+    if not isinstance(min_pixels, (int, np.integer)) or isinstance(min_pixels, NOT_NUMBERS):
         raise ValueError(f"min_pixels: expected a whole number, got {min_pixels!r}")
     if not 0 <= min_pixels <= _MAX_COUNT:
         raise ValueError(f"min_pixels: expected a non-negative count, got {min_pixels}")

@@ -21,11 +21,13 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    NOT_NUMBERS,
     as_gray_float,
     check_pair,
     finite_number,
     float_sized,
     refuse_unreachable_range,
+    whole_value,
 )
 
 __all__ = ["DEFAULTS", "sgm_disparity"]
@@ -180,7 +182,7 @@ def sgm_disparity(
             v = v.reshape(())[()]
         # True searched one level, a string or a list raised "must be real number, not str";
         # any other real number (a Fraction) is read as it was
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+        if isinstance(v, NOT_NUMBERS) or not isinstance(v, numbers.Real):  # 3 ns: no pixels
             raise ValueError(f"{name}: expected a number of pixels, got {v!r}")
         bounds.append(v)
         # The kernel takes i32 levels (and at most 2048 of them); 1e300 is finite, only too big.
@@ -206,8 +208,12 @@ def sgm_disparity(
         ("edge_margin", 0, 2**32 - 1),
     ):
         v = p[name]
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not bottom <= v <= top:
+        # the library's one rule of a count (whole_value, as fuse's min_agree): 3.0 or
+        # Fraction(3) was refused here and taken there, 3 ns was taken as 3
+        whole = whole_value(v)
+        if whole is None or not bottom <= whole <= top:
             raise ValueError(f"{name}: expected an integer in [{bottom}, {top}], got {v!r}")
+        p[name] = whole
     if p["p1"] >= p["p2"]:
         raise ValueError(f"p1: expected p1 < p2, got p1 = {p['p1']}, p2 = {p['p2']}")
     # NaN, inf, 10**400 and strings named as gamma (float() and the kernel named them otherwise)
