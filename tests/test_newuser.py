@@ -4,6 +4,7 @@ mistakes (a video for an image, a range of 0) named in the command line's words.
 from __future__ import annotations
 
 import os
+import re
 from importlib import resources
 from pathlib import Path
 
@@ -82,6 +83,32 @@ def test_a_max_depth_that_leaves_no_depth_names_the_nearest(
     assert main([*argv, "--max-depth", "2.1", "-o", str(tmp_path / "some")]) == 0
     first = capsys.readouterr().out.splitlines()[0]
     assert f", depth {nearest:.3g}-" in first and "within --max-depth" not in first
+
+
+def test_a_max_sigma_that_leaves_no_depth_names_the_smallest_sigma(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``depth --max-sigma 0.0001`` on the sample wrote outputs with no depth and said nothing
+    of why: one warning line on stderr names the option and the frame's smallest sigma_d, and
+    that value given as --max-sigma keeps some depth."""
+    argv = ["depth", str(CONES / "left.png"), str(CONES / "right.png")]
+    argv += ["--calib", str(CONES / "calib.txt")]
+    assert main([*argv, "--max-sigma", "0.0001", "-o", str(tmp_path / "cut")]) == 0
+    out, err = capsys.readouterr()
+    assert not np.isfinite(np.load(tmp_path / "cut" / "depth.npy")).any()
+    lines = [line for line in err.splitlines() if "--max-sigma" in line]
+    assert len(lines) == 1, err
+    said = re.fullmatch(
+        r"stereovision: warning: --max-sigma 0\.0001 m left no depth: the smallest sigma_d of "
+        r"this frame is (\S+) m \(give --max-sigma \1 or more to keep some\)",
+        lines[0],
+    )
+    assert said is not None, lines[0]
+    assert "no depth, 0 points" in out
+    assert main([*argv, "--max-sigma", said[1], "-o", str(tmp_path / "some")]) == 0
+    out, err = capsys.readouterr()
+    assert np.isfinite(np.load(tmp_path / "some" / "depth.npy")).any()
+    assert "--max-sigma" not in err and "no depth" not in out
 
 
 def test_the_nearest_beyond_max_depth_is_shown_beyond_it() -> None:

@@ -824,6 +824,11 @@ def cmd_depth(args: argparse.Namespace) -> int:
         beyond = _beyond_max_depth(res.depth, unfiltered[0].depth, args.max_depth)
         if beyond is not None:
             cloud = f"{beyond}, {len(res.points)} points"
+    if res.depth is not None and args.max_sigma is not None and unfiltered:
+        # the outputs held no depth and nothing said that --max-sigma took it, nor what keeps some
+        tight = _below_max_sigma(res.depth, unfiltered[0], args.max_sigma, args.max_depth)
+        if tight is not None:
+            warnings.warn(tight, stacklevel=1)
     if args.voxel is not None and "cloud.ply" in written:
         # the cloud.ply of --voxel holds fewer points than the result: "N points" read as its
         # (the count comes from the writer: the file was read back whole to count its points)
@@ -887,6 +892,36 @@ def _beyond_max_depth(depth: np.ndarray, before: np.ndarray, max_depth: float) -
     if float(shown) <= max_depth:  # 2.0004 shown as "2" read as within --max-depth 2
         shown = f"{nearest:.7g}"
     return f"no depth within --max-depth {max_depth:g} m (the nearest is {shown} m)"
+
+
+def _below_max_sigma(
+    depth: np.ndarray, before: Any, max_sigma: float, max_depth: float | None = None
+) -> str | None:
+    """``--max-sigma 0.001 m left no depth: the smallest sigma_d of this frame is 0.0123 m``
+    when ``--max-sigma`` took every depth ``before`` (the result as matched) had within
+    ``max_depth``; None otherwise (some depth kept, none to begin with, or ``--max-depth``
+    took them all: :func:`_beyond_max_depth` says so). The smallest sigma is shown with the
+    digits it takes for ``--max-sigma`` of that value to keep its pixel (compared in float32,
+    as :meth:`~stereovision.depth.DepthResult.filtered` does)."""
+    sigma = before.depth_sigma
+    if np.isfinite(depth).any() or sigma is None:
+        return None
+    z = before.depth
+    within = np.isfinite(z) & np.isfinite(sigma)
+    if max_depth is not None:
+        within &= z <= max_depth
+    if not within.any():
+        return None
+    smallest = np.float32(sigma[within].min())
+    if smallest <= max_sigma:  # not the sigma that took them (cannot happen: said of nothing)
+        return None
+    shown = figure_shown(float(smallest))
+    if np.float32(float(shown)) < smallest:  # 0.01234 shown as 0.0123 would keep nothing
+        shown = f"{float(smallest):.9g}"
+    return (
+        f"--max-sigma {max_sigma:g} m left no depth: the smallest sigma_d of this frame is "
+        f"{shown} m (give --max-sigma {shown} or more to keep some)"
+    )
 
 
 def _depth_range(depth: np.ndarray, unit: str) -> str:
