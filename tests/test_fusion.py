@@ -1576,3 +1576,27 @@ def test_an_edge_option_past_float32_is_named(name: str) -> None:
     assert stages == []
     got, _ = fused_dense(d, c, members, guide=guide, **{name: f32_max})
     assert np.isfinite(got).any()
+
+
+@pytest.mark.parametrize(
+    "key", ["tau_dx", "tau_dy", "radius", "tau", "fill_radius", "second_tol", "occlusion_tau"]
+)
+def test_a_tolerance_past_float32_is_its_infinity_without_numpy_warnings(
+    data_dir: Path, key: str
+) -> None:
+    """``tau=1e308`` (and the other tolerances and radii compared with float32 maps) printed
+    NumPy's "RuntimeWarning: overflow encountered in cast" after every matcher had run: it is
+    float32's infinity, as the cast read it, without a word, and gives the map of float32's
+    largest value (every difference within it)."""
+    import warnings
+
+    scene = load_scene(data_dir / "middlebury2003" / "cones")
+    left, right = scene.left[:96, :160], scene.right[:96, :160]
+    top = float(np.finfo(np.float32).max)
+    want = sv_depth_map(left, right, max_disparity=32, **{key: top})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for huge in (1e308, 10**300):
+            got = sv_depth_map(left, right, max_disparity=32, **{key: huge})
+            np.testing.assert_array_equal(got.disparity, want.disparity)
+            np.testing.assert_array_equal(got.confidence, want.confidence)

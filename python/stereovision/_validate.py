@@ -1153,6 +1153,26 @@ def finite_number(value: object, name: str) -> float:
     return out
 
 
+def float32_reach(value: _T) -> _T | float:
+    """``value`` as a float32 map's comparison reads it: itself within float32's range, else
+    its signed infinity.
+
+    A tolerance or radius of 1e308 (or ``10**300``) compared with a float32 map is cast to
+    float32 first, as its infinity, which reads it right (every difference is within it), but
+    the cast printed NumPy's "RuntimeWarning: overflow encountered in cast". Values within the
+    range are returned as given, for the same results.
+
+    Examples
+    --------
+    >>> float32_reach(2.0), float32_reach(1e308), float32_reach(-(10**300))
+    (2.0, inf, -inf)
+    """
+    v = float(value)  # type: ignore[arg-type]
+    if abs(v) <= float(np.finfo(np.float32).max):
+        return value
+    return math.copysign(math.inf, v)
+
+
 def _whole(v: float) -> str:
     """``v`` as Python writes it, a whole number without ".0" (10, not 10.0; 10.0000001)."""
     return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)

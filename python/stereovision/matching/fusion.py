@@ -32,6 +32,7 @@ from stereovision._validate import (
     _plain_option,
     _real_array,
     finite_number,
+    float32_reach,
     refuse_unknown,
     whole_value,
 )
@@ -361,6 +362,8 @@ def fuse(
     mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree = _fuse_options(
         mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
     )
+    # compared with float32 offsets: 1e308 as its float32 infinity, without NumPy's warning
+    tau_dx, tau_dy = float32_reach(tau_dx), float32_reach(tau_dy)
     _check_agree(mode, min_agree, [*sparse, *(["gabor"] if gabor is not None else [])])
 
     names: list[str] = []
@@ -1119,6 +1122,11 @@ def fused_dense(
         edge_radius,
         edge_ratio,
         edge_jump,
+    )
+    # compared with (or added to) float32 maps: 1e308 as its float32 infinity, which reads it
+    # right, without NumPy's "overflow encountered in cast" after every matcher had run
+    radius, tau, fill_radius, second_tol, occlusion_tau = (
+        float32_reach(v) for v in (radius, tau, fill_radius, second_tol, occlusion_tau)
     )
     out = d.copy()
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
