@@ -714,14 +714,19 @@ def _entry_points() -> dict[str, Any]:
     """Entry points whose number or count checks predate the shared rule (NOT_NUMBERS), each
     called with one value in the checked place."""
     from stereovision import bench, evaluate, refine
+    from stereovision.capture import save_pair
+    from stereovision.io import scene_max_disparity
     from stereovision.matching import gabor, hopfield, mcgm, sgm
     from stereovision.matching.fusion import _fuse_options
+    from stereovision.rosbag import _stamp
+    from stereovision.temporal import TemporalFilter
 
     rng = np.random.default_rng(0)
     left = rng.random((24, 40), dtype=np.float32)
     right = np.roll(left, -2, axis=1)
     disp = np.full((24, 40), 2.0, np.float32)
     z = np.full((6, 6), 2.0)
+    tmp = Path("/nonexistent-stereovision-test")  # refused before any file is written
     return {
         "interest rel_threshold": lambda v: hopfield.interest_points(left, rel_threshold=v),
         "interest floor_rel": lambda v: hopfield.interest_points(left, floor_rel=v),
@@ -746,6 +751,11 @@ def _entry_points() -> dict[str, Any]:
         "table1 seed": lambda v: evaluate.table1_report(z, z, seed=v),
         "table1 n_points": lambda v: evaluate.table1_report(z, z, n_points=v),
         "bench runs": lambda v: bench._check_runs(v, "runs"),
+        "temporal max_frames": lambda v: TemporalFilter(max_frames=v),
+        "temporal k": lambda v: TemporalFilter(k=v),
+        "scene_max_disparity width": lambda v: scene_max_disparity(None, v),
+        "save_pair index": lambda v: save_pair(tmp, v, left, left),
+        "rosbag stamp_ns": lambda v: _stamp(v),
     }
 
 

@@ -57,6 +57,8 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import NOT_NUMBERS
+
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
 from stereovision.charuco import CharucoBoard
@@ -272,7 +274,7 @@ def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int
                 f"{name}: expected inner corners as (cols, rows), got {len(items)} values {text!r}"
             )
         for v in items:
-            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+            if not isinstance(v, (int, np.integer)) or isinstance(v, NOT_NUMBERS):
                 raise TypeError(
                     f"{name}: corner counts must be integers, got {v!r} "
                     f"({type(v).__name__}) in {text!r}"

@@ -31,11 +31,13 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    NOT_NUMBERS,
     as_image_array,
     crop_or_pad_hint,
     known_unit,
     number_shown,
     positive_finite,
+    real_number,
     renamed_keyword,
     same_aspect,
     text_shown,
@@ -374,9 +376,7 @@ def _check_alpha(alpha: object, *, any_finite: bool = False) -> None:
     one with ``any_finite``: :meth:`Calibration.rectified_calibration` passes OpenCV's -1, a
     pinhole rig's default scaling): ``"1"`` and None were a TypeError from the comparison
     ("'<=' not supported between instances of 'float' and 'str'"), True was read as 1."""
-    real = isinstance(alpha, (int, float, np.integer, np.floating)) and not isinstance(
-        alpha, (bool, np.bool_)
-    )
+    real = real_number(alpha)
     if any_finite:
         try:
             finite = real and math.isfinite(alpha)  # type: ignore[arg-type]
@@ -532,7 +532,7 @@ class Calibration:
             raise ValueError(f"image_size: expected (width, height), got {size!r}")
         out: list[int] = []
         for v in size:
-            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v <= 0:
+            if not isinstance(v, (int, np.integer)) or isinstance(v, NOT_NUMBERS) or v <= 0:
                 raise ValueError(
                     f"image_size: expected positive integers (width, height), got {size!r}"
                 )
@@ -1298,7 +1298,7 @@ class Calibration:
 
         def integer(key: str) -> int:
             v = need(key)
-            ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
+            ok = real_number(v)
             if not ok or not math.isfinite(float(v)) or float(v) != int(v):
                 raise ValueError(f"calibration file {source}: {key} must be an integer, got {v!r}")
             return int(v)
@@ -1311,9 +1311,7 @@ class Calibration:
                 f"calibration file {source}: rectified must be 0 or 1, got {rectified!r}"
             )
         doffs = get("doffs")
-        if doffs is not None and (
-            isinstance(doffs, bool) or not isinstance(doffs, (int, float, np.integer, np.floating))
-        ):
+        if doffs is not None and (not real_number(doffs)):
             raise ValueError(f"calibration file {source}: doffs must be a number, got {doffs!r}")
         model = get("model")
         fields = {

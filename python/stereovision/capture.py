@@ -56,6 +56,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    NOT_NUMBERS,
     float_sized,
     positive_whole,
     renamed_keyword,
@@ -1564,7 +1565,7 @@ class StereoCamera(PairSource):
         # True was taken as 1 fps, and "30" gave math's TypeError
         float_sized(fps, "fps")  # 10**400: math.isfinite's OverflowError, naming nothing
         if fps is not None and (
-            isinstance(fps, (bool, np.bool_))
+            isinstance(fps, NOT_NUMBERS)  # True was 1 fps, 3 ns 3 fps
             or not isinstance(fps, (int, float, np.integer, np.floating))
             or not (math.isfinite(fps) and fps > 0)
         ):
@@ -2249,7 +2250,7 @@ def _camera_device(src: object) -> str | None:
     """The V4L2 device node a camera source opens (``0`` -> ``/dev/video0``; a path such as
     ``/dev/video0`` or a ``/dev/v4l/by-id/...`` link -> the node it resolves to), or None for
     a file, pattern or URL."""
-    if isinstance(src, (int, np.integer)) and not isinstance(src, bool):
+    if isinstance(src, (int, np.integer)) and not isinstance(src, NOT_NUMBERS):
         return os.path.realpath(f"/dev/video{int(src)}")
     if isinstance(src, str) and "://" not in src:
         node = os.path.realpath(src)
@@ -2484,7 +2485,7 @@ def save_pair(
         If writing fails (no partial file, and no half pair, is left behind).
     """
     # -1 made left_-001.png, a name next_pair_index does not read; a float failed on the format
-    if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or index < 0:
+    if not isinstance(index, (int, np.integer)) or isinstance(index, NOT_NUMBERS) or index < 0:
         raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
@@ -2811,7 +2812,7 @@ def capture(
         raise ValueError("chessboard and charuco: give one calibration target, not both")
     tf = None
     if temporal is not None:
-        if isinstance(temporal, bool) or not isinstance(temporal, (int, np.integer)):
+        if not isinstance(temporal, (int, np.integer)) or isinstance(temporal, NOT_NUMBERS):
             raise ValueError(f"temporal: expected a number of frames, got {temporal!r}")
         if not 2 <= temporal <= 255:
             raise ValueError(f"temporal: expected 2-255 frames a pair, got {temporal}")

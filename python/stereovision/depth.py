@@ -38,6 +38,7 @@ from stereovision._validate import (
     known_unit,
     pair_shape_error,
     path_given,
+    real_number,
     refuse_unknown,
     same_aspect,
     unreachable_range,
@@ -912,9 +913,7 @@ class DepthResult:
             "max_relative_sigma": max_relative_sigma,
         }
         for name, v in limits.items():
-            ok_number = isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(
-                v, bool
-            )
+            ok_number = real_number(v)
             if v is not None and not (
                 ok_number and _finite(v) and (v > 0 or (name == "min_depth" and v == 0))
             ):

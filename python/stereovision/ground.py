@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import known_unit
+from stereovision._validate import NOT_NUMBERS, known_unit, real_number
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -630,7 +630,7 @@ def _fit_ground(
     if tilt >= 90:
         raise ValueError(f"max_tilt_deg: expected less than 90 degrees, got {max_tilt_deg!r}")
     # NumPy's own errors named no argument ("expected non-negative integer"), and took True as 1
-    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+    if not isinstance(seed, (int, np.integer)) or isinstance(seed, NOT_NUMBERS) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
     rig = _rig(calib)
     known = np.isfinite(disp) & (disp + rig[4] > 0)
@@ -749,9 +749,7 @@ def _number(value: object, name: str) -> float:
     """``value`` as a float, after a ``ValueError`` naming ``name`` for what is not a real number:
     ``float()`` read ``"1"`` as 1 m and True as 1 without a word. An int beyond a float's range
     is an infinity of its sign (the range checks then name it)."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(
-        value, (int, float, np.integer, np.floating)
-    ):
+    if not real_number(value):
         raise ValueError(f"{name}: expected a number, got {value!r}")
     try:
         return float(value)
@@ -1251,8 +1249,8 @@ def laser_scan(
     # a NumPy integer (a count from an array) was refused as not an integer, and 2**70 was
     # NumPy's OverflowError "Python int too large to convert to C long" further on
     if (
-        isinstance(min_points, (bool, np.bool_))
-        or not isinstance(min_points, (int, np.integer))
+        not isinstance(min_points, (int, np.integer))
+        or isinstance(min_points, NOT_NUMBERS)
         or min_points < 1
     ):
         raise ValueError(f"min_points: expected an integer >= 1, got {min_points!r}")

@@ -32,6 +32,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import NOT_NUMBERS
 from stereovision.baselines import round_up16
 
 if TYPE_CHECKING:
@@ -1605,11 +1606,7 @@ def scene_max_disparity(
     """
     from stereovision._validate import positive_finite
 
-    if (
-        isinstance(width, (bool, np.bool_))
-        or not isinstance(width, (int, np.integer))
-        or width <= 0
-    ):
+    if not isinstance(width, (int, np.integer)) or isinstance(width, NOT_NUMBERS) or width <= 0:
         raise ValueError(
             f"width: expected the image width in pixels (a positive integer), got {width!r}"
         )

@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import NOT_NUMBERS
+
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.depth import DepthResult
 
@@ -772,7 +774,7 @@ def surface_mesh(
 
     # a bool was taken as a stride of 1, and a text or None for max_jump raised a TypeError
     # naming neither ('>' not supported)
-    if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 1:
+    if not isinstance(step, (int, np.integer)) or isinstance(step, NOT_NUMBERS) or step < 1:
         raise ValueError(f"step must be a positive integer, got {step!r}")
     # as an int: np.uint64 made the indices float64, np.int8 overflowed at column 160
     step = int(step)
@@ -914,8 +916,8 @@ def display_subset(
     [0.0, 6.0, 15.0, 21.0]
     """
     if max_points is not None and (
-        isinstance(max_points, bool)
-        or not isinstance(max_points, (int, np.integer))
+        not isinstance(max_points, (int, np.integer))
+        or isinstance(max_points, NOT_NUMBERS)
         or max_points < 0
     ):
         raise ValueError(
@@ -1020,7 +1022,7 @@ def _render_size(size: Any) -> tuple[int, int]:
     except TypeError:
         items = []
     whole = len(items) == 2 and all(
-        isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)) for v in items
+        isinstance(v, (int, np.integer)) and not isinstance(v, NOT_NUMBERS) for v in items
     )
     if not whole or min(int(v) for v in items) < 1:
         # NumPy numbers as plain ones: "(0, 0)", not "(np.int64(0), np.int64(0))"
@@ -1224,7 +1226,11 @@ def render_result(
     ValueError
         A result without calibration or 3-D points, or ``max_side`` below 16.
     """
-    if isinstance(max_side, bool) or not isinstance(max_side, (int, np.integer)) or max_side < 16:
+    if (
+        not isinstance(max_side, (int, np.integer))
+        or isinstance(max_side, NOT_NUMBERS)
+        or max_side < 16
+    ):
         raise ValueError(f"max_side: expected at least 16 pixels, got {max_side!r}")
     mesh = surface_mesh(result)
     intr = Intrinsics.from_result(result)

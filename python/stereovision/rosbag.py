@@ -81,7 +81,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
-from stereovision._validate import renamed_keyword, source_warning
+from stereovision._validate import real_number, renamed_keyword, source_warning
 from stereovision.capture import PairSource, SourceError, StereoFrame, _pairs, resize_frame
 
 __all__ = [
@@ -123,9 +123,7 @@ def _stamp(stamp_ns: Any) -> int:
     stamp in January 1970, and gave ``int()``'s or OverflowError's message for ``"abc"``, NaN
     or infinity, and ``struct.error`` for a stamp past 2038 (``sec`` is an int32).
     """
-    if isinstance(stamp_ns, (bool, np.bool_)) or not isinstance(
-        stamp_ns, (int, float, np.integer, np.floating)
-    ):
+    if not real_number(stamp_ns):
         raise ValueError(f"stamp_ns: expected a time in nanoseconds, got {stamp_ns!r}")
     value = float(stamp_ns)
     if not math.isfinite(value) or value != math.floor(value):

@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import check_index_range
+from stereovision._validate import NOT_NUMBERS, check_index_range, real_number
 
 __all__ = ["MOTION_MARGIN", "TemporalFilter", "noise_sigma"]
 
@@ -268,15 +268,15 @@ class TemporalFilter:
     _sigmas: deque[float] = field(default_factory=lambda: deque(maxlen=8), repr=False)
 
     def __post_init__(self) -> None:
-        if isinstance(self.max_frames, bool) or not isinstance(self.max_frames, (int, np.integer)):
+        if not isinstance(self.max_frames, (int, np.integer)) or isinstance(
+            self.max_frames, NOT_NUMBERS
+        ):
             raise ValueError(f"max_frames: expected an integer, got {self.max_frames!r}")
         if not 1 <= self.max_frames <= 255:
             raise ValueError(
                 f"max_frames: expected at least 1 and at most 255, got {self.max_frames}"
             )
-        if isinstance(self.k, bool) or not isinstance(
-            self.k, (int, float, np.integer, np.floating)
-        ):
+        if not real_number(self.k):
             raise ValueError(f"k: expected a positive number of sigmas, got {self.k!r}")
         # math, not np.isfinite: 2**70 was NumPy's TypeError "ufunc 'isfinite' not supported"
         try:

@@ -43,7 +43,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8, as_image_array, xy_points
+from stereovision._validate import as_gray_uint8, as_image_array, real_number, xy_points
 from stereovision.rectification_check import (
     DEFAULT_TOLERANCE_PX,
     MIN_MATCHES,
@@ -454,11 +454,7 @@ class UncalibratedRectification:
             If an image is not of :attr:`input_size`, or a tolerance that is not a positive
             number.
         """
-        if (
-            isinstance(tolerance, (bool, np.bool_))
-            or not isinstance(tolerance, (int, float, np.integer, np.floating))
-            or not (np.isfinite(tolerance) and tolerance > 0)
-        ):
+        if not real_number(tolerance) or not (np.isfinite(tolerance) and tolerance > 0):
             raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
         grays = []
         for name, img in (("left", left), ("right", right)):
