@@ -720,6 +720,7 @@ def _entry_points() -> dict[str, Any]:
     from stereovision.matching.fusion import _fuse_options
     from stereovision.rosbag import _stamp
     from stereovision.temporal import TemporalFilter
+    from stereovision.uncalibrated import rectify_uncalibrated
 
     rng = np.random.default_rng(0)
     left = rng.random((24, 40), dtype=np.float32)
@@ -736,6 +737,10 @@ def _entry_points() -> dict[str, Any]:
         ),
         "hopfield A": lambda v: hopfield.hopfield_match(left, right, max_disparity=8, A=v),
         "mcgm max_disparity": lambda v: mcgm.mcgm_match(left, right, max_disparity=v),
+        "mcgm A": lambda v: mcgm.mcgm_match(left, right, max_disparity=8, A=v),
+        "mcgm r_graph": lambda v: mcgm.mcgm_match(left, right, max_disparity=8, r_graph=v),
+        "sgm paths": lambda v: sgm.sgm_disparity(left, right, max_disparity=8, paths=v),
+        "rectify_uncalibrated ransac_px": lambda v: rectify_uncalibrated(left, right, ransac_px=v),
         "refine win_radius": lambda v: refine.refine_disparity(
             left, right, disp, max_disparity=8, win_radius=v
         ),

@@ -764,6 +764,16 @@ def whole_value(value: object) -> int | None:
     return None
 
 
+def refuse_not_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> None:
+    """A ``ValueError`` naming the first of ``params`` whose default is a number (not a switch)
+    and whose value is one of :data:`NOT_NUMBERS`: a matcher's kernel read True as 1 and 3 ns
+    as 3 (``A=True``, ``k_cand=np.timedelta64(3)``). A switch's True is its own."""
+    for name, v in params.items():
+        d = defaults.get(name)
+        if isinstance(d, (int, float)) and not isinstance(d, bool) and isinstance(v, NOT_NUMBERS):
+            raise ValueError(f"{name}: expected a number, got {v!r}")
+
+
 def _real_scalar(value: object) -> float:
     """``value`` as a float when it is one real number: a Python or NumPy int or float, or a
     size-1 NumPy array of them (``np.array(3.0)``, ``np.array([3.0])``: a value read from an

@@ -683,9 +683,7 @@ def rectify_uncalibrated(
     """
     if model not in MODELS:
         raise ValueError(f"model: expected one of {', '.join(MODELS)}, got {model!r}")
-    if isinstance(ransac_px, bool) or not (
-        isinstance(ransac_px, (int, float)) and math.isfinite(ransac_px) and ransac_px > 0
-    ):
+    if not (real_number(ransac_px) and math.isfinite(ransac_px) and ransac_px > 0):
         raise ValueError(f"ransac_px: expected a positive number of pixels, got {ransac_px!r}")
     gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
     if gl.shape != gr.shape:

@@ -24,13 +24,13 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
-    NOT_NUMBERS,
     as_gray_float,
     check_pair,
     float_sized,
     int_in_range,
     luma_weights,
     real_number,
+    refuse_not_numbers,
     refuse_unknown,
     refuse_unreachable_range,
     too_large_for_float,
@@ -195,11 +195,7 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
         finite = not isinstance(v, (float, np.floating)) or math.isfinite(v)  # 10**400 is
         if not real_number(v) or not finite or v < 0:
             raise ValueError(f"{name} must be a non-negative number of pixels, got {_shown(v)}")
-    # the kernel read True as 1 (A=True, k_cand=True), 3 ns as 3; a switch's True is its own
-    for name, v in params.items():
-        number = isinstance(DEFAULTS[name], (int, float)) and not isinstance(DEFAULTS[name], bool)
-        if number and isinstance(v, NOT_NUMBERS):
-            raise ValueError(f"{name}: expected a number, got {v!r}")
+    refuse_not_numbers(params, DEFAULTS)  # the kernel read True as 1 (A=True), 3 ns as 3
     # The kernel clips the range to the image; the clip here keeps it within its integers (2**70
     # was the binding's "OverflowError: int too big to convert").
     big = 2**31 - 1

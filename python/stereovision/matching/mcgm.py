@@ -32,6 +32,7 @@ from stereovision._validate import (
     check_pair,
     float_sized,
     real_number,
+    refuse_not_numbers,
     refuse_unknown,
     refuse_unreachable_range,
     too_large_for_float,
@@ -214,6 +215,7 @@ def _shown(v: object) -> str:
 
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown("MCGM parameter", params, DEFAULTS, "stereovision.matching.mcgm.DEFAULTS")
+    refuse_not_numbers(params, DEFAULTS)  # the kernel read True as 1 (A=True), 3 ns as 3
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if (
             not real_number(v)  # a bool, 3 ns

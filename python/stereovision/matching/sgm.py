@@ -229,7 +229,7 @@ def sgm_disparity(
         # its value, as np.array(8) was taken: np.array([8]) passed "in (3, 8)" and then
         # failed in int() as NumPy's "only 0-dimensional arrays can be converted", naming nothing
         p["paths"] = p["paths"].reshape(())[()]
-    if isinstance(p["paths"], (bool, np.bool_)) or p["paths"] not in (3, 8):
+    if isinstance(p["paths"], NOT_NUMBERS) or p["paths"] not in (3, 8):  # 3 ns was 3 paths
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
