@@ -695,6 +695,20 @@ def test_options_of_the_fit_are_used(data_dir: Path) -> None:
         rectify_uncalibrated(left, right, model="quasi-euclidean")
 
 
+def test_ransac_px_takes_numpy_reals(data_dir: Path) -> None:
+    """``ransac_px=np.float32(1.0)`` or ``np.int64(1)`` was refused as "not a positive number
+    of pixels" (only Python int and float passed), where check()'s tolerance takes NumPy reals:
+    both now fit as 1.0 does; a bool, 0 and NaN are still refused, naming it."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    want = rectify_uncalibrated(sc.left, sc.right, ransac_px=1.0)
+    for v in (np.float32(1.0), np.int64(1)):
+        got = rectify_uncalibrated(sc.left, sc.right, ransac_px=v)
+        assert got.matches == want.matches and np.array_equal(got.H1, want.H1)
+    for bad in (np.True_, np.float64(0.0), float("nan"), "1"):
+        with pytest.raises(ValueError, match="ransac_px: expected a positive"):
+            rectify_uncalibrated(sc.left, sc.right, ransac_px=bad)
+
+
 def test_a_file_without_a_model_or_with_a_short_size(tmp_path: Path) -> None:
     """A file written before the quasi-Euclidean model existed (no ``model``) holds Hartley's
     homographies: it reads as ``"projective"``; a one-number size is named, not an IndexError."""

@@ -43,7 +43,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8, as_image_array, real_number, xy_points
+from stereovision._validate import as_gray_uint8, as_image_array, positive_finite, xy_points
 from stereovision.rectification_check import (
     DEFAULT_TOLERANCE_PX,
     MIN_MATCHES,
@@ -454,7 +454,11 @@ class UncalibratedRectification:
             If an image is not of :attr:`input_size`, or a tolerance that is not a positive
             number.
         """
-        if not real_number(tolerance) or not (np.isfinite(tolerance) and tolerance > 0):
+        if (
+            isinstance(tolerance, (bool, np.bool_))
+            or not isinstance(tolerance, (int, float, np.integer, np.floating))
+            or not (np.isfinite(tolerance) and tolerance > 0)
+        ):
             raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
         grays = []
         for name, img in (("left", left), ("right", right)):
@@ -683,8 +687,8 @@ def rectify_uncalibrated(
     """
     if model not in MODELS:
         raise ValueError(f"model: expected one of {', '.join(MODELS)}, got {model!r}")
-    if not (real_number(ransac_px) and math.isfinite(ransac_px) and ransac_px > 0):
-        raise ValueError(f"ransac_px: expected a positive number of pixels, got {ransac_px!r}")
+    # NumPy reals too (np.float32(1.0) was "not a positive number"), as check()'s tolerance
+    ransac = positive_finite(ransac_px, "ransac_px")
     gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
     if gl.shape != gr.shape:
         raise ValueError(
@@ -708,9 +712,7 @@ def rectify_uncalibrated(
     if float(np.median(np.linalg.norm(p1 - p2, axis=1))) < 0.5:
         raise ValueError("the two images show the same view (no parallax): nothing to rectify")
     try:
-        found, mask = cv2.findFundamentalMat(
-            p1, p2, cv2.USAC_MAGSAC, float(ransac_px), 0.9999, 10000
-        )
+        found, mask = cv2.findFundamentalMat(p1, p2, cv2.USAC_MAGSAC, ransac, 0.9999, 10000)
     except cv2.error:  # MAGSAC++ found no model: OpenCV 5 asserts instead of returning None
         found, mask = None, None
     inl = np.zeros(len(p1), bool) if mask is None else mask.ravel().astype(bool)
