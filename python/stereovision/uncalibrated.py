@@ -3,8 +3,9 @@
 A robot's two cameras may need a look at disparity before anyone has waved a board in front of
 them. :func:`rectify_uncalibrated` finds SIFT matches between the two views (mutual nearest
 neighbours with Lowe's ratio test, as :func:`~stereovision.rectification_check.check_rectification`
-does), keeps those that fit one fundamental matrix ``F`` (OpenCV's MAGSAC++), and finds two
-homographies that put every pair of corresponding points on the same row:
+does), keeps those that fit one fundamental matrix ``F`` (OpenCV's MAGSAC++; RANSAC where it
+fails an assertion), and finds two homographies that put every pair of corresponding points on
+the same row:
 
 - **The model.** Two cameras side by side, each turned a little about its centre: Fusiello and
   Irsara's quasi-Euclidean rectification (five angles and a focal length, here with a second
@@ -713,8 +714,14 @@ def rectify_uncalibrated(
         raise ValueError("the two images show the same view (no parallax): nothing to rectify")
     try:
         found, mask = cv2.findFundamentalMat(p1, p2, cv2.USAC_MAGSAC, ransac, 0.9999, 10000)
-    except cv2.error:  # MAGSAC++ found no model: OpenCV 5 asserts instead of returning None
-        found, mask = None, None
+    except cv2.error:
+        # OpenCV 5's USAC asserts ("!model.empty()") instead of returning None, also where a
+        # model is there to find (Tsukuba with its right image 2 px lower: every USAC method
+        # asserted, "0 of 389 matches fit"; 370 fit RANSAC's): then RANSAC's, same threshold
+        try:
+            found, mask = cv2.findFundamentalMat(p1, p2, cv2.FM_RANSAC, ransac, 0.9999, 10000)
+        except cv2.error:
+            found, mask = None, None
     inl = np.zeros(len(p1), bool) if mask is None else mask.ravel().astype(bool)
     if found is None or found.shape != (3, 3) or inl.sum() < MIN_MATCHES:
         raise ValueError(
