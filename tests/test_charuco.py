@@ -1141,3 +1141,33 @@ def test_mutation_audit_5_white_black_squares_of_the_cut_legacy_board() -> None:
     misplaced = _white_black_squares(gray, wrong_board, *wrong)
     assert misplaced is not None and misplaced >= 2
     assert _white_black_squares(np.full_like(gray, 128), true, *right) is None
+
+
+def test_a_marker_size_opencv_cannot_draw_is_drawn_in_its_layout(tmp_path: Path) -> None:
+    """OpenCV's generateImage fails its own ROI assertion for some marker sizes (21.6 px markers
+    in 27 px squares: cv2.error; ``board --square 24 --unit mm --marker 21 --dpi 96``: "internal
+    error"). Such a board is drawn in the same layout, and gives all its corners."""
+    board = CharucoBoard((5, 4), 1.0, 0.8, "DICT_4X4_50")
+    img = board.image(27)
+    assert img.shape == (4 * 27 + 54, 5 * 27 + 54) and set(np.unique(img)) == {0, 255}
+    big = cv2.resize(img, None, fx=4, fy=4, interpolation=cv2.INTER_LINEAR)
+    found = find_charuco_corners(big, board)
+    assert found is not None and len(found[0]) == board.n_corners
+    want = board.object_points(found[0])[:, :2] * 27 * 4 + 27 * 4 - 0.5  # pixel centres, 4x
+    assert np.abs(found[1] - want).max() < 1.0  # measured 0.57 px (of 108 px squares)
+    run = _cli("board", "-o", str(tmp_path / "b.png"), "--board", "charuco", "--pattern", "5x4",
+               "--square", "24", "--unit", "mm", "--marker", "21", "--dpi", "96",
+               "--dictionary", "4x4_50")  # fmt: skip
+    assert run.returncode == 0 and "internal error" not in run.stderr, run.stderr
+    assert cv2.imread(str(tmp_path / "b.png"), 0).shape == (6 * 91, 7 * 91)
+
+
+def test_the_drawn_board_is_opencvs_image_where_opencv_draws() -> None:
+    """The drawing used where OpenCV's fails is OpenCV's image pixel for pixel where that one
+    draws (80 px squares, 60 px markers; both layouts of an even number of rows)."""
+    from stereovision.charuco import _drawn_board
+
+    for squares, legacy in (((5, 4), False), ((8, 6), True), ((8, 6), False)):
+        board = CharucoBoard(squares, 1.0, 0.75, "DICT_4X4_50", legacy)
+        drawn = _drawn_board(board.cv_board(), board.squares, 80, 80, 60)
+        assert np.array_equal(drawn, board.image(80))

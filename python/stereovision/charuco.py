@@ -299,7 +299,13 @@ class CharucoBoard:
                 f"{marker_px:.2g} px at {p} px per square; {self.dictionary}'s markers need at "
                 f"least {need} px: use a larger marker or more pixels per square"
             )
-        return np.asarray(cv_board.generateImage(size, marginSize=mg, borderBits=1))
+        try:
+            return np.asarray(cv_board.generateImage(size, marginSize=mg, borderBits=1))
+        except cv2.error:
+            # OpenCV's generateImage fails its own assertion on the ROI of a marker of some
+            # sizes (21.6 px in 27 px squares; 35 of 1820 whole-mm boards at 72-300 dpi,
+            # `board` said "internal error"): drawn here then, the same layout
+            return _drawn_board(cv_board, self.squares, p, mg, round(marker_px))
 
     def markers_seen(self, image: npt.ArrayLike) -> tuple[str, int]:
         """The dictionary family that decodes most of this board's marker ids in an image.
@@ -377,6 +383,32 @@ class CharucoBoard:
             else:
                 board = replace(board, legacy=counts[1] > counts[0])
         return board
+
+
+def _drawn_board(
+    cv_board: Any, squares: tuple[int, int], p: int, margin: int, marker_px: int
+) -> npt.NDArray[np.uint8]:
+    """The board's image as ``generateImage`` draws it: black squares, and in each white square
+    its marker (``marker_px`` px, one black border bit) centred, upright, with the board's ids
+    and positions (``getObjPoints``, so the layout, legacy or not, is OpenCV's)."""
+    cols, rows = squares
+    img = np.full((rows * p + 2 * margin, cols * p + 2 * margin), 255, np.uint8)
+    side = float(cv_board.getSquareLength())
+    dictionary = cv_board.getDictionary()
+    white = {}
+    for quad, marker_id in zip(cv_board.getObjPoints(), np.ravel(cv_board.getIds()), strict=True):
+        cx, cy = np.asarray(quad, np.float64).reshape(-1, 3)[:, :2].mean(axis=0)
+        white[(math.floor(cx / side), math.floor(cy / side))] = int(marker_id)
+    off = (p - marker_px) // 2
+    for r in range(rows):
+        for c in range(cols):
+            y0, x0 = margin + r * p, margin + c * p
+            if (c, r) not in white:
+                img[y0 : y0 + p, x0 : x0 + p] = 0
+                continue
+            marker = cv2.aruco.generateImageMarker(dictionary, white[(c, r)], marker_px, None, 1)
+            img[y0 + off : y0 + off + marker_px, x0 + off : x0 + off + marker_px] = marker
+    return img
 
 
 def _white_black_squares(
