@@ -1171,3 +1171,26 @@ def test_the_drawn_board_is_opencvs_image_where_opencv_draws() -> None:
         board = CharucoBoard(squares, 1.0, 0.75, "DICT_4X4_50", legacy)
         drawn = _drawn_board(board.cv_board(), board.squares, 80, 80, 60)
         assert np.array_equal(drawn, board.image(80))
+
+
+def test_a_printable_board_whose_markers_no_detector_decodes_is_refused(tmp_path: Path) -> None:
+    """3 mm markers in 30 mm squares at 72 dpi are 8.5 px, 1.2 px a cell of DICT_5X5_50's 7:
+    ``board`` wrote them, and the board's own image decoded none of its 17 markers. Refused,
+    nothing written, naming the dpi that gives 3 px a cell (178), whose board decodes all."""
+    board = CharucoBoard((7, 5), 30, 3, "DICT_5X5_50")
+    with pytest.raises(
+        ValueError, match=r"marker_size: a 3 mm marker at 72 dpi is 8\.5 px, 1\.2 px"
+    ):
+        board_png(board, 0.03, 72)
+    out = tmp_path / "b.png"
+    run = _cli("board", "-o", str(out), "--board", "charuco", "--pattern", "7x5", "--square",
+               "30", "--unit", "mm", "--marker", "3", "--dpi", "72")  # fmt: skip
+    assert run.returncode == 2 and run.stderr.count("\n") == 1 and not out.exists()
+    assert "use 178 dpi or more, or a larger marker" in run.stderr
+    with pytest.raises(ValueError, match="use 178 dpi"):
+        board_png(board, 0.03, 177)
+    data, _ = board_png(board, 0.03, 178)
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
+    detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_5X5_50))
+    ids = detector.detectMarkers(img)[1]
+    assert ids is not None and sorted(ids.ravel().tolist()) == list(range(17))

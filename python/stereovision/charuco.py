@@ -702,6 +702,31 @@ def _dpi_for(pix: int, square_metres: float, mm: str) -> float:
     return dpi
 
 
+#: Fewest pixels per cell of a marker (its bits and black border) a printed board is written
+#: with: the markers of a board's own image at 1.2-2.5 px per cell were at times none decoded
+#: (3 mm markers at 72 dpi: 0 of 17), from 3.1 px all of them (4X4 to 7X7, AprilTag, ArUco).
+MIN_PX_PER_CELL = 3.0
+
+
+def _check_marker_cells(board: CharucoBoard, pix: int, square_metres: float, dpi: float) -> None:
+    """Refuse a printable board whose markers get under :data:`MIN_PX_PER_CELL` pixels a cell at
+    ``pix`` px per square (``board`` wrote boards no detector decodes), naming the dpi that
+    gives enough: its square is then at least that many whole pixels (``_board_scale``)."""
+    cells = int(_dictionary(board.dictionary).markerSize) + 2
+    ratio = board.marker_size / board.square_size
+    per_cell = pix * ratio / cells
+    if per_cell >= MIN_PX_PER_CELL:
+        return
+    need_px = math.ceil(MIN_PX_PER_CELL * cells / ratio)
+    need_dpi = math.ceil(need_px * 0.0254 / square_metres)
+    raise ValueError(
+        f"marker_size: a {square_metres * ratio * 1000:g} mm marker at {dpi:g} dpi is "
+        f"{pix * ratio:.1f} px, {per_cell:.1f} px a cell of {board.dictionary}'s {cells} (its "
+        f"bits and border); a printed marker needs {MIN_PX_PER_CELL:g} to be decoded: use "
+        f"{need_dpi} dpi or more, or a larger marker"
+    )
+
+
 def board_png(
     board: CharucoBoard | tuple[int, int],
     square_metres: float,
@@ -735,6 +760,7 @@ def board_png(
         # did not give (they gave the square and dpi)
         if (cols + 2) * (rows + 2) * pix * pix > MAX_IMAGE_PIXELS:
             raise _too_large(f"a {cols}x{rows} ChArUco board", (cols, rows), pix, square_metres)
+        _check_marker_cells(board, pix, square_metres, dpi)
         img = board.image(pix, margin=pix)
     else:
         from stereovision.calibrate import parse_pattern
