@@ -1194,3 +1194,15 @@ def test_a_printable_board_whose_markers_no_detector_decodes_is_refused(tmp_path
     detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_5X5_50))
     ids = detector.detectMarkers(img)[1]
     assert ids is not None and sorted(ids.ravel().tolist()) == list(range(17))
+
+
+def test_auto_is_read_in_any_case_as_the_dictionary_names_are(tmp_path: Path) -> None:
+    """``dictionary="5x5_100"`` is DICT_5X5_100, but ``"AUTO"`` (``--dictionary AUTO``) was
+    refused as an unknown ArUco dictionary: it is "auto" now, in any case and spacing."""
+    for given in ("AUTO", "Auto", " auto "):
+        assert CharucoBoard("7x5", 0.03, 0.022, given).dictionary == "auto"
+    out = tmp_path / "b.png"
+    run = _cli("board", "-o", str(out), "--board", "charuco", "--pattern", "7x5", "--square",
+               "30", "--unit", "mm", "--marker", "22", "--dictionary", "AUTO")  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "DICT_5X5_50" in run.stdout and out.is_file()

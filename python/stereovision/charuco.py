@@ -170,6 +170,9 @@ class CharucoBoard:
             )
         object.__setattr__(self, "square_size", s)
         object.__setattr__(self, "marker_size", m)
+        if isinstance(self.dictionary, str) and self.dictionary.strip().lower() == "auto":
+            # as the names: "5x5_100" is DICT_5X5_100, and "AUTO" was an unknown dictionary
+            object.__setattr__(self, "dictionary", "auto")
         if self.dictionary != "auto":
             name = dictionary_name(self.dictionary)
             size = int(_dictionary(name).bytesList.shape[0])
