@@ -1492,3 +1492,10 @@ def test_rectify_takes_the_packages_images_and_names_others(data_dir: Path) -> N
         rect.rectify(sc.left, sc.right > 100)
     with pytest.raises(ValueError, match="left: unsupported dtype int64"):
         rect.rectify(sc.left.astype(np.int64), sc.right)
+
+
+def test_ransac_px_beyond_a_float_is_refused_by_name() -> None:
+    """10**400 raised math.isfinite's bare OverflowError, naming nothing."""
+    a = np.zeros((50, 60), np.uint8)
+    with pytest.raises(ValueError, match=r"^ransac_px: expected a positive number of pixels"):
+        rectify_uncalibrated(a, a, ransac_px=10**400)

@@ -43,7 +43,14 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8, as_image_array, positive_finite, xy_points
+from stereovision._validate import (
+    as_gray_uint8,
+    as_image_array,
+    number_shown,
+    real_number,
+    too_large_for_float,
+    xy_points,
+)
 from stereovision.rectification_check import (
     DEFAULT_TOLERANCE_PX,
     MIN_MATCHES,
@@ -696,7 +703,13 @@ def rectify_uncalibrated(
     if model not in MODELS:
         raise ValueError(f"model: expected one of {', '.join(MODELS)}, got {model!r}")
     # NumPy reals too (np.float32(1.0) was "not a positive number"), as check()'s tolerance
-    ransac = positive_finite(ransac_px, "ransac_px")
+    if too_large_for_float(ransac_px):  # 10**400: math.isfinite's OverflowError
+        raise ValueError(
+            f"ransac_px: expected a positive number of pixels, got {number_shown(ransac_px)}"
+        )
+    if not (real_number(ransac_px) and math.isfinite(ransac_px) and ransac_px > 0):
+        raise ValueError(f"ransac_px: expected a positive number of pixels, got {ransac_px!r}")
+    ransac = float(ransac_px)
     gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
     if gl.shape != gr.shape:
         raise ValueError(
