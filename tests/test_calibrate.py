@@ -2413,3 +2413,41 @@ def test_mutation_audit_5_a_repeat_is_both_images_and_is_said_in_number(
     cal, side_by_side = chessboard
     assert calmod._upright_hint(cal) == ""
     assert calmod._epipolar_label(replace(side_by_side, _calibration=None)) == "|dy|"
+
+
+def _pairs_at_tilts(tilts_deg: list[tuple[float, float]]) -> tuple[list[Any], list[Any]]:
+    """The synthetic rig's pairs of a board tilted by ``(about x, about y)`` degrees, one pair
+    per tilt, each at its own place and distance (a board moved about, not only turned)."""
+    obj_centre = np.array([4 * SYN_SQUARE, 2.5 * SYN_SQUARE, 0.0])
+    places = [(0.0, -0.02, 0.6), (0.03, 0.02, 0.66), (0.02, -0.01, 0.72), (0.01, 0.02, 0.63)]
+    kw: dict[str, Any] = {"pattern": SYN_PATTERN, "square_size": SYN_SQUARE, "image_size": SYN_SIZE}
+    left, right = [], []
+    for k, (ax, ay) in enumerate(tilts_deg):
+        rb = cv2.Rodrigues(np.radians([ax, ay, 0.0]))[0]
+        tv = np.array(places[k % len(places)]) - rb @ obj_centre
+        left.append(render_chessboard(SYN_K1, SYN_D1, cv2.Rodrigues(rb)[0], tv, **kw))
+        tv2 = SYN_R @ tv + SYN_T
+        right.append(render_chessboard(SYN_K2, SYN_D2, cv2.Rodrigues(SYN_R @ rb)[0], tv2, **kw))
+    return left, right
+
+
+def test_boards_held_at_one_tilt_are_refused_and_a_small_spread_warned() -> None:
+    """Pairs of a board only moved about, never turned, fix no focal length: these four were
+    calibrated in silence to 738 px for 700 (scaled copies of a sample pair to 777 px for 533,
+    shifted ones refused in words about the R and T the user never gave). Now a plane spread
+    under MIN_TILT_SPREAD_DEG is refused naming it and one under TILT_SPREAD_WARN_DEG is warned
+    about (the sample pairs' planes are 65 degrees apart)."""
+    left, right = _pairs_at_tilts([(8.0, -12.0)] * 4)
+    with pytest.raises(ValueError, match=r"^the boards' planes are at most 0\.\d degrees apart "):
+        calibrate(left, right, pattern=SYN_PATTERN, square_size=SYN_SQUARE)
+    left, right = _pairs_at_tilts([(4.0, 0.0), (-4.0, 0.0), (0.0, 4.0), (0.0, -4.0), (0, 0)])
+    with pytest.warns(UserWarning, match=r"at most \d\.\d degrees apart over the 5 pairs") as rec:
+        cal, rep = calibrate(left, right, pattern=SYN_PATTERN, square_size=SYN_SQUARE)
+    said = re.search(r"at most (\d\.\d) degrees", str(rec[0].message))
+    assert said is not None and float(said[1]) == pytest.approx(8.0, abs=0.5)  # (4, 0) to (-4, 0)
+    assert "(15 degrees or more apart advised)" in str(rec[0].message)
+    assert str(rec[0].message) in rep.warnings
+    assert cal.K1[0, 0] == pytest.approx(SYN_K1[0, 0], rel=0.02)  # 8 degrees: still usable
+    assert calmod._tilt_spread([np.zeros(3), np.radians([0.0, 30.0, 0.0])]) == pytest.approx(30)
+    # a plane's normal has no sign: a board turned half round is the same plane
+    assert calmod._tilt_spread([np.zeros(3), np.array([0.0, 0.0, np.pi])]) == pytest.approx(0)
