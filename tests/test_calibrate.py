@@ -2451,3 +2451,21 @@ def test_boards_held_at_one_tilt_are_refused_and_a_small_spread_warned() -> None
     assert calmod._tilt_spread([np.zeros(3), np.radians([0.0, 30.0, 0.0])]) == pytest.approx(30)
     # a plane's normal has no sign: a board turned half round is the same plane
     assert calmod._tilt_spread([np.zeros(3), np.array([0.0, 0.0, np.pi])]) == pytest.approx(0)
+
+
+def test_a_camera_mounted_upside_down_is_said_not_called_mis_paired(cached_corners: None) -> None:
+    """OpenCV's pairs with every right image turned half round (a camera mounted upside down):
+    the right corners were put in the left ones' image order, opposite corners paired, and the
+    refusal blamed the pairing ("are they mis-paired ...?", 35.7 px). It now says the camera is
+    upside down, with the RMS the boards read turned give, and how to turn the images."""
+    left, right = _chessboard_paths()
+    turned = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)[::-1, ::-1].copy() for p in right]
+    with pytest.raises(ValueError) as err:
+        calibrate(left, turned, pattern=(9, 6), square_size=1.0)
+    said = str(err.value)
+    assert re.fullmatch(
+        r"stereo RMS 3\d\.\d px, 0\.(1\d|2\d) px with the right boards read turned half round: "
+        r"one camera is mounted upside down against the other; turn the right images by 180 "
+        r"degrees \(or the camera\) and calibrate again",
+        said,
+    ), said

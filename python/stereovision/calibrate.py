@@ -1324,12 +1324,18 @@ def _numbers_differ(
     return out
 
 
+def _shows_one_rig(sol: _Solution) -> bool:
+    """Whether the stereo RMS is within :data:`MAX_STEREO_RMS_PX`, or
+    :data:`MISPAIRED_RMS_RATIO` x each camera's own."""
+    mono = max(sol.rms_left, sol.rms_right)
+    return sol.rms <= MAX_STEREO_RMS_PX or sol.rms <= MISPAIRED_RMS_RATIO * mono
+
+
 def _check_pairing(
     sol: _Solution, names: Sequence[str], differ: Sequence[str], dropped: bool
 ) -> None:
     """Refuse a solution whose pairs do not show one rig (see :data:`MISPAIRED_RMS_RATIO`)."""
-    mono = max(sol.rms_left, sol.rms_right)
-    if sol.rms <= MAX_STEREO_RMS_PX or sol.rms <= MISPAIRED_RMS_RATIO * mono:
+    if _shows_one_rig(sol):
         return
     pair_err = np.sqrt(np.mean(sol.per_view**2, axis=1))
     worst = np.argsort(-pair_err)[:WORST_PAIRS_SHOWN]
@@ -1425,7 +1431,8 @@ def calibrate(
         With ``dictionary="auto"``, also if no image shows enough of the board's markers. If the
         pairs do not show one rig (stereo RMS above :data:`MAX_STEREO_RMS_PX` and
         :data:`MISPAIRED_RMS_RATIO` x each camera's; mis-paired or swapped images): the message
-        names the worst pairs.
+        names the worst pairs, or says that one camera is upside down when the right boards
+        read turned half round fit.
 
     Warns
     -----
@@ -1758,6 +1765,18 @@ def calibrate(
             f"({TILT_SPREAD_WARN_DEG:g} degrees or more apart advised)",
             UserWarning,
         )
+    if board is None and not _shows_one_rig(sol):
+        # A camera mounted upside down shows the board turned half round: the right corners
+        # were put in the left ones' image order, the opposite corners, and every pair looked
+        # mis-paired (35.7 px stereo RMS on OpenCV's pairs, the right images turned).
+        half_turn = _grid_symmetries(pat)[1]
+        turned = _solve(obj, pl, [p[half_turn] for p in pr], size, sol.model, False)
+        if _shows_one_rig(turned):
+            raise ValueError(
+                f"stereo RMS {sol.rms:.1f} px, {turned.rms:.2f} px with the right boards read "
+                "turned half round: one camera is mounted upside down against the other; turn "
+                "the right images by 180 degrees (or the camera) and calibrate again"
+            )
     _check_pairing(
         sol, [pair_names[i] for i in used], [d for d in differ if d not in rejected], drop_outliers
     )
