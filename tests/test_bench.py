@@ -416,3 +416,50 @@ def test_bench_scene_refuses_runs_that_are_no_integer_before_any_work(runs: obje
 
     with pytest.raises(ValueError, match=r"^runs: expected an integer, at least 5 .*got "):
         bench_scene(types.SimpleNamespace(), runs=runs)  # type: ignore[arg-type]
+
+
+def test_bench_of_several_scenes_goes_on_past_a_damaged_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One damaged scene of several stopped the whole run at it (exit 2): the scenes timed
+    before it were never printed (without --json the table comes at the end), those after it
+    never timed, where eval says the damaged one and goes on. bench now does as eval: each
+    damaged scene on a 'failed' line, the others benched and printed, exit status 1."""
+    import cv2
+
+    import stereovision.bench as bench_mod
+
+    good = ("a_good", "c_good")
+    for name in good:
+        (tmp_path / name).mkdir()
+        for side in ("left.png", "right.png"):
+            assert cv2.imwrite(str(tmp_path / name / side), np.zeros((40, 60, 3), np.uint8))
+    bad = tmp_path / "b_bad"
+    bad.mkdir()
+    narrow = tmp_path / "d_narrow"  # too narrow for its range: its message names its folder
+    narrow.mkdir()
+    for side in ("left.png", "right.png"):
+        (bad / side).write_bytes(b"not a png")
+        assert cv2.imwrite(str(narrow / side), np.zeros((40, 12, 3), np.uint8))
+
+    def fake(scene: Any, runs: int) -> list[Any]:  # the figures are not what is checked
+        return [
+            bench_mod.BenchCase(scene.name, "SGBM-3WAY", "opencv", 60, 40, 16, runs, 2.0, 1.0, {})
+        ]
+
+    monkeypatch.setattr(bench_mod, "bench_scene", fake)
+    for json_flag in ([], ["--json"]):
+        assert main(["bench", *json_flag, str(tmp_path)]) == 1
+        cap = capsys.readouterr()
+        objects = [json.loads(ln) for ln in cap.out.splitlines() if ln.startswith("{")]
+        assert [o["scene"].split("/")[-1] for o in objects] == list(good)
+        if not json_flag:  # the table of the two scenes benched, then their JSON lines
+            assert cap.out.splitlines()[0].split()[:4] == ["scene", "size", "D", "case"]
+        err = cap.err.strip().splitlines()
+        assert len(err) == 3 and err[0].startswith(f"failed {bad}: ") and "left.png" in err[0]
+        assert err[1].startswith(f"failed {narrow}: ") and err[1].count(str(narrow)) == 1
+        assert err[2] == "stereovision: 2 of 4 scenes failed (above)"
+    # a damaged scene alone is the one-line error it was (exit 2)
+    assert main(["bench", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("stereovision: error:") and "left.png" in err

@@ -311,13 +311,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
     Returns
     -------
     int
-        0 (the exit status); errors are raised, for the CLI to print as one line.
+        The exit status: 0, or 1 when some of several scenes failed (each said on a
+        ``failed`` line, the others benched); other errors are raised, for the CLI to print
+        as one line.
 
     Raises
     ------
     ValueError
-        If ``runs`` < :data:`MIN_RUNS` or > :data:`stereovision.cli.MAX_RUNS`, or a folder
-        holds no scene.
+        If ``runs`` < :data:`MIN_RUNS` or > :data:`stereovision.cli.MAX_RUNS`, a folder
+        holds no scene, or the one scene given cannot be benched (damaged, too narrow).
     FileNotFoundError
         If a scene folder does not exist.
     """
@@ -331,23 +333,38 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise ValueError(f"--runs: at most {MAX_RUNS}, got {args.runs}")
     dirs = _scene_dirs(args.scenes)
     all_cases: list[BenchCase] = []
+    failed: list[str] = []
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
-        scene = load_scene(d)
-        narrow = scene_too_narrow(scene)
-        if narrow:
-            # as eval says it: "disparity range 16 is not smaller than the image width 8 ...;
-            # give a max_disparity below 8" named a range and an option bench has not
-            raise ValueError(f"{d}: {narrow}")
-        cases = bench_scene(scene, runs=args.runs)
+        try:
+            scene = load_scene(d)
+            narrow = scene_too_narrow(scene)
+            if narrow:
+                # as eval says it: "disparity range 16 is not smaller than the image width 8
+                # ...; give a max_disparity below 8" named a range and an option bench has not
+                raise ValueError(f"{d}: {narrow}")
+            cases = bench_scene(scene, runs=args.runs)
+        except (ValueError, OSError, RuntimeError) as e:
+            if len(dirs) == 1:
+                raise
+            # one damaged scene of many, as eval: said, and the others benched (it stopped the
+            # run, and without --json the table of the scenes timed before it was never printed)
+            failed.append(str(d))
+            said = str(e)  # the narrow scene's message names its folder already
+            said = said if said.startswith(f"{d}: ") else f"{d}: {said}"
+            tqdm.write(f"failed {said}", file=sys.stderr)
+            continue
         all_cases.extend(cases)
         if args.json:
             for c in cases:
                 print(json_line(c.as_dict()), flush=True)
-    if not args.json:
+    if not args.json and all_cases:
         print(format_table(all_cases))
         for c in all_cases:
             print(json_line(c.as_dict()))
+    if failed:
+        print(f"stereovision: {len(failed)} of {len(dirs)} scenes failed (above)", file=sys.stderr)
+        return 1
     return 0
 
 
