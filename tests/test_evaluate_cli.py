@@ -349,3 +349,20 @@ def test_eval_of_a_scene_narrower_than_bms_range_plus_its_block(
     bm = dense_metrics(baselines.opencv_bm(scene.left, scene.right, 48), scene.gt).as_dict()
     assert row["bm"]["bad_2.0"] == pytest.approx(bm["bad_2.0"])
     assert row["bm"]["density"] == pytest.approx(bm["density"])
+
+
+def test_eval_names_a_narrow_scene_among_several_once(tmp_path: Path) -> None:
+    """A scene too narrow for its range among several was said as 'failed <folder>:
+    <folder>: images 8 px wide, ...' (its message names its folder, and the line named it
+    again); the folder is said once, as for any other failing scene."""
+    narrow = syn.narrow_scene(tmp_path)
+    empty = tmp_path / "zz_no_gt"  # a second scene, skipped without GT: no matching runs
+    empty.mkdir()
+    for name in ("left.png", "right.png"):
+        (empty / name).write_bytes((narrow / name).read_bytes())
+    proc = _eval(str(tmp_path), "--no-opencv", "--method", "fast")
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.splitlines()[0] == (
+        f"failed {narrow}: images 8 px wide, not wider than the scene's disparity range "
+        "(16 px, evaluation.md's rule: 16 at least): a scene needs images at least 17 px wide"
+    )

@@ -1762,7 +1762,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 raise
             # one damaged scene of many: say so and go on (the exit status says it at the end)
             failed.append(str(d))
-            tqdm.write(f"failed {d}: {e}", file=sys.stderr)
+            said = str(e)  # the narrow scene's message names its folder already
+            said = said if said.startswith(f"{d}: ") else f"{d}: {said}"
+            tqdm.write(f"failed {said}", file=sys.stderr)
             continue
         rows.append(row)
         if args.json:
