@@ -431,3 +431,48 @@ def test_sgbm_refuses_a_grey_image_beside_a_colour_one(data_dir: Path) -> None:
     np.testing.assert_array_equal(opencv_bm(grey3, s.right, 64), bm)
     sv1 = stereovision_1_0(grey, s.right, 64)  # its BM reads the grey pair too
     np.testing.assert_array_equal(stereovision_1_0(grey3, s.right, 64), sv1)
+
+
+def test_sgbm_refuses_a_range_not_narrower_than_the_images() -> None:
+    """OpenCV's SGBM-3WAY with a range (``max_disparity`` rounded up to 16) of the image's width
+    + 1 killed the process (a segmentation fault: 63 px wide at a max_disparity of 50 or 64,
+    31 px at 20 or 32), and at other widths up to the range failed with OpenCV's words ("Failed
+    to allocate 18446744073709548353 bytes", "count > 0 in function 'allocate'"). Such a range
+    is refused, naming the width it needs and the widest range that fits; run in a child
+    process, where the old code's crash is a failure, not the end of the test session."""
+    import subprocess
+    import sys
+
+    code = """if True:
+        import numpy as np
+        from stereovision.baselines import opencv_sgbm
+        rng = np.random.default_rng(0)
+        for width, md in ((63, 50), (63, 64), (64, 64), (31, 32), (17, 32), (16, 1)):
+            img = (rng.random((20, width, 3)) * 255).astype(np.uint8)
+            try:
+                opencv_sgbm(img, img, md)
+                print("computed", width, md)
+            except ValueError as e:
+                print(e)
+        img = (rng.random((20, 65, 3)) * 255).astype(np.uint8)
+        print(opencv_sgbm(img, img, 64).shape)  # the range + 1 px: computed
+    """
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[-500:]
+
+    def said(num: int, width: int) -> str:
+        fits = f"; give a max_disparity of at most {(width - 1) // 16 * 16}" if width > 16 else ""
+        return (
+            f"SGBM-3WAY's {num} px disparity range (max_disparity rounded up to a multiple of "
+            f"16) needs images at least {num + 1} px wide, got {width}{fits}"
+        )
+
+    assert proc.stdout.splitlines() == [
+        said(64, 63),
+        said(64, 63),
+        said(64, 64),
+        said(32, 31),
+        said(32, 17),
+        said(16, 16),
+        "(20, 65)",
+    ]

@@ -223,12 +223,24 @@ def opencv_sgbm(left: object, right: object, max_disparity: float) -> npt.NDArra
     ------
     ValueError
         On invalid images, mismatched sizes, a grey image beside a colour one (SGBM matches
-        colour; beside a grey file read in colour, three equal channels, it is the grey pair) or a
-        negative/non-finite ``max_disparity``.
+        colour; beside a grey file read in colour, three equal channels, it is the grey pair), a
+        negative/non-finite ``max_disparity``, or a range (rounded up to a multiple of 16) not
+        narrower than the images.
     """
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra, colour=True)
     num = round_up16(max_disparity)
+    width = la.shape[1]
+    if num >= width:
+        # OpenCV's SGBM-3WAY killed the process at a width of num - 1 (a segmentation fault:
+        # 63 px at 64) and failed in its own words at the other widths up to num ("Failed to
+        # allocate 18446744073709548353 bytes"); num + 1 px is computed
+        widest = (width - 1) // 16 * 16
+        fits = f"; give a max_disparity of at most {widest}" if widest >= 16 else ""
+        raise ValueError(
+            f"SGBM-3WAY's {num} px disparity range (max_disparity rounded up to a multiple of "
+            f"16) needs images at least {num + 1} px wide, got {width}{fits}"
+        )
     matcher = cv2.StereoSGBM.create(
         minDisparity=0,
         numDisparities=num,
