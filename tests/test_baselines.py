@@ -476,3 +476,31 @@ def test_sgbm_refuses_a_range_not_narrower_than_the_images() -> None:
         said(16, 16),
         "(20, 65)",
     ]
+
+
+@pytest.mark.parametrize(("fn", "block"), [(ros_stereo_image_proc, 15), (stereovision_1_0, 21)])
+def test_tool_bms_refuse_a_range_that_leaves_their_block_no_room(
+    data_dir: Path, fn, block: int
+) -> None:
+    """The tools' StereoBM (ROS's 15 px block, StereoVision 1.0's 21 px) with a range near the
+    width computed it anyway, as opencv_bm did before it refused: on the cones (450 px) at 432
+    px StereoVision 1.0's disparities reached 2035 px, its density 51 % or 70 % from one run to
+    the next; ROS's at 448 px 25 % or 50 %, up to 498 px. Such a range is refused, naming the
+    widest that fits (its block inside the image); that one is computed as before."""
+    scene = load_scene(data_dir / "middlebury2003" / "cones")
+    widest = (450 - block + 1) // 16 * 16  # 432 (ROS), 416 (StereoVision 1.0)
+    assert widest + block - 1 <= 450 < widest + 16 + block - 1
+    with pytest.raises(ValueError) as err:
+        fn(scene.left, scene.right, widest + 1, "bm")
+    assert str(err.value) == (
+        f"StereoBM's {block} px block and a {widest + 16} px disparity range (a multiple of 16) "
+        f"need images at least {widest + 16 + block - 1} px wide, got 450; give a max_disparity "
+        f"of at most {widest}"
+    )
+    runs = [fn(scene.left, scene.right, widest, "bm") for _ in range(3)]
+    for d in runs[1:]:
+        np.testing.assert_array_equal(d, runs[0])
+    assert not (runs[0] > widest).any()  # NaN compares False
+    narrow = scene.left[:40, : block + 14]  # no range of 16 fits beside the block
+    with pytest.raises(ValueError, match=rf"at least {block + 15} px wide, got {block + 14}$"):
+        fn(narrow, narrow, 1, "bm")

@@ -94,17 +94,34 @@ def round_up16(n: float) -> int:
     return max(16, 16 * math.ceil(x / 16.0))
 
 
-def bm_widest_range(width: int) -> int:
+def bm_widest_range(width: int, block: int = BM_BLOCK_SIZE) -> int:
     """The widest disparity range :func:`opencv_bm` searches in an image ``width`` px wide: the
     largest multiple of 16 that leaves its :data:`BM_BLOCK_SIZE` px block inside the image
-    (``range + BM_BLOCK_SIZE - 1 <= width``; 0 when none does).
+    (``range + BM_BLOCK_SIZE - 1 <= width``; 0 when none does). ``block``: that of another
+    StereoBM (StereoVision 1.0's 21 px).
 
     Examples
     --------
-    >>> bm_widest_range(450), bm_widest_range(30), bm_widest_range(29)
-    (432, 16, 0)
+    >>> bm_widest_range(450), bm_widest_range(30), bm_widest_range(29), bm_widest_range(450, 21)
+    (432, 16, 0, 416)
     """
-    return max(0, (int(width) - BM_BLOCK_SIZE + 1) // 16 * 16)
+    return max(0, (int(width) - block + 1) // 16 * 16)
+
+
+def _refuse_bm_range(num: int, width: int, block: int) -> None:
+    """Refuse a StereoBM range ``num`` whose ``block`` px block has no room in the ``width``.
+
+    StereoBM computed such a range anyway: disparities past it and past the width (2041 px on
+    a 450 px pair at 448 px), most pixels "valid", a run's density not the next's (cones at
+    448 px: 49 %, 75 %, 62 %).
+    """
+    widest = bm_widest_range(width, block)
+    if num > widest:
+        fits = f"; give a max_disparity of at most {widest}" if widest >= 16 else ""
+        raise ValueError(
+            f"StereoBM's {block} px block and a {num} px disparity range (a multiple "
+            f"of 16) need images at least {num + block - 1} px wide, got {width}{fits}"
+        )
 
 
 def bm_reference_range(max_disparity: float, width: int) -> float:
@@ -184,17 +201,7 @@ def opencv_bm(left: object, right: object, max_disparity: float) -> npt.NDArray[
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra)
     num = round_up16(max_disparity)
-    width = la.shape[1]
-    if num > bm_widest_range(width):
-        # StereoBM computed such a range anyway: disparities past it and past the width
-        # (2041 px on a 450 px pair at 448 px), most pixels "valid", a run's density not the
-        # next's (cones at 448 px: 49 %, 75 %, 62 %)
-        widest = bm_widest_range(width)
-        fits = f"; give a max_disparity of at most {widest}" if widest >= 16 else ""
-        raise ValueError(
-            f"StereoBM's {BM_BLOCK_SIZE} px block and a {num} px disparity range (a multiple "
-            f"of 16) need images at least {num + BM_BLOCK_SIZE - 1} px wide, got {width}{fits}"
-        )
+    _refuse_bm_range(num, la.shape[1], BM_BLOCK_SIZE)
     matcher = cv2.StereoBM.create(numDisparities=num, blockSize=BM_BLOCK_SIZE)
     raw = matcher.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right"))
     return _from_opencv(raw)
@@ -298,13 +305,16 @@ def ros_stereo_image_proc(
     Raises
     ------
     ValueError
-        On invalid images, mismatched sizes, a negative or non-finite ``max_disparity`` or an
-        unknown ``algorithm``.
+        On invalid images, mismatched sizes, a negative or non-finite ``max_disparity``, an
+        unknown ``algorithm``, or for BM a range that leaves its 15 px window no room in the
+        images' width (as :func:`opencv_bm`).
     """
     algo = _algorithm(algorithm)
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra)
     num = round_up16(max_disparity)
+    if algo == "bm":  # its window of 15 px, as opencv_bm's
+        _refuse_bm_range(num, la.shape[1], 15)
     gl, gr = as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")
     matcher: cv2.StereoMatcher
     if algo == "bm":
@@ -368,14 +378,16 @@ def stereovision_1_0(
     ------
     ValueError
         On invalid images, mismatched sizes (SGBM: a grey image beside a colour one, as
-        :func:`opencv_sgbm`), a negative or non-finite ``max_disparity`` or an
-        unknown ``algorithm``.
+        :func:`opencv_sgbm`), a negative or non-finite ``max_disparity``, an unknown
+        ``algorithm``, or for BM a range that leaves its 21 px window no room in the images'
+        width (as :func:`opencv_bm`).
     """
     algo = _algorithm(algorithm)
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra, colour=algo == "sgbm")  # BM reads the grey pair
     num = round_up16(max_disparity)
     if algo == "bm":
+        _refuse_bm_range(num, la.shape[1], 21)
         bm = cv2.StereoBM.create(numDisparities=num, blockSize=21)
         return _from_opencv(bm.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")))
     sg = cv2.StereoSGBM.create(
