@@ -504,3 +504,26 @@ def test_tool_bms_refuse_a_range_that_leaves_their_block_no_room(
     narrow = scene.left[:40, : block + 14]  # no range of 16 fits beside the block
     with pytest.raises(ValueError, match=rf"at least {block + 15} px wide, got {block + 14}$"):
         fn(narrow, narrow, 1, "bm")
+
+
+@pytest.mark.parametrize(("fn", "block"), [(ros_stereo_image_proc, 15), (stereovision_1_0, 3)])
+def test_tool_sgbms_refuse_a_range_too_wide_for_the_images(fn, block: int) -> None:
+    """The tools' StereoSGBM (MODE_SGBM: ROS's 15 px block, StereoVision 1.0's 3 px) with a range
+    that leaves less than half its block beside it failed in OpenCV's words, a cv2.error
+    ("... 'params.calcSADWindowSize().width/2' is 7"), naming neither the range nor the width.
+    It is a ValueError naming the width needed and the widest range that fits; the first
+    width that fits is computed."""
+    rng = np.random.default_rng(0)
+    need = 64 + block // 2 + 1  # 72 (ROS), 66 (StereoVision 1.0)
+    img = (rng.random((20, need - 1, 3)) * 255).astype(np.uint8)
+    with pytest.raises(ValueError) as err:
+        fn(img, img, 50, "sgbm")
+    assert str(err.value) == (
+        f"StereoSGBM's {block} px block and a 64 px disparity range (a multiple of 16) need "
+        f"images at least {need} px wide, got {need - 1}; give a max_disparity of at most 48"
+    )
+    tiny = img[:, : block // 2 + 16]  # no range of 16 fits
+    with pytest.raises(ValueError, match=rf"at least {block // 2 + 17} px wide, got "):
+        fn(tiny, tiny, 1, "sgbm")
+    wide = (rng.random((20, need, 3)) * 255).astype(np.uint8)
+    assert fn(wide, wide, 64, "sgbm").shape == (20, need)

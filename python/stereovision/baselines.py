@@ -140,6 +140,22 @@ def bm_reference_range(max_disparity: float, width: int) -> float:
     return widest if round_up16(max_disparity) > widest >= 16 else max_disparity
 
 
+def _refuse_sgbm_range(num: int, width: int, block: int) -> None:
+    """Refuse a MODE_SGBM range ``num`` that leaves less than half its ``block`` beside it.
+
+    OpenCV refused it in its own words, a ``cv2.error`` naming neither the range nor the width
+    ("'params.calcSADWindowSize().width/2' is 7").
+    """
+    need = num + block // 2 + 1
+    if width < need:
+        widest = (width - block // 2 - 1) // 16 * 16
+        fits = f"; give a max_disparity of at most {widest}" if widest >= 16 else ""
+        raise ValueError(
+            f"StereoSGBM's {block} px block and a {num} px disparity range (a multiple of 16) "
+            f"need images at least {need} px wide, got {width}{fits}"
+        )
+
+
 def _check_pair_shapes(left: np.ndarray, right: np.ndarray, colour: bool = False) -> None:
     """Refuse a pair of two sizes (:func:`pair_shape_error`, the API's words). ``colour``: the
     matcher reads the BGR pair (SGBM), so a one-channel image beside a colour one is refused
@@ -306,8 +322,8 @@ def ros_stereo_image_proc(
     ------
     ValueError
         On invalid images, mismatched sizes, a negative or non-finite ``max_disparity``, an
-        unknown ``algorithm``, or for BM a range that leaves its 15 px window no room in the
-        images' width (as :func:`opencv_bm`).
+        unknown ``algorithm``, or a range that leaves the 15 px window no room in the images'
+        width (BM: the whole window, as :func:`opencv_bm`; SGBM: half of it).
     """
     algo = _algorithm(algorithm)
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
@@ -315,6 +331,8 @@ def ros_stereo_image_proc(
     num = round_up16(max_disparity)
     if algo == "bm":  # its window of 15 px, as opencv_bm's
         _refuse_bm_range(num, la.shape[1], 15)
+    else:
+        _refuse_sgbm_range(num, la.shape[1], 15)
     gl, gr = as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")
     matcher: cv2.StereoMatcher
     if algo == "bm":
@@ -379,8 +397,8 @@ def stereovision_1_0(
     ValueError
         On invalid images, mismatched sizes (SGBM: a grey image beside a colour one, as
         :func:`opencv_sgbm`), a negative or non-finite ``max_disparity``, an unknown
-        ``algorithm``, or for BM a range that leaves its 21 px window no room in the images'
-        width (as :func:`opencv_bm`).
+        ``algorithm``, or a range that leaves the window no room in the images' width (BM: its
+        21 px, as :func:`opencv_bm`; SGBM: half its 3 px).
     """
     algo = _algorithm(algorithm)
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
@@ -390,6 +408,7 @@ def stereovision_1_0(
         _refuse_bm_range(num, la.shape[1], 21)
         bm = cv2.StereoBM.create(numDisparities=num, blockSize=21)
         return _from_opencv(bm.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")))
+    _refuse_sgbm_range(num, la.shape[1], 3)
     sg = cv2.StereoSGBM.create(
         minDisparity=0,
         numDisparities=num,
