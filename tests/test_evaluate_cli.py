@@ -366,3 +366,26 @@ def test_eval_names_a_narrow_scene_among_several_once(tmp_path: Path) -> None:
         f"failed {narrow}: images 8 px wide, not wider than the scene's disparity range "
         "(16 px, evaluation.md's rule: 16 at least): a scene needs images at least 17 px wide"
     )
+
+
+def test_eval_of_a_scene_no_higher_than_stereobms_block_says_so_in_one_line(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A scene 10 rows high: the StereoBM reference's cv2.error ended eval with 'internal error:
+    OpenCV(5.1.0) /io/opencv/modules/stereo/src/stereobm.cpp:1189: ... (please report this)'.
+    It is one line naming the height StereoBM needs."""
+    import cv2
+
+    from stereovision.io import read_pfm, write_pfm
+
+    src = data_dir / "middlebury2001" / "tsukuba"
+    scene = tmp_path / "short"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        assert cv2.imwrite(str(scene / name), cv2.imread(str(src / name))[100:110])
+    write_pfm(scene / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[100:110])
+    proc = _eval(str(scene), "--method", "fast")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        "stereovision: error: StereoBM's 15 px block needs images at least 16 px high, got 10"
+    ]

@@ -373,7 +373,13 @@ def test_scaled_calibration_and_compute_view():
             "disparity range 16 is not smaller than the image width 2: it needs images at least "
             "17 px wide, or give a max_disparity below 2",
         ),
-        ((2, 300, 3), "opencv-bm", "opencv-bm cannot match this 300x2 pair: (-211:"),
+        # baselines' words: the height StereoBM's block needs (OpenCV's "(-211: ...
+        # SADWindowSize must be odd, ... not larger than image width or height")
+        (
+            (2, 300, 3),
+            "opencv-bm",
+            "StereoBM's 15 px block needs images at least 16 px high, got 2",
+        ),
     ],
 )
 def test_opencv_methods_on_a_pair_they_cannot_take_say_why(shape, method, said):

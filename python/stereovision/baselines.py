@@ -108,13 +108,19 @@ def bm_widest_range(width: int, block: int = BM_BLOCK_SIZE) -> int:
     return max(0, (int(width) - block + 1) // 16 * 16)
 
 
-def _refuse_bm_range(num: int, width: int, block: int) -> None:
-    """Refuse a StereoBM range ``num`` whose ``block`` px block has no room in the ``width``.
+def _refuse_bm_range(num: int, shape: tuple[int, ...], block: int) -> None:
+    """Refuse a StereoBM range ``num`` whose ``block`` px block has no room in the images.
 
     StereoBM computed such a range anyway: disparities past it and past the width (2041 px on
     a 450 px pair at 448 px), most pixels "valid", a run's density not the next's (cones at
-    448 px: 49 %, 75 %, 62 %).
+    448 px: 49 %, 75 %, 62 %). Images no higher than the block were a cv2.error in OpenCV's
+    words ("SADWindowSize ... not larger than image width or height").
     """
+    height, width = shape[:2]
+    if height <= block:
+        raise ValueError(
+            f"StereoBM's {block} px block needs images at least {block + 1} px high, got {height}"
+        )
     widest = bm_widest_range(width, block)
     if num > widest:
         fits = f"; give a max_disparity of at most {widest}" if widest >= 16 else ""
@@ -210,14 +216,14 @@ def opencv_bm(left: object, right: object, max_disparity: float) -> npt.NDArray[
     Raises
     ------
     ValueError
-        On invalid images, mismatched sizes or a negative/non-finite ``max_disparity``, or a
-        range (rounded up to a multiple of 16) that leaves no room for the block in the image's
-        width (:func:`bm_widest_range`).
+        On invalid images, mismatched sizes or a negative/non-finite ``max_disparity``, images
+        no higher than the block, or a range (rounded up to a multiple of 16) that leaves no
+        room for the block in the image's width (:func:`bm_widest_range`).
     """
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra)
     num = round_up16(max_disparity)
-    _refuse_bm_range(num, la.shape[1], BM_BLOCK_SIZE)
+    _refuse_bm_range(num, la.shape, BM_BLOCK_SIZE)
     matcher = cv2.StereoBM.create(numDisparities=num, blockSize=BM_BLOCK_SIZE)
     raw = matcher.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right"))
     return _from_opencv(raw)
@@ -323,14 +329,15 @@ def ros_stereo_image_proc(
     ValueError
         On invalid images, mismatched sizes, a negative or non-finite ``max_disparity``, an
         unknown ``algorithm``, or a range that leaves the 15 px window no room in the images'
-        width (BM: the whole window, as :func:`opencv_bm`; SGBM: half of it).
+        width (BM: the whole window, as :func:`opencv_bm`, and images no higher than it; SGBM:
+        half of it).
     """
     algo = _algorithm(algorithm)
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra)
     num = round_up16(max_disparity)
     if algo == "bm":  # its window of 15 px, as opencv_bm's
-        _refuse_bm_range(num, la.shape[1], 15)
+        _refuse_bm_range(num, la.shape, 15)
     else:
         _refuse_sgbm_range(num, la.shape[1], 15)
     gl, gr = as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")
@@ -398,14 +405,14 @@ def stereovision_1_0(
         On invalid images, mismatched sizes (SGBM: a grey image beside a colour one, as
         :func:`opencv_sgbm`), a negative or non-finite ``max_disparity``, an unknown
         ``algorithm``, or a range that leaves the window no room in the images' width (BM: its
-        21 px, as :func:`opencv_bm`; SGBM: half its 3 px).
+        21 px, as :func:`opencv_bm`, and images no higher than it; SGBM: half its 3 px).
     """
     algo = _algorithm(algorithm)
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
     _check_pair_shapes(la, ra, colour=algo == "sgbm")  # BM reads the grey pair
     num = round_up16(max_disparity)
     if algo == "bm":
-        _refuse_bm_range(num, la.shape[1], 21)
+        _refuse_bm_range(num, la.shape, 21)
         bm = cv2.StereoBM.create(numDisparities=num, blockSize=21)
         return _from_opencv(bm.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")))
     _refuse_sgbm_range(num, la.shape[1], 3)
