@@ -551,3 +551,20 @@ def test_bms_refuse_images_no_higher_than_their_block(fn, block: int) -> None:
     )
     taller = (rng.random((block + 1, 200, 3)) * 255).astype(np.uint8)
     assert fn(taller, taller, 32).shape == (block + 1, 200)
+
+
+@pytest.mark.parametrize("bad", [None, "64", True, [64], np.array([64, 64]), 10**400])
+def test_references_refuse_a_range_that_is_no_number_naming_it(bad: object) -> None:
+    """A max_disparity of None or [64] was float()'s TypeError naming nothing ("float()
+    argument must be a string or a real number, not 'NoneType'"), "64" and True were taken
+    (True as 1: a 16 px range), 10**400 an OverflowError ('int too large to convert to
+    float'). Each is a ValueError naming the disparity range and the value."""
+    img = np.zeros((40, 60, 3), np.uint8)
+    for fn in (opencv_sgbm, opencv_bm, round_up16):
+        with pytest.raises(ValueError, match=r"^disparity range must be "):
+            fn(img, img, bad) if fn is not round_up16 else fn(bad)  # type: ignore[operator]
+    with pytest.raises(
+        ValueError, match=r"got an integer of 401 digits \(too large for a float\)$"
+    ):
+        round_up16(10**400)
+    assert round_up16(np.int64(17)) == round_up16(np.float32(17.0)) == 32

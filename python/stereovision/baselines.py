@@ -81,16 +81,27 @@ def round_up16(n: float) -> int:
     Raises
     ------
     ValueError
-        If ``n`` is negative, NaN or infinite.
+        If ``n`` is no real number (a bool, a string, None, a list), negative, NaN or
+        infinite.
 
     Examples
     --------
     >>> round_up16(15.4), round_up16(16), round_up16(16.5), round_up16(0)
     (16, 16, 32, 16)
     """
-    x = float(n)
+    from stereovision._validate import number_shown
+
+    # None or [64] was float()'s TypeError naming nothing, "64" and True (1 px) were taken,
+    # 10**400 an OverflowError
+    real = isinstance(n, (int, float, np.integer, np.floating))
+    if not real or isinstance(n, (bool, np.bool_)):
+        raise ValueError(f"disparity range must be a number of pixels, finite and >= 0, got {n!r}")
+    try:
+        x = float(n)
+    except OverflowError:
+        x = math.inf
     if not math.isfinite(x) or x < 0:
-        raise ValueError(f"disparity range must be finite and >= 0, got {n!r}")
+        raise ValueError(f"disparity range must be finite and >= 0, got {number_shown(n)}")
     return max(16, 16 * math.ceil(x / 16.0))
 
 
