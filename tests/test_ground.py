@@ -12,6 +12,7 @@ import sys
 import warnings
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -1718,6 +1719,34 @@ def test_cli_depth_ground_says_why_no_floor_was_tried(
     assert _no_floor_line(disp, calib) == (
         "ground plane: none found (no near-level plane holds 3 % of the pixels)"
     )
+
+
+def test_cli_depth_ground_fits_a_map_without_a_floor_once(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``depth --ground`` (and batch's pairs through it) of a map without a floor ran the fit
+    twice: once for the plane, once more in _no_floor_line only to say why. The reason is the
+    one fit's now, the same line."""
+    from typing import Any
+
+    from stereovision import ground
+    from stereovision.cli import _ground_outputs
+
+    kitti = data_dir / "kitti2015" / "000005_10"
+    calib = load_scene(kitti).calib
+    wall = np.full((375, 1242), 20.0)  # enough to try a fit; no near-level plane
+    fit, calls = ground._fit_ground, []
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        return fit(*args, **kwargs)
+
+    monkeypatch.setattr(ground, "_fit_ground", spy)
+    lines: list[str] = []
+    res = SimpleNamespace(disparity=wall)
+    assert _ground_outputs(res, calib, Path("unused"), log=lines.append) == {}
+    assert lines == ["ground plane: none found (no near-level plane holds 3 % of the pixels)"]
+    assert len(calls) == 1
 
 
 def test_mutation_audit_5_no_floor_line_counts_pixels_as_the_fit_does() -> None:

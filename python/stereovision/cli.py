@@ -954,18 +954,18 @@ def _ground_outputs(
     import cv2
 
     from stereovision.ground import (
-        _no_floor_line,
-        fit_ground_plane,
+        _fit_ground,
         laser_scan,
         obstacle_mask,
         occupancy_grid,
     )
     from stereovision.io import atomic_write
 
-    plane = fit_ground_plane(res.disparity, calib)
+    # the fit's own reason when it finds none: _no_floor_line ran the whole fit a second time
+    plane, why = _fit_ground(res.disparity, calib)
     if plane is None:
         if log is not None:
-            log(_no_floor_line(res.disparity, calib))
+            log(why)
         return {}
     if log is not None:
         log(plane.describe(unit))

@@ -737,9 +737,9 @@ def _no_floor_line(disparity: npt.ArrayLike, calib: Calibration) -> str:
     """The line for a map :func:`fit_ground_plane` (default parameters) found no floor in, with
     the reason that holds: under :data:`MIN_PIXELS` disparities (finite, in front of the
     camera) no fit is tried; else no near-level plane held :data:`MIN_INLIER_SHARE` of them, or
-    the best one's pixels lay along a line (:data:`MIN_SPREAD_SHARE`). ``depth --ground`` and
-    the GUI's Find floor say it. The fit is run again (the same seed: the same outcome); it
-    costs a fit only where none was found.
+    the best one's pixels lay along a line (:data:`MIN_SPREAD_SHARE`). The fit is run again
+    (the same seed: the same outcome): ``depth --ground`` and the GUI's Find floor take the
+    line from their own fit (:func:`_fit_ground`) instead.
     """
     plane, why = _fit_ground(disparity, calib)
     return why if plane is None else ""

@@ -723,15 +723,22 @@ def floor_text(plane: Any, unit: str = "m", result: Any = None) -> str:
 def floor_view(result: Any) -> tuple[Any, str]:
     """The floor of a depth result: the ground plane (None when none is found) and a picture
     of it, its obstacles in red (data URL; "" when none). :func:`floor_text` says the plane."""
-    from stereovision.ground import fit_ground_plane, obstacle_mask
+    plane, url, _ = _floor_view(result)
+    return plane, url
+
+
+def _floor_view(result: Any) -> tuple[Any, str, str]:
+    """:func:`floor_view`'s plane and picture, and with no plane the line saying why (as
+    :func:`floor_text` gives it; "" with a plane), from the one fit."""
+    from stereovision.ground import _fit_ground, obstacle_mask
 
     calib = result.calibration
-    plane = fit_ground_plane(result.disparity, calib)
+    plane, why = _fit_ground(result.disparity, calib)
     if plane is None:
-        return None, ""
+        return None, "", why
     img = result.left_rectified if result.left_rectified is not None else None
     if img is None:
-        return plane, ""
+        return plane, "", ""
     out = np.array(img, np.uint8)
     if out.ndim == 2:
         out = np.repeat(out[..., None], 3, axis=2)
@@ -739,7 +746,7 @@ def floor_view(result: Any) -> tuple[Any, str]:
     obstacles = obstacle_mask(result.point_image(filled=True), plane, min_height=lo, max_height=hi)
     for mask, colour in ((plane.inliers, (60, 200, 60)), (obstacles, (40, 40, 230))):
         out[mask] = (0.5 * out[mask] + 0.5 * np.array(colour)).astype(np.uint8)
-    return plane, _data_url(out)
+    return plane, _data_url(out), ""
 
 
 def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int) -> Any:
@@ -2716,10 +2723,8 @@ class StereoApp:
             return
 
         def run() -> tuple[Any, str, str]:
-            plane, url = floor_view(res)
-            # why none: its line runs the fit again (ground._no_floor_line), so here, not on
-            # the page's loop
-            return plane, url, floor_text(None, "m", res) if plane is None else ""
+            # why none comes from the same fit: floor_text(None, ..., res) would run it again
+            return _floor_view(res)
 
         try:
             plane, url, why = await asyncio.get_running_loop().run_in_executor(self._executor, run)
