@@ -1419,6 +1419,25 @@ def test_an_extent_of_whole_cells_has_no_extra_column(
     assert grid.data[:, -1].max() == 100
 
 
+@pytest.mark.parametrize(("resolution", "forward"), [(1e-308, (0.0, 20.0)), (0.1, (-1e308, 1e308))])
+def test_a_grid_past_a_float_of_cells_is_refused_by_name(
+    resolution: float, forward: tuple[float, float]
+) -> None:
+    """An extent over cells so small (or an extent so wide) that their count is past a float
+    (inf) raised OverflowError "cannot convert float infinity to integer", naming nothing; it
+    is a grid over 4096 cells a side, as one of 1e9 cells is. A partial cell is still counted
+    a hair past a whole number of them (2.1000001 m of 0.3 m: 8), not one a hair short (7)."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    box = _camera_points([(1.0, 0.0, 0.5)] * 3)
+    with pytest.raises(ValueError, match=r"^resolution: .* over 4096 a side$"):
+        occupancy_grid(box, plane, resolution=resolution, forward=forward)
+    for far, cols in ((2.1000001, 8), (2.0999999, 7)):
+        grid = occupancy_grid(box, plane, resolution=0.3, forward=(0.0, far), lateral=(-1, 1))
+        assert grid.data.shape[1] == cols
+
+
 def test_laser_scan_beam_count_and_range_min() -> None:
     """-0.3 to 0.3 rad by 0.1 rad is 7 beams (0.6 / 0.1 is 5.999999999999999 in floats: 6
     beams, angle_max 0.2); points nearer than range_min are dropped: the hand-placed beam's

@@ -1035,6 +1035,12 @@ def occupancy_grid(
         raise ValueError(f"forward: expected (near, far) with far > near, got {forward!r}")
     if not (math.isfinite(y0) and math.isfinite(y1) and y1 > y0):
         raise ValueError(f"lateral: expected (right, left) with left > right, got {lateral!r}")
+    # a quotient past a float (1 m of 1e-308 m cells, or an extent of -1e308 to 1e308 m) is
+    # inf, which _cells could not count (OverflowError "cannot convert float infinity")
+    if not (math.isfinite((x1 - x0) / res) and math.isfinite((y1 - y0) / res)):
+        raise ValueError(
+            f"resolution: {res!r} m cells over {x1 - x0:g} x {y1 - y0:g} m are over 4096 a side"
+        )
     cols, rows = _cells(x1 - x0, res), _cells(y1 - y0, res)
     if cols > 4096 or rows > 4096:
         raise ValueError(f"resolution: a {cols} x {rows} grid is over 4096 cells a side")
