@@ -422,6 +422,28 @@ def test_a_k_past_float32_averages_as_a_large_one(data_dir: Path, k: float) -> N
     assert big.mean_frames() == ref.mean_frames() == 4.0
 
 
+@pytest.mark.parametrize("k", [np.float32(3e38), np.float16(60000.0)])
+def test_a_numpy_k_past_its_type_averages_without_an_overflow_warning(
+    data_dir: Path, k: np.floating
+) -> None:
+    """A NumPy k (np.float32's or np.float16's large values, which the constructor accepts)
+    times the noise was multiplied in k's own type: inf, with NumPy's "overflow encountered in
+    scalar multiply" RuntimeWarning on every pair. It is a large k now: no warning, the same
+    frames as k = 1e4, bit for bit."""
+    import warnings
+
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(3)
+    pairs = [(noisy(sc.left, 8.0, rng), noisy(sc.right, 8.0, rng)) for _ in range(3)]
+    big, ref = TemporalFilter(k=k), TemporalFilter(k=1e4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for left, right in pairs:
+            got, want = big(left, right), ref(left, right)
+            assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+    assert big.restarts == 0 and big.mean_frames() == 3.0
+
+
 @pytest.mark.parametrize("shape", [(1, 1), (1, 64), (2, 2), (64, 2), (2, 8, 3)])
 def test_frames_too_small_name_the_pair_and_the_size_needed(shape: tuple[int, ...]) -> None:
     """Frames under 3 x 3 px were refused in noise_sigma's words ("image: expected an (H, W) or

@@ -405,7 +405,9 @@ class TemporalFilter:
         # The kernel takes the threshold as float32: a k the constructor accepts (1e38, 2**130)
         # times the noise was +inf there, refused as "ks" on the second pair. Any threshold
         # over a grey difference's largest (255) restarts no pixel, so it is capped.
-        ks = min(self.k * self.sigma, _KS_MAX)
+        # float(): a NumPy k (np.float32(3e38), np.float16(6e4)) multiplied in its own type,
+        # overflowing with NumPy's RuntimeWarning on every pair
+        ks = min(float(self.k) * self.sigma, _KS_MAX)
         out = []
         for img, d, m in zip(imgs, diffs, self._means, strict=True):
             # In place: m.mean and m.count are updated.
