@@ -711,11 +711,15 @@ simd_fn! {
             let len = j_hi + 1 - j_lo;
             let rb = &mut rbest[base..base + len];
             let rj = &mut rk[base..base + len];
-            for (t, ((&v, b), kk)) in cell[j_lo..=j_hi].iter().zip(rb).zip(rj).enumerate() {
+            // The level as a u16 counter (n <= 2048): a usize one made the compiler carry four
+            // vectors of u64 indices and pack them to u16 lanes every 16 levels.
+            let mut j = j_lo as u16;
+            for ((&v, b), kk) in cell[j_lo..=j_hi].iter().zip(rb).zip(rj) {
                 // Arithmetic select: stores every lane, so the loop vectorises without masks.
                 let mask = u16::from(v < *b).wrapping_neg();
-                *kk = (((j_lo + t) as u16) & mask) | (*kk & !mask);
+                *kk = (j & mask) | (*kk & !mask);
                 *b = (*b).min(v);
+                j = j.wrapping_add(1);
             }
         }
     }
@@ -2272,12 +2276,16 @@ mod tests {
         // At each right pixel xr: the first level j minimising S(xr + d_min + j, j) over the left
         // pixels in the image (u16::MAX and level 0 where none is), for ranges reaching past
         // either edge of the row; the outputs are overwritten whatever they held.
-        let (w, n) = (13usize, 6usize);
-        let s: Vec<u16> = noise(w * n, 1, 7)
-            .iter()
-            .map(|v| (v * 5.0).round() as u16)
-            .collect();
-        for d_min in [-9i64, -4, 0, 3, 20] {
+        // Level counts past 16 and 32 run the vectorised loop (its u16 level counter) with and
+        // without a tail.
+        for (w, n, d_min) in [6usize, 17, 40, 129]
+            .into_iter()
+            .flat_map(|n| [-9i64, -4, 0, 3, 20].map(|d| (13 + n, n, d)))
+        {
+            let s: Vec<u16> = noise(w * n, 1, 7)
+                .iter()
+                .map(|v| (v * 5.0).round() as u16)
+                .collect();
             let (mut rbest, mut rk) = (vec![7u16; w], vec![7u16; w]);
             right_winners(&s, w, n, d_min, &mut rbest, &mut rk);
             for xr in 0..w as i64 {
@@ -2291,7 +2299,11 @@ mod tests {
                     .min()
                     .unwrap_or((u16::MAX, 0));
                 let i = w - 1 - xr as usize;
-                assert_eq!((rbest[i], rk[i]), want, "d_min {d_min}, xr {xr}");
+                assert_eq!(
+                    (rbest[i], rk[i]),
+                    want,
+                    "{n} levels, d_min {d_min}, xr {xr}"
+                );
             }
         }
     }
