@@ -666,27 +666,45 @@ simd_fn! {
     }
 }
 
-simd_fn! {
-    /// Minimum of a slice (`u16::MAX` when empty).
-    fn min_u16(v: &[u16]) -> u16 {
-        v.iter().fold(u16::MAX, |m, &x| m.min(x))
-    }
+/// Minimum of a slice (`u16::MAX` when empty). Inlined into [`select_row`], which is compiled
+/// for AVX2 as a whole: as a dispatched function of its own it was called three times a pixel.
+#[inline(always)]
+fn min_u16(v: &[u16]) -> u16 {
+    v.iter().fold(u16::MAX, |m, &x| m.min(x))
 }
 
-/// First index of the minimum of a non-empty slice, and the minimum.
-#[inline]
+/// First index of the minimum of a non-empty slice (at most 2048 values), and the minimum.
+#[inline(always)]
 fn argmin(cell: &[u16]) -> (usize, u16) {
     let m = min_u16(cell);
-    // Blocks of 16 compared at once (vectorised), then the one holding it scanned.
-    let mut base = 0;
-    for block in cell.chunks(16) {
-        if block.iter().fold(false, |f, &v| f | (v == m)) {
-            let i = block.iter().position(|&v| v == m).unwrap_or(0);
-            return (base + i, m);
-        }
-        base += block.len();
+    // The least index holding it, as a minimum over u16 indices: one vectorised pass where a
+    // scan for the first match took a branch per level.
+    let mut j = 0u16;
+    let mut k = u16::MAX;
+    for &v in cell {
+        k = k.min(if v == m { j } else { u16::MAX });
+        j = j.wrapping_add(1);
     }
-    (0, m)
+    (usize::from(k), m)
+}
+
+/// Minimum of a slice (at most 2048 values) outside indices `k - 1 ..= k + 1` (`u16::MAX` when
+/// nothing is left): one vectorised pass with those lanes masked, where the two ranges either
+/// side each ended in a scalar tail.
+#[inline(always)]
+fn min_apart(cell: &[u16], k: usize) -> u16 {
+    let first = (k as u16).wrapping_sub(1); // k = 0: 0xffff, and j - first < 3 for j in 0..2
+    let mut j = 0u16;
+    let mut m = u16::MAX;
+    for &v in cell {
+        m = m.min(if j.wrapping_sub(first) < 3 {
+            u16::MAX
+        } else {
+            v
+        });
+        j = j.wrapping_add(1);
+    }
+    m
 }
 
 simd_fn! {
@@ -744,58 +762,56 @@ impl Winners {
     }
 }
 
-/// Winner, uniqueness, left-right check and sub-pixel vertex for one row of the summed volume.
-fn select_row(
-    s: &[u16],
-    w: usize,
-    n_all: usize,
-    d_min: i64,
-    p: &SgmParams,
-    win: &mut Winners,
-    out: &mut [f32],
-) {
-    let d_max = d_min + n_all as i64 - 1;
-    let Winners { rbest, rk } = win;
-    right_winners(s, w, n_all, d_min, rbest, rk);
-    for (x, o) in out.iter_mut().enumerate() {
-        // Levels 0..inside land in the right image. The right band (d_min < 0) is not reported.
-        let inside = (x as i64 - d_min + 1).min(n_all as i64);
-        if inside <= 0 || x as i64 - d_min >= w as i64 {
-            *o = f32::NAN;
-            continue;
-        }
-        let band = x as i64 - d_max < 0;
-        let n = inside as usize;
-        let cell = &s[x * n_all..x * n_all + n];
-        let (k, m) = argmin(cell);
-        // In the band a true match outside the image pushes the winner against its edge
-        // (n - 1 - k = x - d: the winner's right column).
-        if band && ((n - 1 - k) as u32) < p.edge_margin {
-            *o = f32::NAN;
-            continue;
-        }
-        let best = u64::from(m);
-        let other = u64::from(min_u16(&cell[..k.saturating_sub(1)]).min(if k + 2 < n {
-            min_u16(&cell[k + 2..])
-        } else {
-            u16::MAX
-        }));
-        let unique = 100 * other > (100 + u64::from(p.uniqueness)) * best;
-        let xr = (x as i64 - (d_min + k as i64)) as usize; // k < inside: in the image
-        let consistent = usize::from(rk[w - 1 - xr]).abs_diff(k) <= p.lr_tol as usize;
-        *o = if unique && consistent {
-            let mut frac = 0.0f64;
-            if k > 0 && k < n - 1 {
-                let (sm, sp) = (f64::from(cell[k - 1]), f64::from(cell[k + 1]));
-                let den = sm + sp - 2.0 * best as f64;
-                if den > 0.0 {
-                    frac = (sm - sp) / (2.0 * den);
-                }
+simd_fn! {
+    /// Winner, uniqueness, left-right check and sub-pixel vertex for one row of the summed volume.
+    fn select_row(
+        s: &[u16],
+        w: usize,
+        n_all: usize,
+        d_min: i64,
+        p: &SgmParams,
+        win: &mut Winners,
+        out: &mut [f32],
+    ) {
+        let d_max = d_min + n_all as i64 - 1;
+        let Winners { rbest, rk } = win;
+        right_winners(s, w, n_all, d_min, rbest, rk);
+        for (x, o) in out.iter_mut().enumerate() {
+            // Levels 0..inside land in the right image. The right band (d_min < 0) is not reported.
+            let inside = (x as i64 - d_min + 1).min(n_all as i64);
+            if inside <= 0 || x as i64 - d_min >= w as i64 {
+                *o = f32::NAN;
+                continue;
             }
-            ((d_min + k as i64) as f64 + frac) as f32
-        } else {
-            f32::NAN
-        };
+            let band = x as i64 - d_max < 0;
+            let n = inside as usize;
+            let cell = &s[x * n_all..x * n_all + n];
+            let (k, m) = argmin(cell);
+            // In the band a true match outside the image pushes the winner against its edge
+            // (n - 1 - k = x - d: the winner's right column).
+            if band && ((n - 1 - k) as u32) < p.edge_margin {
+                *o = f32::NAN;
+                continue;
+            }
+            let best = u64::from(m);
+            let other = u64::from(min_apart(cell, k));
+            let unique = 100 * other > (100 + u64::from(p.uniqueness)) * best;
+            let xr = (x as i64 - (d_min + k as i64)) as usize; // k < inside: in the image
+            let consistent = usize::from(rk[w - 1 - xr]).abs_diff(k) <= p.lr_tol as usize;
+            *o = if unique && consistent {
+                let mut frac = 0.0f64;
+                if k > 0 && k < n - 1 {
+                    let (sm, sp) = (f64::from(cell[k - 1]), f64::from(cell[k + 1]));
+                    let den = sm + sp - 2.0 * best as f64;
+                    if den > 0.0 {
+                        frac = (sm - sp) / (2.0 * den);
+                    }
+                }
+                ((d_min + k as i64) as f64 + frac) as f32
+            } else {
+                f32::NAN
+            };
+        }
     }
 }
 
@@ -2304,6 +2320,33 @@ mod tests {
                     want,
                     "{n} levels, d_min {d_min}, xr {xr}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn argmin_and_min_apart_equal_their_definition() {
+        // The first index of the minimum, and the minimum away from it by more than one index
+        // (at either end too), on cells of 1..=200 values drawn from a few so that they tie.
+        let mut s = 99u32;
+        let mut rand = move || {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            s >> 8
+        };
+        for n in 1..=200usize {
+            for spread in [3u32, 40] {
+                let cell: Vec<u16> = (0..n).map(|_| (rand() % spread + 7) as u16).collect();
+                let m = *cell.iter().min().unwrap();
+                let first = cell.iter().position(|&v| v == m).unwrap();
+                assert_eq!(argmin(&cell), (first, m), "{cell:?}");
+                for k in 0..n {
+                    let want = (0..n)
+                        .filter(|&i| i.abs_diff(k) > 1)
+                        .map(|i| cell[i])
+                        .min()
+                        .unwrap_or(u16::MAX);
+                    assert_eq!(min_apart(&cell, k), want, "k {k} of {cell:?}");
+                }
             }
         }
     }
