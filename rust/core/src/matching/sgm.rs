@@ -179,9 +179,17 @@ pub fn census(img: ImageView<'_>) -> Result<Vec<u64>> {
 }
 
 simd_fn! {
-    /// One row of the cost volume, `n` levels per pixel (the popcount is a hardware one in the
-    /// AVX2 build).
-    fn cost_row(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
+    /// One row of the cost volume, `n` levels per pixel. `simd`: take [`hamming_avx2`] where a
+    /// pixel has at least 32 levels inside the image (the same integers; the compiler's loop
+    /// otherwise, which the AVX2 build vectorises by a nibble table as well, 16 levels a step).
+    fn cost_row_as(
+        cl: &[u64],
+        cr_rev: &[u64],
+        d_min: i64,
+        n: usize,
+        out: &mut [u8],
+        simd: Option<Avx2>,
+    ) {
         let w = cl.len() as i64;
         for (x, cell) in out.chunks_exact_mut(n).enumerate() {
             let a = cl[x];
@@ -197,10 +205,17 @@ simd_fn! {
             // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
             let start = (w - 1 - x as i64 + d_min + lo as i64) as usize; // >= 0 by lo's bound
             let right = &cr_rev[start..start + hi + 1 - lo];
-            for (v, &b) in cell[lo..=hi].iter_mut().zip(right) {
-                *v = (a ^ b).count_ones() as u8;
-            }
-            let best = cell[lo..=hi].iter().fold(OUTSIDE, |m, &v| m.min(v));
+            let inside = &mut cell[lo..=hi];
+            let (best, worst) = match simd.and_then(|t| hamming_avx2(t, a, right, inside)) {
+                Some(bw) => bw,
+                None => {
+                    for (v, &b) in inside.iter_mut().zip(right) {
+                        *v = (a ^ b).count_ones() as u8;
+                    }
+                    let best = inside.iter().fold(OUTSIDE, |m, &v| m.min(v));
+                    (best, inside.iter().fold(0, |m, &v| m.max(v)))
+                }
+            };
             // Levels whose right pixel is outside the image cost a little more than the best
             // inside level: nearly neutral, so the paths from the left edge carry only a slight
             // preference for the levels that stay inside (with a high cost a flat region took
@@ -208,7 +223,6 @@ simd_fn! {
             // levels outside).
             // Where every inside level costs the same (a flat patch) they stay neutral: nothing
             // to prefer, and a margin there would carry d_min from the edge across a flat image.
-            let worst = cell[lo..=hi].iter().fold(0, |m, &v| m.max(v));
             let out = if worst == best {
                 best
             } else {
@@ -218,6 +232,114 @@ simd_fn! {
             cell[hi + 1..].fill(out);
         }
     }
+}
+
+/// The Hamming costs `out[k] = popcount(a ^ right[k])` of one pixel in AVX2, 32 levels a
+/// vector, and their minimum and maximum; `None` below 32 levels. The compiler's loop counted
+/// 16 levels a step and packed each four u64 counts to bytes on their own, then took the
+/// minimum and maximum in two more passes.
+#[inline(always)]
+fn hamming_avx2(_avx2: Avx2, a: u64, right: &[u64], out: &mut [u8]) -> Option<(u8, u8)> {
+    let n = out.len();
+    if n < 32 || right.len() < n {
+        return None;
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        // A tail of under 16 levels is counted one by one: a last vector overlapping the one
+        // before would count 32 (teddyH's 129 levels: 160 counted for 129).
+        let tail = n % 32;
+        let nv = if tail >= 16 { n } else { n - tail };
+        // SAFETY: `_avx2` proves the CPU has AVX2; `hamming_kernel` reads `right[..nv]` and
+        // writes `out[..nv]`, within the lengths checked above (`32 <= nv <= n`).
+        let (mut best, mut worst) =
+            unsafe { hamming_kernel(a, right.as_ptr(), out.as_mut_ptr(), nv) };
+        for (v, &b) in out[nv..].iter_mut().zip(&right[nv..n]) {
+            *v = (a ^ b).count_ones() as u8;
+            best = best.min(*v);
+            worst = worst.max(*v);
+        }
+        Some((best, worst))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        None
+    }
+}
+
+/// [`hamming_avx2`]'s loop.
+///
+/// # Safety
+/// The CPU has AVX2; `right` holds `n` codes and `out` `n` bytes, `n >= 32`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn hamming_kernel(a: u64, right: *const u64, out: *mut u8, n: usize) -> (u8, u8) {
+    use std::arch::x86_64::*;
+    let av = _mm256_set1_epi64x(a as i64);
+    let nibble = _mm256_set1_epi8(0x0f);
+    #[rustfmt::skip]
+    let bits = _mm256_setr_epi8(
+        0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,
+        0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,
+    );
+    // After the packs and the quadword permute a lane holds byte pairs 0 2 4 6 1 3 5 7 (of 16
+    // levels): back in order.
+    #[rustfmt::skip]
+    let order = _mm256_setr_epi8(
+        0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15,
+        0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15,
+    );
+    let zero = _mm256_setzero_si256();
+    let mut best = _mm256_set1_epi8(-1);
+    let mut worst = zero;
+    let mut k = 0;
+    while k < n {
+        // The last block ends at level n, overlapping the one before: the levels computed
+        // twice get the same values.
+        let k0 = k.min(n - 32);
+        // Eight vectors of four u64 counts (at most 64 each): levels k0 + 4 i + q.
+        let mut s = [zero; 8];
+        for (i, si) in s.iter_mut().enumerate() {
+            let x = _mm256_xor_si256(_mm256_loadu_si256(right.add(k0 + 4 * i).cast()), av);
+            let lo = _mm256_shuffle_epi8(bits, _mm256_and_si256(x, nibble));
+            let hi = _mm256_shuffle_epi8(bits, _mm256_and_si256(_mm256_srli_epi16::<4>(x), nibble));
+            *si = _mm256_sad_epu8(_mm256_add_epi8(lo, hi), zero);
+        }
+        // To bytes (no saturation below 65): per 128-bit half, levels 0 1 4 5 8 9 ... of the
+        // 32 in the low half and 2 3 6 7 ... in the high one.
+        let q0 = _mm256_packus_epi32(
+            _mm256_packus_epi32(s[0], s[1]),
+            _mm256_packus_epi32(s[2], s[3]),
+        );
+        let q1 = _mm256_packus_epi32(
+            _mm256_packus_epi32(s[4], s[5]),
+            _mm256_packus_epi32(s[6], s[7]),
+        );
+        let b = _mm256_packus_epi16(q0, q1);
+        let b = _mm256_shuffle_epi8(_mm256_permute4x64_epi64::<0xd8>(b), order);
+        _mm256_storeu_si256(out.add(k0).cast(), b);
+        best = _mm256_min_epu8(best, b);
+        worst = _mm256_max_epu8(worst, b);
+        k += 32;
+    }
+    let lo = _mm_min_epu8(
+        _mm256_castsi256_si128(best),
+        _mm256_extracti128_si256::<1>(best),
+    );
+    let hi = _mm_max_epu8(
+        _mm256_castsi256_si128(worst),
+        _mm256_extracti128_si256::<1>(worst),
+    );
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<8>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<8>(hi));
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<4>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<4>(hi));
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<2>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<2>(hi));
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<1>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<1>(hi));
+    (_mm_cvtsi128_si32(lo) as u8, _mm_cvtsi128_si32(hi) as u8)
 }
 
 /// The cost volume `C[(y * w + x) * n + k]` for disparity `d_min + k`.
@@ -236,7 +358,7 @@ pub fn cost_volume_into(cl: &[u64], cr: &[u64], w: usize, d_min: i64, n: usize, 
         .for_each_init(Vec::new, |rev, (y, row)| {
             rev.clear();
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
-            cost_row(&cl[y * w..(y + 1) * w], rev, d_min, n, row)
+            cost_row_as(&cl[y * w..(y + 1) * w], rev, d_min, n, row, Avx2::detect())
         });
 }
 
@@ -1398,7 +1520,14 @@ fn three_paths_as<T: PathCost + Send>(
             };
             rev.clear();
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
-            cost_row(&cl[y * w..(y + 1) * w], &rev, d_min, n, &mut c);
+            cost_row_as(
+                &cl[y * w..(y + 1) * w],
+                &rev,
+                d_min,
+                n,
+                &mut c,
+                Avx2::detect(),
+            );
             horizontal(&c, &img[y * w..(y + 1) * w], n, p, lut, &mut acc, &mut hp);
             let waiting = {
                 let mut f = lock(&flight);
@@ -2349,6 +2478,83 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_avx2_hamming_costs_are_the_compilers() {
+        // Whole cost rows by the AVX2 kernel against the compiler's loop, for every level count
+        // 1..=200 (32 and more take the kernel; its tail below 16 levels goes one by one,
+        // above it a last vector overlaps the one before), odd and even widths, ranges past
+        // either edge, on random 64-bit codes, census-like 62-bit ones and equal codes (a flat
+        // patch: every inside level ties).
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        };
+        let mut s = 7u64;
+        let mut rand = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            s
+        };
+        for n in 1..=200usize {
+            for w in [1usize, 2, 31, 64, 97, 230] {
+                for d_min in [-40i64, 0, 5] {
+                    let codes: [Vec<u64>; 3] = [
+                        (0..2 * w).map(|_| rand()).collect(),
+                        (0..2 * w).map(|_| rand() >> 2).collect(),
+                        vec![0x0123_4567_89ab_cdef; 2 * w],
+                    ];
+                    for c in &codes {
+                        let (cl, rev): (&[u64], Vec<u64>) =
+                            (&c[..w], c[w..].iter().rev().copied().collect());
+                        let mut want = vec![0u8; w * n];
+                        let mut got = vec![1u8; w * n];
+                        cost_row_as(cl, &rev, d_min, n, &mut want, None);
+                        cost_row_as(cl, &rev, d_min, n, &mut got, Some(avx2));
+                        assert_eq!(got, want, "{n} levels, width {w}, d_min {d_min}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_avx2_hamming_costs_count_every_bit() {
+        // The kernel against the definition, popcount(a ^ b), where every count 0..=64 occurs
+        // (64 kills a count capped or wrapped at 63, which census codes of 62 bits never reach)
+        // and every nibble value in every nibble (kills a wrong table entry, a high nibble
+        // shifted in without its mask and counts packed out of level order); the minimum and
+        // maximum it returns too (from either end, so a reduction that drops a lane fails).
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        };
+        let a = 0xf0f0_0000_ffff_1234u64;
+        let mut b: Vec<u64> = (0..=64u32)
+            .map(|p| a ^ 1u64.checked_shl(p).map_or(u64::MAX, |v| v - 1))
+            .collect();
+        for v in 0..16u64 {
+            for at in 0..16 {
+                b.push(a ^ (v << (4 * at)));
+            }
+        }
+        b.extend((0..16u64).map(|v| a ^ (v * 0x1111_1111_1111_1111)));
+        for n in 32..=b.len() {
+            for right in [&b[..n], &b[b.len() - n..]] {
+                let rev: Vec<u64> = right.iter().rev().copied().collect();
+                for r in [right, &rev[..]] {
+                    let want: Vec<u8> = r.iter().map(|&x| (a ^ x).count_ones() as u8).collect();
+                    let mut got = vec![0u8; n];
+                    let bw = hamming_avx2(avx2, a, r, &mut got);
+                    assert_eq!(got, want, "{n} levels");
+                    let (lo, hi) = (*want.iter().min().unwrap(), *want.iter().max().unwrap());
+                    assert_eq!(bw, Some((lo, hi)), "{n} levels");
+                }
+            }
+        }
+        assert_eq!(hamming_avx2(avx2, a, &b[..31], &mut [0; 31]), None);
     }
 
     #[test]
