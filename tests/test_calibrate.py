@@ -2465,7 +2465,24 @@ def test_a_camera_mounted_upside_down_is_said_not_called_mis_paired(cached_corne
     said = str(err.value)
     assert re.fullmatch(
         r"stereo RMS 3\d\.\d px, 0\.(1\d|2\d) px with the right boards read turned half round: "
-        r"one camera is mounted upside down against the other; turn the right images by 180 "
+        r"the right camera is mounted upside down against the other; turn the right images by "
+        r"180 degrees \(or the camera\) and calibrate again",
+        said,
+    ), said
+
+
+def test_a_left_camera_mounted_upside_down_is_named(cached_corners: None) -> None:
+    """OpenCV's pairs with every left image turned half round: the message said to turn the
+    right images, and doing so gave pairs refused as swapped (T = (+3.3, 0, 0)). The turned
+    solution's T tells which camera is upside down: the left one here, its images to turn."""
+    left, right = _chessboard_paths()
+    turned = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)[::-1, ::-1].copy() for p in left]
+    with pytest.raises(ValueError) as err:
+        calibrate(turned, right, pattern=(9, 6), square_size=1.0)
+    said = str(err.value)
+    assert re.fullmatch(
+        r"stereo RMS 3\d\.\d px, 0\.(1\d|2\d) px with the right boards read turned half round: "
+        r"the left camera is mounted upside down against the other; turn the left images by 180 "
         r"degrees \(or the camera\) and calibrate again",
         said,
     ), said

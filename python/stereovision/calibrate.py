@@ -1772,10 +1772,22 @@ def calibrate(
         half_turn = _grid_symmetries(pat)[1]
         turned = _solve(obj, pl, [p[half_turn] for p in pr], size, sol.model, False)
         if _shows_one_rig(turned):
+            # Which one: the turned solution's T is that of the cameras as they stand. The right
+            # one upside down puts the left camera at +x in its frame (T's x > 0); the left one
+            # upside down puts the right camera at -x in its own (T's x < 0, as in a sound rig),
+            # where turning the right images, as was said, gave a rig refused as swapped (OpenCV's
+            # pairs, left images turned). A vertical rig's sign is no one's convention: not said.
+            tt = np.ravel(turned.T)
+            side = "right" if tt[0] > 0 else "left"
+            which = (
+                f"the {side} camera is mounted upside down against the other; turn the {side} "
+                "images"
+                if abs(tt[0]) > abs(tt[1])
+                else "one camera is mounted upside down against the other; turn its images"
+            )
             raise ValueError(
                 f"stereo RMS {sol.rms:.1f} px, {turned.rms:.2f} px with the right boards read "
-                "turned half round: one camera is mounted upside down against the other; turn "
-                "the right images by 180 degrees (or the camera) and calibrate again"
+                f"turned half round: {which} by 180 degrees (or the camera) and calibrate again"
             )
     _check_pairing(
         sol, [pair_names[i] for i in used], [d for d in differ if d not in rejected], drop_outliers
