@@ -463,3 +463,37 @@ def test_bench_of_several_scenes_goes_on_past_a_damaged_one(
     assert main(["bench", str(bad)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("stereovision: error:") and "left.png" in err
+
+
+def test_bench_interrupted_prints_the_scenes_it_timed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without --json the table comes at the end: a Ctrl-C (or SIGTERM) during the second of
+    several scenes lost the first one's timing, as a damaged scene did before bench went on
+    past it. The scenes timed are now printed (table and JSON lines), then 'interrupted'."""
+    import cv2
+
+    import stereovision.bench as bench_mod
+
+    for name in ("a_first", "b_second", "c_third"):
+        (tmp_path / name).mkdir()
+        for side in ("left.png", "right.png"):
+            assert cv2.imwrite(str(tmp_path / name / side), np.zeros((40, 60, 3), np.uint8))
+
+    def fake(scene: Any, runs: int) -> list[Any]:
+        if scene.name.endswith("b_second"):
+            raise KeyboardInterrupt
+        return [
+            bench_mod.BenchCase(scene.name, "SGBM-3WAY", "opencv", 60, 40, 16, runs, 2.5, 1.0, {})
+        ]
+
+    monkeypatch.setattr(bench_mod, "bench_scene", fake)
+    assert main(["bench", str(tmp_path)]) == 130
+    cap = capsys.readouterr()
+    assert cap.out.splitlines()[0].split()[:4] == ["scene", "size", "D", "case"]
+    objects = [json.loads(ln) for ln in cap.out.splitlines() if ln.startswith("{")]
+    assert [(o["scene"].split("/")[-1], o["ms"]) for o in objects] == [("a_first", 2.5)]
+    assert cap.err.strip().splitlines()[-1] == "stereovision: interrupted"
+    assert main(["bench", "--json", str(tmp_path)]) == 130  # its lines went out as it went
+    objects = [json.loads(ln) for ln in capsys.readouterr().out.splitlines()]
+    assert [o["scene"].split("/")[-1] for o in objects] == ["a_first"]

@@ -313,7 +313,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     int
         The exit status: 0, or 1 when some of several scenes failed (each said on a
         ``failed`` line, the others benched); other errors are raised, for the CLI to print
-        as one line.
+        as one line. A Ctrl-C (or SIGTERM) prints the scenes timed so far, then is raised.
 
     Raises
     ------
@@ -335,33 +335,42 @@ def cmd_bench(args: argparse.Namespace) -> int:
     all_cases: list[BenchCase] = []
     failed: list[str] = []
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
-    for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
-        try:
-            scene = load_scene(d)
-            narrow = scene_too_narrow(scene)
-            if narrow:
-                # as eval says it: "disparity range 16 is not smaller than the image width 8
-                # ...; give a max_disparity below 8" named a range and an option bench has not
-                raise ValueError(f"{d}: {narrow}")
-            cases = bench_scene(scene, runs=args.runs)
-        except (ValueError, OSError, RuntimeError) as e:
-            if len(dirs) == 1:
-                raise
-            # one damaged scene of many, as eval: said, and the others benched (it stopped the
-            # run, and without --json the table of the scenes timed before it was never printed)
-            failed.append(str(d))
-            said = str(e)  # the narrow scene's message names its folder already
-            said = said if said.startswith(f"{d}: ") else f"{d}: {said}"
-            tqdm.write(f"failed {said}", file=sys.stderr)
-            continue
-        all_cases.extend(cases)
-        if args.json:
-            for c in cases:
-                print(json_line(c.as_dict()), flush=True)
-    if not args.json and all_cases:
-        print(format_table(all_cases))
-        for c in all_cases:
-            print(json_line(c.as_dict()))
+
+    def print_table() -> None:
+        if not args.json and all_cases:  # --json printed each scene's lines as it went
+            print(format_table(all_cases))
+            for c in all_cases:
+                print(json_line(c.as_dict()))
+
+    try:
+        for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
+            try:
+                scene = load_scene(d)
+                narrow = scene_too_narrow(scene)
+                if narrow:
+                    # as eval says it: "disparity range 16 is not smaller than the image width 8
+                    # ...; give a max_disparity below 8" named a range and an option bench has not
+                    raise ValueError(f"{d}: {narrow}")
+                cases = bench_scene(scene, runs=args.runs)
+            except (ValueError, OSError, RuntimeError) as e:
+                if len(dirs) == 1:
+                    raise
+                # one damaged scene of many, as eval: said, and the others benched (it stopped
+                # the run, and without --json the table of the scenes timed before it was never
+                # printed)
+                failed.append(str(d))
+                said = str(e)  # the narrow scene's message names its folder already
+                said = said if said.startswith(f"{d}: ") else f"{d}: {said}"
+                tqdm.write(f"failed {said}", file=sys.stderr)
+                continue
+            all_cases.extend(cases)
+            if args.json:
+                for c in cases:
+                    print(json_line(c.as_dict()), flush=True)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (Terminated): the scenes timed are kept
+        print_table()
+        raise
+    print_table()
     if failed:
         print(f"stereovision: {len(failed)} of {len(dirs)} scenes failed (above)", file=sys.stderr)
         return 1
