@@ -1206,3 +1206,35 @@ def test_auto_is_read_in_any_case_as_the_dictionary_names_are(tmp_path: Path) ->
                "30", "--unit", "mm", "--marker", "22", "--dictionary", "AUTO")  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert "DICT_5X5_50" in run.stdout and out.is_file()
+
+
+def test_the_dpi_named_for_too_small_markers_is_the_least_that_is_taken() -> None:
+    """A board refused for markers under 3 px a cell names "use N dpi or more": N was rounded
+    up from the whole pixels a square needs, where the square is itself a rounded count, so
+    N - 1 dpi often gave the same square (8 mm squares of 4 mm DICT_4X4_50 markers at 72 dpi:
+    'use 115 dpi', and 114 was taken: 36 px squares, 3.0 px a cell; 160 of 207 boards swept).
+    N is now the least whole dpi taken, and its board decodes every marker."""
+    for dictionary, square_mm, marker_mm in (
+        ("DICT_4X4_50", 8, 4),
+        ("DICT_4X4_50", 10, 2),
+        ("DICT_5X5_50", 30, 3),
+        ("DICT_6X6_250", 15, 5),
+        ("DICT_APRILTAG_36h11", 24, 8),
+        ("DICT_5X5_50", 10, 7),  # 3 x 7 / 0.7 px is 30.000000000000004: 76 dpi, not 77
+    ):
+        board = CharucoBoard((5, 4), square_mm, marker_mm, dictionary)
+        with pytest.raises(ValueError, match=r"use \d+ dpi or more") as info:
+            board_png(board, square_mm / 1000, 72)
+        need = int(re.search(r"use (\d+) dpi", str(info.value)).group(1))  # type: ignore[union-attr]
+        with pytest.raises(ValueError, match=rf"use {need} dpi or more"):
+            board_png(board, square_mm / 1000, need - 1)
+        data, _ = board_png(board, square_mm / 1000, need)
+        img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
+        detector = cv2.aruco.ArucoDetector(
+            cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary))
+        )
+        ids = detector.detectMarkers(img)[1]
+        assert ids is not None and sorted(ids.ravel().tolist()) == list(range(10)), (
+            dictionary,
+            need,
+        )

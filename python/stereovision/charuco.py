@@ -721,7 +721,13 @@ def _check_marker_cells(board: CharucoBoard, pix: int, square_metres: float, dpi
     if per_cell >= MIN_PX_PER_CELL:
         return
     need_px = math.ceil(MIN_PX_PER_CELL * cells / ratio)
-    need_dpi = math.ceil(need_px * 0.0254 / square_metres)
+    # The least whole dpi whose square, rounded to whole pixels as _board_scale does, is taken
+    # here: rounded up from need_px it was often one more (8 mm squares, 4 mm 4X4 markers:
+    # "use 115 dpi", and 114 gave the same 36 px squares). From a px lower: need_px's ceil can
+    # be one over (3 x 7 / 0.7 is 30.000000000000004, and 30 px squares are taken)
+    need_dpi = max(1, math.floor((need_px - 1.5) * 0.0254 / square_metres))
+    while round(square_metres / 0.0254 * need_dpi) * ratio / cells < MIN_PX_PER_CELL:
+        need_dpi += 1
     raise ValueError(
         f"marker_size: a {square_metres * ratio * 1000:g} mm marker at {dpi:g} dpi is "
         f"{pix * ratio:.1f} px, {per_cell:.1f} px a cell of {board.dictionary}'s {cells} (its "
