@@ -130,6 +130,29 @@ def test_the_nearest_beyond_max_depth_is_shown_beyond_it() -> None:
     assert _beyond_max_depth(none, np.array([[1.5, nan]], np.float32), 2.0) is None
 
 
+def test_max_sigma_with_a_max_depth_past_float32_says_one_line_without_numpy_warnings() -> None:
+    """``--max-depth 1e300 --max-sigma 0.0001`` also printed NumPy's "overflow encountered in
+    cast" (the limit compared with the float32 depths unguarded) before the --max-sigma line;
+    the limit reads as float32's infinity, as DepthResult.filtered reads it."""
+    import types
+    import warnings
+
+    from stereovision.cli import _below_max_sigma
+
+    nan = np.float32(np.nan)
+    before = types.SimpleNamespace(
+        depth=np.array([[2.0, 3.0]], np.float32), depth_sigma=np.array([[0.5, 0.25]], np.float32)
+    )
+    none = np.full((1, 2), nan, np.float32)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        said = _below_max_sigma(none, before, 0.0001, 1e300)
+    assert said == (
+        "--max-sigma 0.0001 m left no depth: the smallest sigma_d of this frame is 0.25 m "
+        "(give --max-sigma 0.25 or more to keep some)"
+    )
+
+
 @pytest.mark.parametrize("value", ["0", "-5", "1.5", "abc"])
 def test_max_disparity_refused_in_the_options_words(
     value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]

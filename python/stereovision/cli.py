@@ -28,7 +28,13 @@ import numpy as np
 
 from stereovision._interrupt import Terminated, raise_terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import advice_for, figure_shown, first_line, internal_error
+from stereovision._validate import (
+    advice_for,
+    figure_shown,
+    first_line,
+    float32_reach,
+    internal_error,
+)
 
 EXIT_ERROR = 2
 EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
@@ -909,7 +915,8 @@ def _below_max_sigma(
     z = before.depth
     within = np.isfinite(z) & np.isfinite(sigma)
     if max_depth is not None:
-        within &= z <= max_depth
+        # 1e300 is float32's inf, as filtered() reads it, without NumPy's cast warning
+        within &= z <= float32_reach(max_depth)
     if not within.any():
         return None
     smallest = np.float32(sigma[within].min())
