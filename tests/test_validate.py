@@ -795,6 +795,42 @@ def test_every_count_takes_the_whole_numbers_min_agree_takes(value: object) -> N
     np.testing.assert_array_equal(sgm.sgm_disparity(left, right, max_disparity=8, p1=value), want)
 
 
+@pytest.mark.parametrize(
+    ("value", "want"),
+    [
+        (Fraction(3 * 10**17 + 1, 10**17), None),  # its nearest float is 3.0
+        (Decimal("3.00000000000000001"), None),
+        (Decimal("9007199254740993"), 9007199254740993),  # not its float's ...992
+        (Decimal("sNaN"), None),  # compared, it raised InvalidOperation
+        (np.longdouble(3), 3),  # a NumPy float, as np.float32(3)
+        (np.longdouble(3) + np.longdouble(2) ** -60, None),
+        (np.array([3], np.longdouble), 3),
+    ],
+    ids=repr,
+)
+def test_whole_value_reads_each_number_by_its_own_value(value: object, want: int | None) -> None:
+    """whole_value read a Fraction or a Decimal as its nearest float: a fraction a hair above
+    3 was the count 3 and a 16-digit Decimal another count; np.longdouble(3) was no count
+    (its item() is no Python float) where np.float32(3) was."""
+    from stereovision._validate import whole_value
+
+    got = whole_value(value)
+    assert got == want and (want is None or type(got) is int)
+
+
+def test_whole_value_gives_an_enum_member_as_its_int() -> None:
+    """A count given as an IntEnum member came back as the member: the 'Python int' it says."""
+    import enum
+
+    from stereovision._validate import whole_value
+
+    class Paths(enum.IntEnum):
+        FEW = 3
+
+    got = whole_value(Paths.FEW)
+    assert got == 3 and type(got) is int
+
+
 @pytest.mark.parametrize("value", [2.5, "3", None, np.array([3, 3]), Fraction(5, 2)], ids=repr)
 def test_every_count_refuses_what_min_agree_refuses(value: object) -> None:
     from stereovision.matching import gabor, sgm

@@ -756,11 +756,25 @@ def whole_value(value: object) -> int | None:
     >>> whole_value(3.0), whole_value(np.array([2])), whole_value(2.5), whole_value(True)
     (3, 2, None, None)
     """
-    plain = _plain_option(value)
+    if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
+        value = value.reshape(())[()]
+    if isinstance(value, NOT_NUMBERS):
+        return None
+    # each kind judged by its own value, not by its nearest float: Fraction(3 * 10**17 + 1,
+    # 10**17) and Decimal('3.00000000000000001') were 3.0 as floats, Decimal('9007199254740993')
+    # 9007199254740992, and np.longdouble(3) (whose item() is no float) no count at all
+    if isinstance(value, (int, np.integer)):
+        return int(value)  # an IntEnum member as its int
+    if isinstance(value, numbers.Rational):
+        return int(value.numerator) if value.denominator == 1 else None
+    if isinstance(value, decimal.Decimal):
+        whole = value.is_finite() and value == value.to_integral_value()  # sNaN: not compared
+        return int(value) if whole else None
+    if isinstance(value, (float, np.floating)):
+        return int(value) if np.isfinite(value) and value == np.floor(value) else None
+    plain = _plain_real(value)  # another numbers.Real: as its float, as before
     if isinstance(plain, float) and math.isfinite(plain) and plain.is_integer():
         return int(plain)
-    if isinstance(plain, int) and not isinstance(plain, bool):
-        return plain
     return None
 
 
