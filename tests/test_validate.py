@@ -831,6 +831,30 @@ def test_whole_value_gives_an_enum_member_as_its_int() -> None:
     assert got == 3 and type(got) is int
 
 
+@pytest.mark.parametrize(
+    "value", [3.0, np.float32(3), np.int64(3), Fraction(3), Decimal("3"), np.array([3])], ids=repr
+)
+def test_positive_whole_takes_the_whole_numbers_every_count_takes(value: object) -> None:
+    """positive_whole (capture's count/every, run_stream's frames) was a second rule of a
+    count written beside whole_value: it refused Fraction(3), Decimal('3') and np.array([3])
+    that min_agree and the matchers' counts take. It is whole_value above 0 now."""
+    from stereovision._validate import positive_whole
+
+    got = positive_whole(value, "count")
+    assert got == 3 and type(got) is int
+
+
+@pytest.mark.parametrize(
+    "value", [0, -1.0, 2.5, Fraction(5, 2), Decimal("NaN"), True, np.timedelta64(3), "3"], ids=repr
+)
+def test_positive_whole_refuses_in_its_own_words(value: object) -> None:
+    from stereovision._validate import positive_whole
+
+    with pytest.raises(ValueError) as exc:
+        positive_whole(value, "frames", "a positive number of pairs")
+    assert str(exc.value) == f"frames: expected a positive number of pairs, got {value!r}"
+
+
 @pytest.mark.parametrize("value", [2.5, "3", None, np.array([3, 3]), Fraction(5, 2)], ids=repr)
 def test_every_count_refuses_what_min_agree_refuses(value: object) -> None:
     from stereovision.matching import gabor, sgm

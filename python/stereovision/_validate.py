@@ -852,8 +852,9 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
 
 
 def positive_whole(value: object, name: str, expected: str = "a positive integer") -> int:
-    """``value`` as an ``int`` above 0: an integer (not a bool) or a finite whole float
-    (``3.0``).
+    """``value`` as an ``int`` above 0: a whole number as :func:`whole_value` reads it (an
+    integer, not a bool, or a finite whole float such as ``3.0``, Fraction, Decimal or size-1
+    array of one).
 
     Parameters
     ----------
@@ -874,16 +875,10 @@ def positive_whole(value: object, name: str, expected: str = "a positive integer
         ``"NAME: expected EXPECTED, got VALUE"`` for a bool, a non-number, a NaN, an infinity,
         a fraction (2.5 pairs were taken as 3, NaN as none) or a number below 1.
     """
-    ok = not isinstance(value, (bool, np.bool_, np.timedelta64))
-    if ok and isinstance(value, (int, np.integer)):
-        ok = int(value) > 0
-    elif ok and isinstance(value, (float, np.floating)):
-        ok = bool(math.isfinite(value) and value == math.floor(value) and value > 0)
-    else:
-        ok = False
-    if not ok:
+    whole = whole_value(value)  # the one rule of a count, its own check merged into it
+    if whole is None or whole < 1:
         raise ValueError(f"{name}: expected {expected}, got {_shown(value)}")
-    return int(value)  # type: ignore[call-overload]
+    return whole
 
 
 def float_sized(value: _T, name: str) -> _T:
