@@ -89,8 +89,9 @@ def test_a_max_sigma_that_leaves_no_depth_names_the_smallest_sigma(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``depth --max-sigma 0.0001`` on the sample wrote outputs with no depth and said nothing
-    of why: one warning line on stderr names the option and the frame's smallest sigma_d, and
-    that value given as --max-sigma keeps some depth."""
+    of why: one warning line on stderr names the option and the frame's smallest depth sigma
+    (in metres: not sigma_d, the disparity's in pixels, which the summary names), and that value
+    given as --max-sigma keeps some depth."""
     argv = ["depth", str(CONES / "left.png"), str(CONES / "right.png")]
     argv += ["--calib", str(CONES / "calib.txt")]
     assert main([*argv, "--max-sigma", "0.0001", "-o", str(tmp_path / "cut")]) == 0
@@ -99,8 +100,8 @@ def test_a_max_sigma_that_leaves_no_depth_names_the_smallest_sigma(
     lines = [line for line in err.splitlines() if "--max-sigma" in line]
     assert len(lines) == 1, err
     said = re.fullmatch(
-        r"stereovision: warning: --max-sigma 0\.0001 m left no depth: the smallest sigma_d of "
-        r"this frame is (\S+) m \(give --max-sigma \1 or more to keep some\)",
+        r"stereovision: warning: --max-sigma 0\.0001 m left no depth: the smallest depth sigma "
+        r"of this frame is (\S+) m \(give --max-sigma \1 or more to keep some\)",
         lines[0],
     )
     assert said is not None, lines[0]
@@ -148,7 +149,7 @@ def test_max_sigma_with_a_max_depth_past_float32_says_one_line_without_numpy_war
         warnings.simplefilter("error")
         said = _below_max_sigma(none, before, 0.0001, 1e300)
     assert said == (
-        "--max-sigma 0.0001 m left no depth: the smallest sigma_d of this frame is 0.25 m "
+        "--max-sigma 0.0001 m left no depth: the smallest depth sigma of this frame is 0.25 m "
         "(give --max-sigma 0.25 or more to keep some)"
     )
 

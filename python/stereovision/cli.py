@@ -903,7 +903,7 @@ def _beyond_max_depth(depth: np.ndarray, before: np.ndarray, max_depth: float) -
 def _below_max_sigma(
     depth: np.ndarray, before: Any, max_sigma: float, max_depth: float | None = None
 ) -> str | None:
-    """``--max-sigma 0.001 m left no depth: the smallest sigma_d of this frame is 0.0123 m``
+    """``--max-sigma 0.001 m left no depth: the smallest depth sigma of this frame is 0.0123 m``
     when ``--max-sigma`` took every depth ``before`` (the result as matched) had within
     ``max_depth``; None otherwise (some depth kept, none to begin with, or ``--max-depth``
     took them all: :func:`_beyond_max_depth` says so). The smallest sigma is shown with the
@@ -926,7 +926,7 @@ def _below_max_sigma(
     if np.float32(float(shown)) < smallest:  # 0.01234 shown as 0.0123 would keep nothing
         shown = f"{float(smallest):.9g}"
     return (
-        f"--max-sigma {max_sigma:g} m left no depth: the smallest sigma_d of this frame is "
+        f"--max-sigma {max_sigma:g} m left no depth: the smallest depth sigma of this frame is "
         f"{shown} m (give --max-sigma {shown} or more to keep some)"
     )
 
