@@ -1499,3 +1499,26 @@ def test_ransac_px_beyond_a_float_is_refused_by_name() -> None:
     a = np.zeros((50, 60), np.uint8)
     with pytest.raises(ValueError, match=r"^ransac_px: expected a positive number of pixels"):
         rectify_uncalibrated(a, a, ransac_px=10**400)
+
+
+@pytest.mark.parametrize(
+    "value", [np.timedelta64(3), 10**400, -(10**400)], ids=["3 ns", "10**400", "-10**400"]
+)
+def test_both_rectification_checks_refuse_a_tolerance_that_is_no_number_of_pixels(
+    value: object,
+) -> None:
+    """UncalibratedRectification.check took a tolerance of 3 ns as 3 px (2f65049's shared rule
+    was lost there in a later merge), and it and check_rectification raised NumPy's bare
+    TypeError "ufunc 'isfinite' not supported" for 10**400: both are refused naming it."""
+    from stereovision.rectification_check import check_rectification
+
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (60, 50), (60, 50), np.zeros((3, 3)), 40, 0.1, 0.2, (1.0, 9.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    a = np.zeros((50, 60), np.uint8)
+    said = r"^tolerance: expected a positive number of pixels, got "
+    with pytest.raises(ValueError, match=said):
+        rect.check(a, a, tolerance=value)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=said):
+        check_rectification(a, a, tolerance=value)  # type: ignore[arg-type]

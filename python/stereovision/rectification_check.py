@@ -18,7 +18,14 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8, as_image_array, real_number, remap_image
+from stereovision._validate import (
+    as_gray_uint8,
+    as_image_array,
+    number_shown,
+    real_number,
+    remap_image,
+    too_large_for_float,
+)
 from stereovision._validate import require as _require_type
 from stereovision.calibration import Calibration, _check_alpha
 
@@ -233,8 +240,15 @@ def check_rectification(
         Images that are not images, of different sizes or of the wrong size for ``calib``, or
         a tolerance that is not a positive number (Python or NumPy real).
     """
-    if not real_number(tolerance) or not (np.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
+    # 10**400: np.isfinite's bare TypeError "ufunc 'isfinite' not supported", naming nothing
+    if (
+        too_large_for_float(tolerance)
+        or not real_number(tolerance)
+        or not (np.isfinite(tolerance) and tolerance > 0)
+    ):
+        raise ValueError(
+            f"tolerance: expected a positive number of pixels, got {number_shown(tolerance)}"
+        )
     _check_alpha(alpha)  # also without a calibration (it took any alpha without a word)
     if calib is not None:
         _require_type(calib, "Calibration", "calib")

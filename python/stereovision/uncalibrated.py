@@ -469,12 +469,16 @@ class UncalibratedRectification:
             If an image is not of :attr:`input_size`, or a tolerance that is not a positive
             number.
         """
+        # real_number (2f65049's rule, lost here in a merge): 3 ns was 3 px; and 10**400 was
+        # np.isfinite's bare TypeError
         if (
-            isinstance(tolerance, (bool, np.bool_))
-            or not isinstance(tolerance, (int, float, np.integer, np.floating))
+            too_large_for_float(tolerance)
+            or not real_number(tolerance)
             or not (np.isfinite(tolerance) and tolerance > 0)
         ):
-            raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
+            raise ValueError(
+                f"tolerance: expected a positive number of pixels, got {number_shown(tolerance)}"
+            )
         grays = []
         for name, img in (("left", left), ("right", right)):
             g = as_gray_uint8(img, name)
