@@ -71,9 +71,26 @@ def test_pcd_keeps_image_layout(result, tmp_path):
 
 
 def test_pcd_rgb_is_packed_like_pcl():
-    packed = export._pack_rgb(np.array([[255, 0, 0], [0, 128, 1]], np.uint8))
-    assert packed.view("<u4").tolist() == [0xFF0000, 0x008001]
-    np.testing.assert_array_equal(export._unpack_rgb(packed), [[255, 0, 0], [0, 128, 1]])
+    """pcl::PointXYZRGB's rgba with alpha 255 (opaque), as PCL writes it: alpha was 0."""
+    rgb = np.array([[255, 0, 0], [0, 128, 1], [255, 255, 255], [0, 0, 0]], np.uint8)
+    packed = export._pack_rgb(rgb)
+    assert packed.view("<u4").tolist() == [0xFFFF0000, 0xFF008001, 0xFFFFFFFF, 0xFF000000]
+    np.testing.assert_array_equal(export._unpack_rgb(packed), rgb)
+
+
+def test_pcd_written_colours_are_opaque_and_read_back(result, tmp_path):
+    """The file's own bytes: alpha 255 in every point's rgb, white (a NaN float) kept bit for
+    bit, and read_pcd gives the colours back."""
+    left = result.left_rectified.copy()
+    left[0, :4] = [[255, 255, 255], [0, 0, 0], [3, 2, 1], [255, 128, 0]]  # BGR
+    path = export.write_pcd(tmp_path / "c.pcd", replace(result, left_rectified=left))
+    raw = path.read_bytes()
+    body = raw[raw.index(b"DATA binary\n") + len(b"DATA binary\n") :]
+    bits = np.frombuffer(body, "<u4").reshape(-1, 4)[:, 3]
+    assert bits[:4].tolist() == [0xFFFFFFFF, 0xFF000000, 0xFF010203, 0xFF0080FF]
+    assert (bits >> 24 == 255).all()
+    _, cols = export.read_pcd(path)
+    np.testing.assert_array_equal(cols, left[..., ::-1])
 
 
 _COLOURS = np.array([[255, 0, 0], [10, 20, 30], [0, 128, 1]], np.uint8)
@@ -695,9 +712,10 @@ def test_pcd_and_mesh_writers_write_the_records_without_copying_them(result, tmp
     rec = np.frombuffer(body, np.float32).reshape(-1, 4)
     assert len(rec) == h * w
     np.testing.assert_array_equal(rec[:, :3], pts.reshape(-1, 3))
-    rgb = rec[:, 3].view(np.uint32)  # PCL's packed 0x00RRGGBB
+    rgb = rec[:, 3].view(np.uint32)  # PCL's packed 0xFFRRGGBB (alpha 255)
     flat = cols.reshape(-1, 3).astype(np.uint32)
-    np.testing.assert_array_equal(rgb, (flat[:, 0] << 16) | (flat[:, 1] << 8) | flat[:, 2])
+    packed = (flat[:, 0] << 16) | (flat[:, 1] << 8) | flat[:, 2]
+    np.testing.assert_array_equal(rgb, np.uint32(0xFF000000) | packed)
     files = []
 
     @contextlib.contextmanager

@@ -5,9 +5,10 @@ Conventions shared with pyvista, Open3D, MeshLab and PCL:
 - PLY: ``binary_little_endian 1.0``; vertex ``float x, y, z`` + ``uchar red, green, blue``; mesh
   faces as ``list uchar int vertex_indices``. Metres, left rectified camera frame (X right, Y down,
   Z forward).
-- PCD (PCL 0.7): ``FIELDS x y z rgb``, ``rgb`` packed into a float (``r << 16 | g << 8 | b``, as
-  ``pcl::PointXYZRGB`` writes it); the cloud keeps the image layout (``WIDTH`` = image width,
-  ``HEIGHT`` = image height, row-major), pixels without depth are NaN points (``is_dense`` false).
+- PCD (PCL 0.7): ``FIELDS x y z rgb``, ``rgb`` packed into a float (``255 << 24 | r << 16 |
+  g << 8 | b``: opaque, as ``pcl::PointXYZRGB`` writes it); the cloud keeps the image layout
+  (``WIDTH`` = image width, ``HEIGHT`` = image height, row-major), pixels without depth are NaN
+  points (``is_dense`` false).
 - NPZ: ``depth``, ``confidence``, ``disparity`` (H, W float32, NaN = none), ``K`` (3x3),
   ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``
   (int64; float64 for a fractional range), ``min_disparity`` (float64), ``depth_sigma`` (H, W
@@ -258,8 +259,10 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
 
 
 def _pack_rgb(colors: npt.NDArray[np.uint8]) -> npt.NDArray[np.float32]:
+    """RGB as PCL packs it, ``0xFFRRGGBB`` in the bits of a float32: pcl::PointXYZRGB's
+    ``rgba`` with its alpha 255 (opaque; alpha 0 was written, which PCL never does)."""
     c = colors.reshape(-1, 3).astype(np.uint32)
-    packed = (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]
+    packed = np.uint32(0xFF000000) | (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]
     return packed.astype("<u4").view("<f4")
 
 
@@ -320,11 +323,12 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
     pts, cols = organised_points(result)
     h, w = pts.shape[:2]
     rec = np.empty(
-        h * w, dtype=np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<f4")])
+        h * w, dtype=np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<u4")])
     )
     flat = pts.reshape(-1, 3)
     rec["x"], rec["y"], rec["z"] = flat[:, 0], flat[:, 1], flat[:, 2]
-    rec["rgb"] = _pack_rgb(cols)
+    # stored as the bits: with alpha 255 white is a NaN float, kept bit for bit as an integer
+    rec["rgb"] = _pack_rgb(cols).view("<u4")
     header = (
         "# .PCD v0.7 - Point Cloud Data file format (stereovision, metres, X right Y down Z fwd)\n"
         "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
