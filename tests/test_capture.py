@@ -2964,13 +2964,38 @@ def test_an_integer_beyond_a_float_is_refused_by_name(tmp_path: Path) -> None:
     from stereovision.capture import check_read_timeout
 
     big = 10**400
-    with pytest.raises(ValueError, match=r"^image_size: at most 16384 px per side, got 1000"):
+    with pytest.raises(
+        ValueError,
+        match=r"^image_size: at most 16384 px per side, got \(an integer of 401 digits, 480\)$",
+    ):
         parse_size((big, 480), "image_size")
     for name in ("read_timeout", "open_timeout"):
         with pytest.raises(
-            ValueError, match=rf"^{name}: expected at most [\d.e+]+ seconds .*got 1000"
+            ValueError,
+            match=rf"^{name}: expected at most [\d.e+]+ seconds .*got an integer of 401 digits$",
         ):
             check_read_timeout(big, name)  # type: ignore[arg-type]
+    # its size, not its digits: 10**5000 has no str (Python's "Exceeds the limit (4300
+    # digits)" ValueError, naming no keyword)
+    huge = 10**5000
+    with pytest.raises(
+        ValueError, match=r"^image_size: at most .*got \(640, an integer of 5001 digits\)$"
+    ):
+        parse_size((640, huge), "image_size")
+    with pytest.raises(
+        ValueError,
+        match=r"^image_size: expected .*got \(a negative integer of 5001 digits, 480\)$",
+    ):
+        parse_size([-huge, 480], "image_size")
+    with pytest.raises(
+        ValueError, match=r"^read_timeout: expected at most .*got an integer of 5001"
+    ):
+        check_read_timeout(huge)  # type: ignore[arg-type]
+    with pytest.raises(
+        ValueError,
+        match=r"^open_timeout: expected a positive .*got a negative integer of 5001 digits$",
+    ):
+        check_read_timeout(-huge, "open_timeout")  # type: ignore[arg-type]
     missing = str(tmp_path / "none.avi")  # refused before the open: no FileNotFoundError
     with pytest.raises(ValueError, match=r"^fps: an integer of 401 digits is beyond a float's"):
         StereoCamera(missing, missing, fps=big)

@@ -61,6 +61,7 @@ from stereovision._validate import (
     positive_whole,
     renamed_keyword,
     source_warning,
+    too_large_for_float,
 )
 from stereovision.calibrate import (
     DEFAULT_READ_TIMEOUT,
@@ -321,12 +322,23 @@ def parse_size(text: str | tuple[int, int] | None, name: str = "size") -> tuple[
         )
         vals = (int(items[0]), int(items[1])) if whole else (0, 0)
     if min(vals) <= 0:
-        raise ValueError(f"{name}: expected WIDTHxHEIGHT with positive integers, got {text!r}")
+        big = isinstance(text, (tuple, list)) and any(map(too_large_for_float, text))
+        shown = f"({', '.join(map(_int_shown, text))})" if big else repr(text)
+        raise ValueError(f"{name}: expected WIDTHxHEIGHT with positive integers, got {shown}")
     # Frames of another size are resized to this one: 100000x100000 made OpenCV fail to
     # allocate 30 GB per frame, an internal error instead of a word about the size.
     if max(vals) > MAX_SIDE:
-        raise ValueError(f"{name}: at most {MAX_SIDE} px per side, got {vals[0]}x{vals[1]}")
+        big = any(map(too_large_for_float, vals))
+        shown = f"({', '.join(map(_int_shown, vals))})" if big else f"{vals[0]}x{vals[1]}"
+        raise ValueError(f"{name}: at most {MAX_SIDE} px per side, got {shown}")
     return vals
+
+
+def _int_shown(value: object) -> str:
+    """``repr(value)`` for a message, an int beyond a float as its digits' count: the 401
+    digits of 10**400 filled the line, and 10**5000 has no str (Python's "Exceeds the limit
+    (4300 digits)" ValueError, naming no keyword)."""
+    return too_large_for_float(value, why=False) or repr(value)
 
 
 # ---------------------------------------------------------------------------------- camera
@@ -594,13 +606,14 @@ def check_read_timeout(timeout: float | None, name: str = "read_timeout") -> Non
         or not (timeout > 0 and (isinstance(timeout, (int, np.integer)) or math.isfinite(timeout)))
     ):
         raise ValueError(
-            f"{name}: expected a positive number of seconds (None: no limit), got {timeout!r}"
+            f"{name}: expected a positive number of seconds (None: no limit), "
+            f"got {_int_shown(timeout)}"
         )
     # 1e10 s passed too, and overflowed the wait as inf did (an internal OverflowError)
     if timeout is not None and timeout > threading.TIMEOUT_MAX:
         raise ValueError(
             f"{name}: expected at most {threading.TIMEOUT_MAX:g} seconds (None: no limit), "
-            f"got {timeout!r}"
+            f"got {_int_shown(timeout)}"
         )
 
 
