@@ -1735,6 +1735,17 @@ def test_run_stream_refuses_a_report_period_that_is_no_number_of_seconds() -> No
             f"report_period: expected a number of seconds >= 0, got {period!r}"
         )
         assert rig.count == 0
+    # a timedelta64 (an np.integer) passed, and the loop's UFuncTypeError came after a pair was
+    # taken; -10**5000 has no repr (Python's "Exceeds the limit (4300 digits)", naming nothing)
+    for period, shown in (
+        (np.timedelta64(1, "s"), "np.timedelta64(1,'s')"),
+        (-(10**5000), "a negative integer of 5001 digits"),
+    ):
+        rig = _FakeRig([_frame(i) for i in range(3)])
+        with pytest.raises(ValueError) as err:
+            run_stream(rig, max_disparity=8, pipelined=False, check=False, report_period=period)  # type: ignore[arg-type]
+        assert str(err.value) == f"report_period: expected a number of seconds >= 0, got {shown}"
+        assert rig.count == 0
     for period, reports in ((0.0, 3), (float("inf"), 1)):
         rig = _FakeRig([_frame(i) for i in range(3)])
         rep = run_stream(rig, max_disparity=8, pipelined=False, check=False, report_period=period)  # type: ignore[arg-type]

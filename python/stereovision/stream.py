@@ -39,7 +39,13 @@ import numpy as np
 
 from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import HELD_WARNINGS, first_line, positive_whole, user_stacklevel
+from stereovision._validate import (
+    HELD_WARNINGS,
+    first_line,
+    positive_whole,
+    too_large_for_float,
+    user_stacklevel,
+)
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
@@ -886,13 +892,16 @@ def run_stream(
     if frames is not None:
         frames = positive_whole(frames, "frames", "a positive number of pairs")
     check_read_timeout(read_timeout)
-    # "1" raised TypeError in the loop after a pair was taken; NaN gave no report but the last
+    # "1" raised TypeError in the loop after a pair was taken; NaN gave no report but the last;
+    # np.timedelta64 (an np.integer) the loop's UFuncTypeError after a pair was taken
     if (
-        isinstance(report_period, (bool, np.bool_))
+        isinstance(report_period, (bool, np.bool_, np.timedelta64))
         or not isinstance(report_period, (int, float, np.integer, np.floating))
         or not report_period >= 0
     ):
-        raise ValueError(f"report_period: expected a number of seconds >= 0, got {report_period!r}")
+        # -10**5000 by its size: it has no repr (Python's 4300-digit limit, naming nothing)
+        shown = too_large_for_float(report_period, why=False) or repr(report_period)
+        raise ValueError(f"report_period: expected a number of seconds >= 0, got {shown}")
     if homographies is not None:
         if calib is not None:
             raise ValueError("homographies and calib: give one way to rectify the pairs")
