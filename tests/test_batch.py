@@ -1823,6 +1823,33 @@ def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
     assert (s["seq/0000"]["this_run"], s["seq/0001"]["this_run"]) == ("processed", "skipped")
 
 
+def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A version 1 summary lists no outputs: its entries take the files found in their folders
+    as their list, so one whose disparity.pfm had gone listed the others alone, and a done pair
+    was skipped with every output it listed there, its disparity.pfm never written again (only
+    disparity.pfm was looked for before). disparity.pfm, written for every pair, is always
+    looked for."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    pfm = out / "a" / "disparity.pfm"
+    disparity = read_pfm(pfm)
+    summary = json.loads((out / SUMMARY_NAME).read_text())
+    summary["version"] = 1  # as a batch before ed0f5f2 wrote it: no outputs list
+    del summary["pairs"]["a"]["outputs"]
+    (out / SUMMARY_NAME).write_text(json.dumps(summary, indent=1))
+    (out / "a" / "overview.png").unlink()  # no version 1 batch wrote one
+    pfm.unlink()
+    capsys.readouterr()
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 0 skipped (done before), 0 failed")
+    np.testing.assert_array_equal(read_pfm(pfm), disparity)
+    assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)
+
+
 def test_a_changed_pair_is_redone_from_another_working_directory(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -1093,12 +1093,14 @@ def _skip(
 
 
 def _outputs_missing(entry: dict[str, Any], out: Path, name: str) -> list[str]:
-    """The outputs ``entry`` (a done pair's record) lists that are not files in its folder
-    (``disparity.pfm``, written for every pair, for a record that lists none). Only
-    disparity.pfm was looked for: a pair whose cloud.ply had gone was skipped as done, its
-    cloud never written again."""
+    """The outputs ``entry`` (a done pair's record) lists that are not files in its folder,
+    and ``disparity.pfm`` (written for every pair) if it is not. Only disparity.pfm was looked
+    for: a pair whose cloud.ply had gone was skipped as done, its cloud never written again.
+    disparity.pfm whatever the list: a version 1 summary's entry lists the files found in its
+    folder (:func:`_list_legacy_outputs`), without a disparity.pfm that had gone."""
     listed = entry.get("outputs")
-    names = [str(f) for f in listed] if isinstance(listed, list) and listed else ["disparity.pfm"]
+    names = [str(f) for f in listed] if isinstance(listed, list) else []
+    names += [] if "disparity.pfm" in names else ["disparity.pfm"]
     return [f for f in names if not (out / name / f).is_file()]
 
 
