@@ -1794,6 +1794,36 @@ def test_a_redo_without_calib_removes_the_stale_depth_files_but_not_a_link(
     assert (pair / "depth.png").is_symlink() and mine.is_file()
 
 
+def test_batch_keeps_dask_logs_off_for_a_restarted_worker_and_restores_the_config() -> None:
+    """The low-level log length was 0 only while the client and cluster started: a worker
+    killed (OOM, a crash) and restarted by its nanny met a scheduler that logged its last 1000
+    messages to it again, each pair's image bytes in them (4 MB after 20 tasks of 200 kB).
+    It stays 0 until the run closes Dask, and is as it was after."""
+    import dask
+
+    from stereovision.batch import _Dask
+
+    before = dask.config.get("distributed.admin.low-level-log-length")
+    runner = _Dask()
+    runner.start(None, 1)
+    try:
+        sched = runner.cluster.scheduler
+        old = set(sched.workers)
+        for pid in runner.client.run(os.getpid).values():
+            os.kill(pid, signal.SIGKILL)
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and (not sched.workers or set(sched.workers) == old):
+            time.sleep(0.2)
+        new = set(sched.workers) - old
+        assert new, "the nanny did not restart the worker"
+        assert runner.client.submit(len, b"x" * 1000, pure=False).result() == 1000
+        assert [sched.stream_comms[w].recent_message_log.maxlen for w in new] == [0]
+        assert dask.config.get("distributed.admin.low-level-log-length") == 0
+    finally:
+        runner.close([])
+    assert dask.config.get("distributed.admin.low-level-log-length") == before
+
+
 def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1143,6 +1143,7 @@ class _Dask:
         self.client: Any = None
         self.cluster: Any = None
         self.desc = ""
+        self._quiet = contextlib.ExitStack()  # Dask's low-level logs off until close()
 
     def start(self, scheduler: str | None, workers: int) -> None:
         try:
@@ -1205,12 +1206,19 @@ class _Dask:
         # Dask's client (and a LocalCluster's scheduler, in this process) log their last 1000
         # messages under 1 MB for debugging, each submitted pair's image bytes with them: the
         # client grew by the pairs' size (0.7 MB a pair of 384x288 PNGs, 21 MB over 30), up to
-        # a GB over a night's run. Read when they start, so set only for that.
-        with HeldInterrupts(), dask.config.set({"distributed.admin.low-level-log-length": 0}):
-            if scheduler is not None:
-                connect()
-            else:
-                _in_thread_without_sigint(local)
+        # a GB over a night's run. Read as each log is made: when they start, and when the
+        # scheduler meets a worker its nanny restarted (a worker killed: set only for the
+        # start, that worker's log held the pairs sent to it again), so until close().
+        self._quiet.enter_context(dask.config.set({"distributed.admin.low-level-log-length": 0}))
+        try:
+            with HeldInterrupts():
+                if scheduler is not None:
+                    connect()
+                else:
+                    _in_thread_without_sigint(local)
+        except BaseException:
+            self._quiet.close()
+            raise
 
     def close(self, futures: list[Any]) -> None:
         with HeldInterrupts():
@@ -1223,6 +1231,8 @@ class _Dask:
                     self.cluster.close()
             except Exception:  # shutting down is best effort; the results are already written
                 pass
+            finally:
+                self._quiet.close()  # Dask's config as it was
 
 
 def _calib_payload(
