@@ -665,6 +665,33 @@ def test_commands_named_in_the_prose_take_their_options() -> None:
     assert checked >= 60, checked  # 81 on 2026-12-06
 
 
+def test_every_option_is_documented_with_its_command() -> None:
+    """Every option a command's --help lists is named (by one of its option strings) in a
+    paragraph or code block of the README or docs/ that names that command (`stream`,
+    `stereovision gui ...`): `stream --serve`, `--no-check`, `--no-pipeline`, `gui --port`,
+    `--no-browser` and `board --dpi` were named nowhere."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    paragraphs = [part for page in PAGES for part in re.split(r"\n\s*\n", page.read_text())]
+    unnamed, checked = [], 0
+    for command, sub in commands.choices.items():
+        names_command = re.compile(rf"(?:`|stereovision )(?:stereovision )?{command}\b")
+        with_command = [p for p in paragraphs if names_command.search(p)]
+        for action in sub._actions:
+            if not action.option_strings or "--help" in action.option_strings:
+                continue
+            checked += 1
+            named = re.compile("|".join(re.escape(o) + r"(?![\w-])" for o in action.option_strings))
+            if not any(named.search(p) for p in with_command):
+                unnamed.append(f"{command} {action.option_strings[-1]}")
+    assert not unnamed, f"options no paragraph naming their command names: {unnamed}"
+    assert checked >= 140, checked  # 151 on 2026-12-06
+
+
 def test_synopsis_choices_are_the_parsers() -> None:
     """An option shown with its values (`--method fused|gabor|census|fast`, `--unit m|ft|...`)
     in a code block lists exactly the values the parser accepts."""
