@@ -400,6 +400,36 @@ def test_public_functions_document_their_parameters_and_returns() -> None:
     assert not problems, "\n".join(problems)
 
 
+def test_public_dataclasses_document_their_fields() -> None:
+    """Every public field of a dataclass ``stereovision`` exports is named in its docstring's
+    Parameters or Attributes: ``DepthResult.min_disparity`` and ``left_rectified`` (the image
+    the cloud takes its colours from) were in none."""
+    import dataclasses
+
+    import stereovision as sv
+
+    undocumented, checked = [], 0
+    for name in sv.__all__:
+        cls = getattr(sv, name)
+        if not (inspect.isclass(cls) and dataclasses.is_dataclass(cls)):
+            continue
+        sections = _numpydoc_sections(inspect.getdoc(cls) or "")
+        said = {
+            part.strip()
+            for section in ("Parameters", "Attributes")
+            for line in sections.get(section, "").splitlines()
+            if line and not line[0].isspace()
+            for part in line.split(" : ")[0].split(",")
+        }
+        for f in dataclasses.fields(cls):
+            if not f.name.startswith("_"):
+                checked += 1
+                if f.name not in said:
+                    undocumented.append(f"{name}.{f.name}")
+    assert not undocumented, f"fields no docstring names: {undocumented}"
+    assert checked >= 40, checked  # 53 on 2026-12-06
+
+
 #: The modules whose classes and functions a user's script meets beyond ``_public_api``'s:
 #: what ``depth_map``, ``check_rectification``, ``rectify_uncalibrated``, ``occupancy_grid`` and
 #: the evaluation return, and the 3-D view's camera; the capture, ChArUco, stream and bench

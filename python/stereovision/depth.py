@@ -597,8 +597,14 @@ class DepthResult:
         int for a whole number of pixels (the estimated range always is), else the float given
         (37.5 stays 37.5: the Gabor channel searches up to it, the census semi-global map up to
         the next whole pixel, 38).
+    min_disparity : float
+        Smallest disparity searched (``depth_map``'s ``min_disparity``, 0 by default).
     calibration : Calibration or None
         Calibration of the rectified pair the depth was computed with.
+    left_rectified : ndarray, uint8 (H, W, 3) or None
+        The left image as matched, BGR (rectified when ``calib`` rectified the pair; a copy,
+        not the caller's buffer): the cloud's colours (also of the cloud :meth:`to_ply` rebuilds
+        after ``cloud=False``; black without it) and ``overview.png``'s left panel.
     timings : dict
         Seconds spent per stage (``rectify``, ``prepare``, ``match``, ``refine`` and ``fill``
         when they ran, ``triangulate`` with a calibration).
