@@ -155,6 +155,37 @@ def test_bench_of_a_scene_narrower_than_its_range_names_the_width_needed(
     ]
 
 
+def test_bench_of_a_scene_no_higher_than_stereobms_block_times_the_others(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A crop of tsukuba 12 rows high: StereoBM's refusal ('needs images at least 16 px high')
+    failed the whole scene. Every other case is now benched, StereoBM left out and said why."""
+    import cv2
+
+    from stereovision.io import read_pfm, write_pfm
+
+    src = data_dir / SCENE
+    scene = tmp_path / "low"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        assert cv2.imwrite(str(scene / name), cv2.imread(str(src / name))[100:112])
+    write_pfm(scene / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[100:112].copy())
+    note = (
+        f"{scene}: no StereoBM figures: StereoBM's 15 px block needs images at least 16 px "
+        "high, got 12"
+    )
+    sparse = [sparse_name(m) for m in SPARSE_METHODS if m != "gabor"]
+    for json_flag in ([], ["--json"]):
+        assert main(["bench", *json_flag, str(scene)]) == 0
+        cap = capsys.readouterr()
+        assert cap.err.splitlines() == [note]
+        lines = [_strict_json(ln) for ln in cap.out.splitlines() if ln.startswith("{")]
+        assert [ln["case"] for ln in lines] == [*METHODS, "pipeline", *sparse, "SGBM-3WAY"]
+        by: dict[Any, dict[str, Any]] = {ln["case"]: ln for ln in lines}
+        assert by["SGBM-3WAY"]["ratio_sgbm"] == 1.0 and by["SGBM-3WAY"]["bad_2.0"] > 0
+        assert by["pipeline"]["density"] > 50
+
+
 class _Clock:
     """A fake ``time.perf_counter``: only the fake matchers below move it."""
 
@@ -235,6 +266,8 @@ def _fake_bench(
     monkeypatch.setattr(match_mod, "match", match)
     monkeypatch.setattr(baselines, "opencv_bm", _fake(clock, 0.001, disp, calls["bm"], pattern))
     monkeypatch.setattr(baselines, "opencv_sgbm", _fake(clock, 0.002, disp, calls["sgbm"], pattern))
+    # the fake StereoBM runs on any pair: the real one's block needs 16 rows, not these 8
+    monkeypatch.setattr(baselines, "bm_reference_refusal", lambda *_a: None)
     rng = np.random.default_rng(0)
     img = (rng.random((8, 32, 3)) * 255).astype(np.uint8)
     scene = types.SimpleNamespace(

@@ -1878,6 +1878,8 @@ def test_eval_times_are_the_medians_of_the_timed_runs(monkeypatch: pytest.Monkey
     monkeypatch.setattr(depth_mod, "depth_map", fake(0.010, res))
     monkeypatch.setattr(baselines, "opencv_bm", fake(0.001, disp))
     monkeypatch.setattr(baselines, "opencv_sgbm", fake(0.002, disp))
+    # the fake StereoBM runs on any pair: the real one's block needs 16 rows, not these 8
+    monkeypatch.setattr(baselines, "bm_reference_refusal", lambda *_a: None)
     img = np.zeros((8, 32, 3), np.uint8)
     gt = np.full((8, 32), 2.0, np.float32)
     scene = types.SimpleNamespace(

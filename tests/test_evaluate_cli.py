@@ -368,24 +368,48 @@ def test_eval_names_a_narrow_scene_among_several_once(tmp_path: Path) -> None:
     )
 
 
-def test_eval_of_a_scene_no_higher_than_stereobms_block_says_so_in_one_line(
-    data_dir: Path, tmp_path: Path
-) -> None:
-    """A scene 10 rows high: the StereoBM reference's cv2.error ended eval with 'internal error:
-    OpenCV(5.1.0) /io/opencv/modules/stereo/src/stereobm.cpp:1189: ... (please report this)'.
-    It is one line naming the height StereoBM needs."""
+def _low_scene(data_dir: Path, tmp_path: Path, rows: int = 12) -> Path:
+    """A crop of tsukuba ``rows`` rows high (range 16), with its GT."""
     import cv2
 
     from stereovision.io import read_pfm, write_pfm
 
     src = data_dir / "middlebury2001" / "tsukuba"
-    scene = tmp_path / "short"
+    scene = tmp_path / "low"
     scene.mkdir()
     for name in ("left.png", "right.png"):
-        assert cv2.imwrite(str(scene / name), cv2.imread(str(src / name))[100:110])
-    write_pfm(scene / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[100:110])
-    proc = _eval(str(scene), "--method", "fast")
-    assert proc.returncode == 2 and proc.stdout == ""
-    assert proc.stderr.splitlines() == [
-        "stereovision: error: StereoBM's 15 px block needs images at least 16 px high, got 10"
-    ]
+        assert cv2.imwrite(str(scene / name), cv2.imread(str(src / name))[100 : 100 + rows])
+    write_pfm(scene / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[100 : 100 + rows].copy())
+    return scene
+
+
+def test_eval_of_a_scene_no_higher_than_stereobms_block_scores_ours_and_sgbm(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A scene 12 rows high: since 67b28cf StereoBM's refusal ('needs images at least 16 px
+    high') failed the whole scene (exit 2, no figures). Ours and SGBM-3WAY are now scored as
+    on any scene, the StereoBM column blank (no 'bm' keys in --json) and one line says why."""
+    from stereovision import baselines
+    from stereovision.evaluate import dense_metrics
+    from stereovision.io import load_scene
+
+    scene_dir = _low_scene(data_dir, tmp_path)
+    scene = load_scene(scene_dir)
+    note = (
+        f"{scene_dir}: no StereoBM figures: StereoBM's 15 px block needs images at least 16 px "
+        "high, got 12"
+    )
+    proc = _eval(str(scene_dir), "--json", "--method", "fast")
+    assert proc.returncode == 0 and proc.stderr.splitlines() == [note]
+    (row,) = _rows(proc.stdout)
+    assert "bm" not in row and "bm_ms" not in row and row["sgbm_ms"] > 0
+    sgbm = dense_metrics(baselines.opencv_sgbm(scene.left, scene.right, 16), scene.gt).as_dict()
+    assert row["sgbm"]["bad_2.0"] == pytest.approx(sgbm["bad_2.0"])
+    assert row["ours"]["n_gt"] == sgbm["n_gt"] > 0 and row["ours"]["density"] > 50
+    proc = _eval(str(scene_dir), "--method", "fast", "--runs", "2")
+    assert proc.returncode == 0 and proc.stderr.splitlines() == [note]
+    lines = proc.stdout.splitlines()
+    cells = lines[2].split("|")
+    assert cells[3].strip() == "" and cells[4].split()[0] == f"{row['sgbm']['bad_2.0']:.1f}"
+    assert lines[3].startswith("mean bad-2.0: ours ") and "StereoBM" not in lines[3]
+    assert "StereoBM" not in lines[4] and "SGBM-3WAY" in lines[4]

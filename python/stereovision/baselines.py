@@ -41,6 +41,7 @@ __all__ = [
     "BM_BLOCK_SIZE",
     "SGBM_BLOCK_SIZE",
     "bm_reference_range",
+    "bm_reference_refusal",
     "bm_widest_range",
     "opencv_bm",
     "opencv_sgbm",
@@ -155,6 +156,27 @@ def bm_reference_range(max_disparity: float, width: int) -> float:
     """
     widest = bm_widest_range(width)
     return widest if round_up16(max_disparity) > widest >= 16 else max_disparity
+
+
+def bm_reference_refusal(max_disparity: float, shape: tuple[int, ...]) -> str | None:
+    """Why :func:`opencv_bm` cannot run as a reference on images of ``shape`` at
+    :func:`bm_reference_range`, or None: images no higher than its block, or under 30 px wide
+    (no range fits). ``eval`` and ``bench`` then score the other matchers and leave StereoBM
+    out, saying this, rather than fail the whole scene.
+
+    Examples
+    --------
+    >>> bm_reference_refusal(64, (375, 450)) is None, bm_reference_refusal(64, (375, 70)) is None
+    (True, True)
+    >>> bm_reference_refusal(16, (12, 384))
+    "StereoBM's 15 px block needs images at least 16 px high, got 12"
+    """
+    num = round_up16(bm_reference_range(max_disparity, shape[1]))
+    try:
+        _refuse_bm_range(num, shape, BM_BLOCK_SIZE)
+    except ValueError as e:
+        return str(e)
+    return None
 
 
 def _refuse_sgbm_range(num: int, width: int, block: int) -> None:

@@ -162,7 +162,8 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     Returns
     -------
     list of BenchCase
-        In the order: dense methods, pipeline, sparse methods, StereoBM, SGBM-3WAY.
+        In the order: dense methods, pipeline, sparse methods, StereoBM, SGBM-3WAY; no
+        StereoBM on a scene it cannot run on (:func:`~stereovision.baselines.bm_reference_refusal`).
 
     Raises
     ------
@@ -207,7 +208,10 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     bm_md = baselines.bm_reference_range(md, np.asarray(left).shape[1])
     bm = lambda: baselines.opencv_bm(left, right, bm_md)  # noqa: E731
     sgbm = lambda: baselines.opencv_sgbm(left, right, md)  # noqa: E731
-    cases += [("StereoBM", "opencv", keep("StereoBM", bm))]
+    # none on a scene no higher than its block (or under 30 px wide): its refusal failed the
+    # whole scene; cmd_bench says why the case is missing
+    if baselines.bm_reference_refusal(md, np.asarray(left).shape) is None:
+        cases += [("StereoBM", "opencv", keep("StereoBM", bm))]
     cases += [(REFERENCE, "opencv", keep(REFERENCE, sgbm))]
     for _, _, fn in cases:  # warm-up: first-call allocations, thread pools, caches
         fn()
@@ -325,6 +329,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """
     from tqdm import tqdm
 
+    from stereovision import baselines
     from stereovision.cli import MAX_RUNS
     from stereovision.io import load_scene, scene_too_narrow
 
@@ -364,6 +369,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
                 tqdm.write(f"failed {said}", file=sys.stderr)
                 continue
             all_cases.extend(cases)
+            # bench_scene left StereoBM out (too low for its block): say why
+            no_bm = baselines.bm_reference_refusal(scene.max_disparity, scene.left.shape)
+            if no_bm is not None:
+                tqdm.write(f"{d}: no StereoBM figures: {no_bm}", file=sys.stderr)
             if args.json:
                 for c in cases:
                     print(json_line(c.as_dict()), flush=True)

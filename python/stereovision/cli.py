@@ -1598,6 +1598,10 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
     # StereoBM's block needs its range + 14 px of width: on a narrower scene the reference runs
     # on the widest range that fits (it refused, and the whole scene with it)
     bm_md = baselines.bm_reference_range(md, np.asarray(scene.left).shape[1])
+    # a scene no higher than its block (or under 30 px wide) has none: ours and SGBM are
+    # scored, StereoBM left out (its refusal failed the whole scene); cmd_eval says why
+    shape = np.asarray(scene.left).shape
+    with_bm = with_opencv and baselines.bm_reference_refusal(md, shape) is None
     warm = runs == 1
     for _ in range(runs if warm else runs + 1):
         timed(
@@ -1611,8 +1615,9 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
                 return_channels=method == "fused",
             ),
         )
-        if with_opencv:
+        if with_bm:
             timed("bm", lambda: baselines.opencv_bm(scene.left, scene.right, bm_md))
+        if with_opencv:
             timed("sgbm", lambda: baselines.opencv_sgbm(scene.left, scene.right, md))
         warm = True
     res = outputs["ours"]
@@ -1622,12 +1627,12 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
     row["ours_ms"] = float(np.median(times["ours"]))
     row["runs"] = runs
     sgbm = None
-    if with_opencv:
-        bm = outputs["bm"]
-        sgbm = outputs["sgbm"]
+    if with_bm:
         row["bm_ms"] = float(np.median(times["bm"]))
+        row["bm"] = dense_metrics(outputs["bm"], scene.gt).as_dict()
+    if with_opencv:
+        sgbm = outputs["sgbm"]
         row["sgbm_ms"] = float(np.median(times["sgbm"]))
-        row["bm"] = dense_metrics(bm, scene.gt).as_dict()
         row["sgbm"] = dense_metrics(sgbm, scene.gt).as_dict()
         row["sgbm+fill"] = dense_metrics(baselines.row_fill(sgbm), scene.gt).as_dict()
     if calib is not None and res.depth is not None:
@@ -1699,9 +1704,11 @@ def _eval_time_line(row: dict[str, Any]) -> str:
     runs = row["runs"]
     how = "one run, no warm-up" if runs == 1 else f"median of {runs} runs after a warm-up"
     line = f"{row['scene']}: time, {how}: ours {row['ours_ms']:.1f} ms"
+    if "bm_ms" in row:  # none on a scene StereoBM cannot run on
+        line += f", StereoBM {row['bm_ms']:.1f} ms"
     if "sgbm_ms" in row:
         line += (
-            f", StereoBM {row['bm_ms']:.1f} ms, SGBM-3WAY {row['sgbm_ms']:.1f} ms"
+            f", SGBM-3WAY {row['sgbm_ms']:.1f} ms"
             f" (ours {row['ours_ms'] / row['sgbm_ms']:.1f} x SGBM-3WAY)"
         )
     return line
@@ -1711,6 +1718,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
     from tqdm import tqdm
 
+    from stereovision.baselines import bm_reference_refusal
     from stereovision.io import distinct_scenes, find_scenes, load_scene, scene_too_narrow
 
     dirs: list[Path] = []
@@ -1774,6 +1782,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
             tqdm.write(f"failed {said}", file=sys.stderr)
             continue
         rows.append(row)
+        if "sgbm" in row and "bm" not in row:  # StereoBM cannot run on it: say why it is blank
+            no_bm = bm_reference_refusal(scene.max_disparity, scene.left.shape)
+            tqdm.write(f"{d}: no StereoBM figures: {no_bm}", file=sys.stderr)
         if args.json:
             print(json_line({k: v for k, v in row.items() if not k.startswith("_")}))
             continue
