@@ -2374,6 +2374,44 @@ def test_each_floor_fit_reaches_on_ground(data_dir: Path) -> None:
     assert [p is not None for p in seen] == [g["found"] for g in rep.grounds]
 
 
+def _blank_frame(index: int) -> Any:
+    """A textureless pair 64x48: no pixel has a disparity, so no floor is found in it."""
+    from stereovision.capture import StereoFrame
+
+    img = np.full((48, 64, 3), 128, np.uint8)
+    now = time.monotonic()
+    return StereoFrame(img, img.copy(), now, now, index)
+
+
+def test_a_stream_without_a_floor_says_why(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--ground-every`` on pairs without a floor ended on "floor: 0 of 2 fits", not saying
+    why; the line now gives the last fit's reason (fit_ground_plane's). The no-floor records
+    keep their documented keys ({"pair": n, "found": False}); the report holds the reason."""
+    import stereovision.stream as stream
+
+    calib = Calibration.from_file(data_dir / SCENE / "calib.txt").scaled_to((64, 48))
+    why = "ground plane: none found (0 pixels have a disparity; a fit needs 500)"
+    calib.save(tmp_path / "rig.yaml")
+    monkeypatch.setattr(
+        stream,
+        "open_source",
+        lambda args, fps=None: _SkippingRig([_blank_frame(i) for i in range(3)]),
+    )
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check"]
+    argv += ["--calib", str(tmp_path / "rig.yaml"), "--max-disparity", "8"]
+    assert main([*argv, "--ground-every", "2"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"floor: 0 of 2 fits; last (pair 2): {why}"
+    rig: Any = _FakeRig([_blank_frame(i) for i in range(3)])
+    rep = run_stream(rig, calib, max_disparity=8, pipelined=False, check=False, ground_every=2)
+    assert rep.grounds == [{"pair": 0, "found": False}, {"pair": 2, "found": False}]
+    assert rep.ground_reason == why and "ground_reason" not in rep.as_dict()
+
+
 @PIPELINED
 def test_the_stream_command_passes_its_options_on(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch

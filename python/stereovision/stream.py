@@ -193,6 +193,11 @@ class StreamReport:
     grounds : list of dict
         With ``ground_every``: every floor fit (:meth:`~stereovision.ground.GroundPlane.as_dict`
         and the ``pair``), or ``{"pair": n, "found": False}`` when no floor was in view.
+    ground_reason : str or None
+        With ``ground_every``: why the last fit that found no floor found none (for example
+        ``ground plane: none found (0 pixels have a disparity; a fit needs 500)``); None when
+        every fit found one. Said on the CLI's ``floor:`` line when no fit found a floor; not
+        in :meth:`as_dict`.
     noise_sigma : float
         Noise of the first left frame as grabbed (before rectification), in grey levels
         (:func:`~stereovision.temporal.noise_sigma`; NaN when no pair came).
@@ -222,6 +227,7 @@ class StreamReport:
     rectification: dict[str, Any] | None = None
     checks: list[dict[str, Any]] = field(default_factory=list, repr=False)
     grounds: list[dict[str, Any]] = field(default_factory=list, repr=False)
+    ground_reason: str | None = field(default=None, repr=False)
     temporal: dict[str, float] | None = None
     noise_sigma: float = math.nan
     error: str | None = None
@@ -232,9 +238,9 @@ class StreamReport:
         Returns
         -------
         dict
-            The report's fields by name (times rounded: ``seconds``, ``fps``, ``stage_ms``,
-            ``latency_ms``, ``wait_ms``, ``skew_ms``, ``density``, ``noise_sigma``), with
-            ``"summary": True``.
+            The report's fields by name but ``reports`` and ``ground_reason`` (times rounded:
+            ``seconds``, ``fps``, ``stage_ms``, ``latency_ms``, ``wait_ms``, ``skew_ms``,
+            ``density``, ``noise_sigma``), with ``"summary": True``.
         """
         return {
             "summary": True,
@@ -988,6 +994,7 @@ def run_stream(
     checks: list[dict[str, Any]] = []
     grounds: list[dict[str, Any]] = []
     first_plane: list[Any] = []  # the first floor found, for the mount check
+    no_floor: str | None = None  # why the last fit without a floor found none
     window: list[_Done] = []
     reports: list[dict[str, Any]] = []
     md = max_disparity
@@ -1023,7 +1030,9 @@ def run_stream(
             res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, cloud=False, **kw)
             if ground_every is not None and tally.n % ground_every == 0:
                 assert rect_calib is not None
-                plane = _note_ground(tally.n, res.disparity, rect_calib, grounds, first_plane)
+                plane, why = _note_ground(tally.n, res.disparity, rect_calib, grounds, first_plane)
+                if plane is None:
+                    no_floor = why
                 if on_ground is not None:
                     on_ground(plane)
             t_last = time.perf_counter()
@@ -1113,6 +1122,7 @@ def run_stream(
         rectification=checks[0] if checks else None,
         checks=checks,
         grounds=grounds,
+        ground_reason=no_floor,
         noise_sigma=noise,
         error=error,
         temporal=None
@@ -1157,16 +1167,18 @@ def _note_ground(
     calib: Calibration,
     grounds: list[dict[str, Any]],
     first_plane: list[Any],
-) -> Any:
+) -> tuple[Any, str]:
     """Fit the floor of a pair; warn (once) when the mount has moved from the first fit: the
     fits differ and the first fit's plane no longer holds. ``first_plane`` keeps that plane
-    (empty until one is found). Returns the plane (None when none was found)."""
-    from stereovision.ground import fit_ground_plane
+    (empty until one is found). Returns the plane (None when none was found) and, without
+    one, the reason :func:`~stereovision.ground.fit_ground_plane` found none ("" with one)."""
+    from stereovision.ground import _fit_ground
 
-    plane = fit_ground_plane(disparity, calib)
+    plane, why = _fit_ground(disparity, calib)
     if plane is None:
+        # the record keeps its documented keys: the reason goes to the summary line
         grounds.append({"pair": pair, "found": False})
-        return None
+        return None, why
     entry = {"pair": pair, "found": True, **plane.as_dict(), "moved": False}
     first = next((g for g in grounds if g["found"]), None)
     if first is not None and first_plane:
@@ -1188,7 +1200,7 @@ def _note_ground(
     elif first is None:
         first_plane.append(plane)
     grounds.append(entry)
-    return plane
+    return plane, ""
 
 
 # ---------------------------------------------------------------------------------------- CLI
@@ -1528,10 +1540,13 @@ def cmd_stream(args: argparse.Namespace) -> int:
         found = [g for g in report.grounds if g["found"]]
         if report.grounds:
             last = found[-1] if found else None
+            # no floor in any fit: "0 of N fits" alone did not say why (no disparity, no
+            # near-level plane, pixels along a line)
+            why = f"; last (pair {report.grounds[-1]['pair']}): {report.ground_reason}"
             print(
                 f"floor: {len(found)} of {len(report.grounds)} fits"
                 + (
-                    ""
+                    (why if report.ground_reason else "")
                     if last is None
                     else f"; last (pair {last['pair']}): camera {last['height_m']:.3f} m above it,"
                     f" pitch {last['pitch_deg']:+.2f} deg, roll {last['roll_deg']:+.2f} deg"
