@@ -568,3 +568,24 @@ def test_references_refuse_a_range_that_is_no_number_naming_it(bad: object) -> N
     ):
         round_up16(10**400)
     assert round_up16(np.int64(17)) == round_up16(np.float32(17.0)) == 32
+
+
+@pytest.mark.parametrize(
+    ("fn", "width", "need"),
+    [
+        (opencv_bm, 30, 46),  # its 15 px block: 16 + 15 - 1 = 30 px hold a 16 px range
+        (lambda left, right, d: ros_stereo_image_proc(left, right, d, "bm"), 30, 46),
+        (lambda left, right, d: stereovision_1_0(left, right, d, "bm"), 36, 52),  # 21 px
+        (lambda left, right, d: ros_stereo_image_proc(left, right, d, "sgbm"), 24, 40),  # 15 // 2
+        (lambda left, right, d: stereovision_1_0(left, right, d, "sgbm"), 18, 34),  # 3 // 2
+    ],
+)
+def test_a_width_that_holds_only_the_16_px_range_names_it(fn, width: int, need: int) -> None:
+    """Mutation audit: the refusals name the widest range that fits from 16 px on (``widest >=
+    16``); at the width where that is exactly 16 a 32 px range is refused with 'give a
+    max_disparity of at most 16', and 16 is computed."""
+    img = (np.random.default_rng(0).random((30, width, 3)) * 255).astype(np.uint8)
+    with pytest.raises(ValueError, match=rf"at least {need} px wide, got {width}; give a "
+                       r"max_disparity of at most 16$"):  # fmt: skip
+        fn(img, img, 32)
+    assert fn(img, img, 16).shape == (30, width)
