@@ -1805,3 +1805,20 @@ def test_mutation_audit_5_scan_dict_scalars_are_mapped_not_rounded() -> None:
     d = json.loads(json.dumps(scan.as_dict()))
     assert d["range_min"] == 0.25 and d["angle_increment"] == 0.123456789
     assert d["ranges"] == [1.2346, 2.0]
+
+
+def test_mutation_audit_grid_sides_past_a_float_and_at_4096_cells() -> None:
+    """Mutation audit of the cell count: an extent past a float of cells sideways (lateral
+    -1e308 to 1e308 m) is refused by name as forward's is (it was OverflowError "cannot convert
+    float infinity to integer"); 4096 cells a side is the largest grid taken (each way), 4097
+    is refused."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    box = _camera_points([(1.0, 0.0, 0.5)] * 3)
+    with pytest.raises(ValueError, match=r"^resolution: 0\.1 m cells over 20 x inf m are over "):
+        occupancy_grid(box, plane, resolution=0.1, forward=(0, 20), lateral=(-1e308, 1e308))
+    grid = occupancy_grid(box, plane, resolution=0.1, forward=(0, 409.6), lateral=(-409.6, 0))
+    assert grid.data.shape == (4096, 4096)
+    with pytest.raises(ValueError, match=r"^resolution: a 4097 x 1 grid is over 4096 cells"):
+        occupancy_grid(box, plane, resolution=0.1, forward=(0, 409.7), lateral=(-0.1, 0))
