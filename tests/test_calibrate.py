@@ -2486,3 +2486,18 @@ def test_a_left_camera_mounted_upside_down_is_named(cached_corners: None) -> Non
         r"degrees \(or the camera\) and calibrate again",
         said,
     ), said
+
+
+def test_mutation_audit_tilt_spread_sign_and_a_spread_past_the_warning() -> None:
+    """Mutation audit of 56188f0: a plane's normal has no sign, so boards whose normals point
+    170 degrees apart lie 10 degrees apart (a turn about the board's own normal, the existing
+    case, flips no normal); a spread of 20 degrees (past TILT_SPREAD_WARN_DEG) is calibrated
+    without the tilt warning."""
+    flip = calmod._tilt_spread([np.zeros(3), np.radians([170.0, 0.0, 0.0])])
+    assert flip == pytest.approx(10.0)
+    left, right = _pairs_at_tilts([(10.0, 0.0), (-10.0, 0.0), (0.0, 10.0), (0.0, -10.0), (0, 0)])
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*degrees apart")
+        cal, rep = calibrate(left, right, pattern=SYN_PATTERN, square_size=SYN_SQUARE)
+    assert not any("degrees apart" in w for w in rep.warnings)
+    assert cal.K1[0, 0] == pytest.approx(SYN_K1[0, 0], rel=0.02)
