@@ -954,3 +954,24 @@ def test_a_clipped_colour_channel_is_no_part_of_the_lights_fit(
     diff = sv._core.temporal_grey_difference(frame, mean)
     # within 3e-3: noisy() truncates, both frame and mean half a level low
     assert _brightness_change(diff, mean, tf.sigma, frame) == pytest.approx(fit, abs=3e-3)
+
+
+def test_a_large_k_restarts_no_pixel_even_at_the_largest_grey_difference(data_dir: Path) -> None:
+    """Mutation audit of the k cap (_KS_MAX): it must lie past any grey difference, so that a
+    large k restarts no pixel, as documented. A 12 x 12 px patch black in one pair and white in
+    the next (a difference of 255) is averaged to mid-grey by k = 1e38 (capped) and 1e4 alike;
+    a cap at 100 grey levels restarted it (255 out)."""
+    sc = load_scene(data_dir / VENUS)
+    first = [sc.left.copy(), sc.right.copy()]
+    second = [sc.left.copy(), sc.right.copy()]
+    for img in first:
+        img[100:112, 200:212] = 0
+    for img in second:
+        img[100:112, 200:212] = 255
+    for k in (1e38, 1e4):
+        filt = TemporalFilter(k=k)
+        filt(*first)
+        out = filt(*second)
+        assert filt.restarts == 0
+        for img in out:
+            assert set(np.unique(img[100:112, 200:212])) <= {127, 128}, k
