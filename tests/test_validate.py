@@ -869,3 +869,15 @@ def test_every_count_refuses_what_min_agree_refuses(value: object) -> None:
         gabor.gabor_disparity(left, left, max_disparity=8, iters_per_level=value)
     with pytest.raises(ValueError, match=r"^p1"):
         sgm.sgm_disparity(left, left, max_disparity=8, p1=value)
+
+
+def test_mutation_audit_positive_whole_refuses_zero_in_any_type() -> None:
+    """Mutation audit of b21f9f0: a count of 0 is refused as a float (0.0, np.float32(0.0),
+    -0.0) as it is as an integer, not taken as 0 pairs; whole floats are their integers."""
+    from stereovision._validate import positive_whole
+
+    for bad in (0, 0.0, -0.0, np.float32(0.0), -2.0, np.int64(0)):
+        with pytest.raises(ValueError, match=r"^every: expected a positive integer, got "):
+            positive_whole(bad, "every")
+    got = [positive_whole(v, "every") for v in (1.0, np.float32(2.0), np.int64(3), 4)]
+    assert got == [1, 2, 3, 4] and all(type(v) is int for v in got)
