@@ -3089,3 +3089,16 @@ def test_mutation_audit_5_a_device_ended_of_a_camera_and_a_file(
 
     camera = SimpleNamespace(sources=sources)
     assert _device_ended(camera, SourceError("ended", side=side, frames=3)) is lost
+
+
+def test_mutation_audit_the_view_rounds_16_bits_as_the_pipeline_does() -> None:
+    """Mutation audit of 06b636b: the view shows a 16-bit left image as as_bgr_uint8 makes it
+    8-bit (divided by 257, rounded to nearest) for every one of the 65536 values, not truncated
+    (129 is 1, not 0; 65407 is 255, 65406 254)."""
+    from stereovision._validate import as_bgr_uint8
+    from stereovision.stream import _view_bgr
+
+    grey = np.arange(65536, dtype=np.uint16).reshape(256, 256)
+    shown = _view_bgr(grey)
+    np.testing.assert_array_equal(shown, as_bgr_uint8(grey))
+    assert shown[0, 129, 0] == 1 and tuple(shown.reshape(-1, 3)[65406:65408, 0]) == (254, 255)
