@@ -4388,3 +4388,19 @@ def test_capture_of_a_camera_that_stops_delivering_fails_and_keeps_its_pairs(
     assert sorted(p.name for p in out.iterdir()) == [
         f"{side}_{i:04d}.png" for side in ("left", "right") for i in (1, 2, 3)
     ]
+
+
+def test_mutation_audit_a_one_channel_frame_is_delivered_as_bgr() -> None:
+    """Mutation audit of b0727eb: a camera handing (h, w, 1) frames (a grey driver's) is made
+    BGR as a 2-D grey frame is, its grey in each channel; without that branch the frame stayed
+    one channel beside a BGR right frame."""
+
+    class _OneChannelCap(_FakeCap):
+        def retrieve(self) -> tuple[bool, np.ndarray]:
+            return True, cv2.cvtColor(_numbered(0), cv2.COLOR_BGR2GRAY)[:, :, None]
+
+    with StereoCamera(_OneChannelCap("L", []), _FakeCap("R", [])) as cam:
+        fr = cam.read()
+    grey = cv2.cvtColor(_numbered(0), cv2.COLOR_BGR2GRAY)
+    assert fr.left.shape == fr.right.shape == (*grey.shape, 3)
+    assert all((fr.left[:, :, c] == grey).all() for c in range(3))
