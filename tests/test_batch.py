@@ -1851,6 +1851,21 @@ def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
     np.testing.assert_array_equal(read_ply(cloud)[0], points)
     s = _summary(out)["pairs"]
     assert (s["seq/0000"]["this_run"], s["seq/0001"]["this_run"]) == ("processed", "skipped")
+    # mutation audit: of several such pairs the line counts them all and names the first
+    # one's missing outputs, each of them, in its record's order
+    gone = [f for f in s["seq/0000"]["outputs"] if f != "disparity.pfm"][:2]
+    assert len(gone) == 2, s["seq/0000"]["outputs"]
+    for f in gone:
+        (out / "seq/0000" / f).unlink()
+    (out / "seq/0001/cloud.ply").unlink()
+    capsys.readouterr()
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("2 processed, 0 skipped (done before), 0 failed")
+    assert _not_progress(captured.err) == [
+        f"2 pair(s) done before miss some of their outputs (e.g. seq/0000: {', '.join(gone)}); "
+        "they are done again"
+    ]
 
 
 def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again(
