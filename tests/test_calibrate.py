@@ -2492,7 +2492,17 @@ def test_mutation_audit_tilt_spread_sign_and_a_spread_past_the_warning() -> None
     """Mutation audit of 56188f0: a plane's normal has no sign, so boards whose normals point
     170 degrees apart lie 10 degrees apart (a turn about the board's own normal, the existing
     case, flips no normal); a spread of 20 degrees (past TILT_SPREAD_WARN_DEG) is calibrated
-    without the tilt warning."""
+    without the tilt warning; the refusal's whole line names the 5 degrees needed."""
+    left, right = _pairs_at_tilts([(8.0, -12.0)] * 4)
+    with pytest.raises(ValueError) as err:
+        calibrate(left, right, pattern=SYN_PATTERN, square_size=SYN_SQUARE)
+    assert re.fullmatch(
+        r"the boards' planes are at most 0\.\d degrees apart over the 4 pairs: held at nearly "
+        r"one tilt \(only moved, or brought nearer\), the board does not fix the focal length "
+        r"\(nor the baseline\); tilt it by 20-45 degrees, left and right, up and down, between "
+        r"views \(at least 5 degrees apart are needed\)",
+        str(err.value),
+    ), str(err.value)
     flip = calmod._tilt_spread([np.zeros(3), np.radians([170.0, 0.0, 0.0])])
     assert flip == pytest.approx(10.0)
     left, right = _pairs_at_tilts([(10.0, 0.0), (-10.0, 0.0), (0.0, 10.0), (0.0, -10.0), (0, 0)])
