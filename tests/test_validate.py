@@ -713,12 +713,13 @@ def test_a_timedelta_scalar_is_no_count(value: np.timedelta64) -> None:
 def _entry_points() -> dict[str, Any]:
     """Entry points whose number or count checks predate the shared rule (NOT_NUMBERS), each
     called with one value in the checked place."""
-    from stereovision import bench, evaluate, refine
-    from stereovision.capture import save_pair
+    from stereovision import bench, evaluate, export, refine
+    from stereovision.capture import check_read_timeout, save_pair
     from stereovision.io import scene_max_disparity
     from stereovision.matching import gabor, hopfield, mcgm, sgm
     from stereovision.matching.fusion import _fuse_options
     from stereovision.rosbag import _stamp
+    from stereovision.stream import run_stream
     from stereovision.temporal import TemporalFilter
     from stereovision.uncalibrated import rectify_uncalibrated
 
@@ -761,6 +762,9 @@ def _entry_points() -> dict[str, Any]:
         "scene_max_disparity width": lambda v: scene_max_disparity(None, v),
         "save_pair index": lambda v: save_pair(tmp, v, left, left),
         "rosbag stamp_ns": lambda v: _stamp(v),
+        "voxel_downsample voxel": lambda v: export.voxel_downsample(z[:, :3], voxel=v),
+        "run_stream report_period": lambda v: run_stream(None, report_period=v),  # type: ignore[arg-type]
+        "capture read_timeout": lambda v: check_read_timeout(v),
     }
 
 
@@ -772,6 +776,74 @@ def test_no_entry_point_takes_a_bool_or_a_timedelta_as_a_number(entry: str, valu
     name = entry.split()[1]
     with pytest.raises(ValueError, match=rf"^{name}\b.*got {re.escape(repr(value))}"):
         _entry_points()[entry](value)
+
+
+def _timedelta_places(tmp_path: Path) -> dict[str, tuple[Any, type[Exception], str]]:
+    """Checks whose message shows more than the value (a pair of numbers, a fixed phrase) or
+    whose refusal of a non-number is a TypeError, each called with one value."""
+    from stereovision import depth_map
+    from stereovision.baselines import round_up16
+    from stereovision.calibration import Calibration
+    from stereovision.capture import parse_size
+    from stereovision.export import encode_depth_png
+    from stereovision.matches import Matches
+
+    img = np.zeros((20, 30), np.uint8)
+    q = tmp_path / "Q.dat"
+    q.write_text("1 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 10 0\n")
+    no = np.zeros(0, np.float32)
+    return {
+        "depth_map max_disparity": (
+            lambda v: depth_map(img, img, max_disparity=v),
+            TypeError,
+            "max_disparity: expected a number of pixels, got ",
+        ),
+        "depth_map min_disparity": (
+            lambda v: depth_map(img, img, max_disparity=8, min_disparity=v),
+            TypeError,
+            "min_disparity: expected a number of pixels, got ",
+        ),
+        "png16 scale": (
+            lambda v: encode_depth_png(np.ones((2, 2)), scale=v),
+            TypeError,
+            "scale: expected a number (units per metre), got timedelta64 ",
+        ),
+        "parse_size": (
+            lambda v: parse_size((v, 480), "image_size"),
+            ValueError,
+            "image_size: expected WIDTHxHEIGHT with positive integers, got (",
+        ),
+        "from_q image_size": (
+            lambda v: Calibration.from_q(q, (v, 480)),
+            ValueError,
+            "image_size for ",
+        ),
+        "Matches image_shape": (
+            lambda v: Matches(no, no, no, no, no, image_shape=(v, 40)),
+            ValueError,
+            "image_shape must be positive (H, W) integers, got (",
+        ),
+        "round_up16": (
+            lambda v: round_up16(v),
+            ValueError,
+            "disparity range must be a number of pixels, finite and >= 0, got ",
+        ),
+    }
+
+
+@pytest.mark.parametrize("value", [np.timedelta64(640), np.timedelta64(640, "ns")], ids=repr)
+@pytest.mark.parametrize("place", sorted(_timedelta_places(Path("/nonexistent-stereovision-test"))))
+def test_no_pair_of_numbers_or_range_takes_a_timedelta(
+    tmp_path: Path, place: str, value: np.timedelta64
+) -> None:
+    """640 ns was the width 640 (capture's image_size, from_q's, a Matches' image_shape), a
+    cube side or a scale of 640 (export), a range of 640 px (round_up16); depth_map's range
+    let it through its TypeError to a later ValueError in other words. Each is refused as a
+    bool is there, naming the value."""
+    call, kind, says = _timedelta_places(tmp_path)[place]
+    with pytest.raises(kind, match="^" + re.escape(says)) as info:
+        call(value)
+    assert repr(value) in str(info.value)
 
 
 @pytest.mark.parametrize(

@@ -90,12 +90,11 @@ def round_up16(n: float) -> int:
     >>> round_up16(15.4), round_up16(16), round_up16(16.5), round_up16(0)
     (16, 16, 32, 16)
     """
-    from stereovision._validate import number_shown
+    from stereovision._validate import number_shown, real_number
 
-    # None or [64] was float()'s TypeError naming nothing, "64" and True (1 px) were taken,
-    # 10**400 an OverflowError
-    real = isinstance(n, (int, float, np.integer, np.floating))
-    if not real or isinstance(n, (bool, np.bool_)):
+    # None or [64] was float()'s TypeError naming nothing, "64", True (1 px) and 3 ns were
+    # taken, 10**400 an OverflowError
+    if not real_number(n):
         raise ValueError(f"disparity range must be a number of pixels, finite and >= 0, got {n!r}")
     try:
         x = float(n)

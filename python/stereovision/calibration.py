@@ -1856,7 +1856,8 @@ class Calibration:
             size = tuple(image_size)
         except TypeError:  # None raised "'NoneType' object is not iterable", naming neither
             raise bad from None
-        if len(size) != 2 or any(isinstance(v, (bool, np.bool_)) for v in size):
+        # (np.timedelta64(640), 480) was 640x480 (float() reads a unitless timedelta)
+        if len(size) != 2 or any(isinstance(v, NOT_NUMBERS) for v in size):
             raise bad
         try:
             [float(v) for v in size]  # (640, None), ("a", 480): float()'s words, naming nothing

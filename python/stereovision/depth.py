@@ -1468,11 +1468,11 @@ def depth_map(
         raise TypeError(
             f"progress: expected a callable taking a stage name, or None, got {progress!r}"
         )
-    numbers = (int, float, np.integer, np.floating)
     for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if value is None and name == "max_disparity":
             continue  # estimated from the images below
-        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers):
+        # real_number: a timedelta (an np.integer) passed here, refused later in other words
+        if not real_number(value):
             raise TypeError(f"{name}: expected a number of pixels, got {value!r}")
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")

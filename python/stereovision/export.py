@@ -37,6 +37,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     NO_DEPTH,
+    NOT_NUMBERS,
     check_index_range,
     not_a_result,
     number_shown,
@@ -709,7 +710,8 @@ def voxel_downsample(
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
     # Not a real number (a string, None): numpy's isfinite failed naming no argument.
-    if isinstance(voxel, (bool, np.bool_)) or not isinstance(voxel, numbers.Real):
+    # np.timedelta64 is a numbers.Real too: 3 ns was a cube side of 3
+    if isinstance(voxel, NOT_NUMBERS) or not isinstance(voxel, numbers.Real):
         raise ValueError(f"voxel: expected a positive cube side, got {voxel!r}")
     try:  # as a float: a Fraction made numpy's isfinite fail
         side = float(voxel)
@@ -864,8 +866,9 @@ def _check_scale(scale: float) -> float:
     named), as a float: another real number (a ``fractions.Fraction``) made an object array in
     numpy ("loop of ufunc does not support argument 0 of type float"), and an int too large
     for a float failed in ``math.isfinite`` naming no argument."""
-    if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, numbers.Real):
-        # a string (scale="1000") failed inside numpy with "ufunc 'isfinite' not supported"
+    if isinstance(scale, NOT_NUMBERS) or not isinstance(scale, numbers.Real):
+        # 3 ns was 3 units per metre; a string (scale="1000") failed inside numpy with
+        # "ufunc 'isfinite' not supported"
         raise TypeError(
             f"scale: expected a number (units per metre), got {type(scale).__name__} {scale!r}"
         )

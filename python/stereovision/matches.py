@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import NOT_NUMBERS
 from stereovision.calibration import Calibration
 from stereovision.io import atomic_write
 
@@ -39,8 +40,8 @@ def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
 
 def _whole_positive(v: object) -> bool:
     """Whether ``v`` is a positive whole number: an integer (not a bool) or a finite whole
-    float (``64.0``; not ``64.5``)."""
-    if isinstance(v, (bool, np.bool_)):
+    float (``64.0``; not ``64.5``); never one of NOT_NUMBERS (3 ns was 3 pixels)."""
+    if isinstance(v, NOT_NUMBERS):
         return False
     if isinstance(v, (int, np.integer)):
         return bool(v > 0)
