@@ -714,12 +714,13 @@ def _entry_points() -> dict[str, Any]:
     """Entry points whose number or count checks predate the shared rule (NOT_NUMBERS), each
     called with one value in the checked place."""
     from stereovision import bench, evaluate, export, refine
+    from stereovision.calibrate import _check_max_pairs
     from stereovision.capture import check_read_timeout, save_pair
     from stereovision.io import scene_max_disparity
     from stereovision.matching import gabor, hopfield, mcgm, sgm
     from stereovision.matching.fusion import _fuse_options
     from stereovision.rosbag import _stamp
-    from stereovision.stream import run_stream
+    from stereovision.stream import FrameServer, run_stream
     from stereovision.temporal import TemporalFilter
     from stereovision.uncalibrated import rectify_uncalibrated
 
@@ -763,6 +764,8 @@ def _entry_points() -> dict[str, Any]:
         "save_pair index": lambda v: save_pair(tmp, v, left, left),
         "rosbag stamp_ns": lambda v: _stamp(v),
         "voxel_downsample voxel": lambda v: export.voxel_downsample(z[:, :3], voxel=v),
+        "calibrate_from_bag max_pairs": lambda v: _check_max_pairs(v),
+        "FrameServer port": lambda v: FrameServer(port=v),
         "run_stream report_period": lambda v: run_stream(None, report_period=v),  # type: ignore[arg-type]
         "capture read_timeout": lambda v: check_read_timeout(v),
     }
@@ -844,6 +847,23 @@ def test_no_pair_of_numbers_or_range_takes_a_timedelta(
     with pytest.raises(kind, match="^" + re.escape(says)) as info:
         call(value)
     assert repr(value) in str(info.value)
+
+
+@pytest.mark.parametrize("value", [40, 40.0, np.int64(40), np.array([40]), Fraction(40)], ids=repr)
+def test_max_pairs_and_port_take_the_whole_numbers_every_count_takes(value: object) -> None:
+    """calibrate_from_video/bag's max_pairs and FrameServer's port were checked by hand as a
+    Python int: np.int64(40) read from an array (or 40.0 from a config) was refused, which
+    every other count takes (whole_value). Both are that Python int now."""
+    from stereovision.calibrate import _check_max_pairs
+    from stereovision.stream import FrameServer
+
+    got = _check_max_pairs(value)
+    assert got == 40 and type(got) is int
+    server = FrameServer(port=0 * value)  # type: ignore[operator]
+    try:
+        assert server.port > 0
+    finally:
+        server.close()
 
 
 @pytest.mark.parametrize(

@@ -59,7 +59,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS
+from stereovision._validate import NOT_NUMBERS, whole_value
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
@@ -1992,7 +1992,7 @@ def calibrate_from_video(
     """
     from stereovision.capture import StereoCamera, check_read_timeout
 
-    _check_max_pairs(max_pairs)
+    max_pairs = _check_max_pairs(max_pairs)
     check_read_timeout(read_timeout)
 
     # as given: StereoCamera takes paths and indexes (a str() made np.int64(1) the file "1")
@@ -2052,7 +2052,7 @@ def calibrate_from_bag(
     """
     from stereovision.rosbag import BagCamera
 
-    _check_max_pairs(max_pairs)
+    max_pairs = _check_max_pairs(max_pairs)
     cam = BagCamera(path, left_topic=left_topic, right_topic=right_topic, max_skew_ms=max_skew_ms)
     return _calibrate_from_camera(
         cam,
@@ -2066,11 +2066,15 @@ def calibrate_from_bag(
     )
 
 
-def _check_max_pairs(max_pairs: object) -> None:
-    if isinstance(max_pairs, bool) or not isinstance(max_pairs, int) or max_pairs < MIN_PAIRS:
+def _check_max_pairs(max_pairs: object) -> int:
+    """``max_pairs`` as an int of at least :data:`MIN_PAIRS`, by a count's rule
+    (:func:`~stereovision._validate.whole_value`: np.int64(40) read from an array was refused)."""
+    whole = whole_value(max_pairs)
+    if whole is None or whole < MIN_PAIRS:
         raise ValueError(
             f"max_pairs: expected an integer of at least {MIN_PAIRS}, got {max_pairs!r}"
         )
+    return whole
 
 
 def _calibrate_from_camera(

@@ -46,6 +46,7 @@ from stereovision._validate import (
     real_number,
     too_large_for_float,
     user_stacklevel,
+    whole_value,
 )
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
@@ -312,8 +313,11 @@ class FrameServer:
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
-        if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        # a count's rule (whole_value): np.int64(8080) read from an array was refused
+        whole = whole_value(port)
+        if whole is None or not 0 <= whole <= 65535:
             raise ValueError(f"port: expected 0 to 65535 (0 = any free port), got {port!r}")
+        port = whole
         self._cond = threading.Condition()
         self._latest: tuple[np.ndarray, np.ndarray, float] | None = None
         self._seq = 0
