@@ -1298,7 +1298,7 @@ def test_fused_dense_clears_census_only_marks_the_edge_step_drops() -> None:
         "second_tol",
         "occlusion_tau",
         "speckle_area",
-        "speckle_diff",
+        "speckle_diff",  # the speckle kernel's f32, cast in Rust: no warning before either
         "edge_radius",
         "edge_ratio",
         "edge_jump",
@@ -1579,7 +1579,17 @@ def test_an_edge_option_past_float32_is_named(name: str) -> None:
 
 
 @pytest.mark.parametrize(
-    "key", ["tau_dx", "tau_dy", "radius", "tau", "fill_radius", "second_tol", "occlusion_tau"]
+    "key",
+    [
+        "tau_dx",
+        "tau_dy",
+        "radius",
+        "tau",
+        "fill_radius",
+        "second_tol",
+        "occlusion_tau",
+        "speckle_diff",  # the speckle kernel's f32, cast in Rust: no warning before either
+    ],
 )
 def test_a_tolerance_past_float32_is_its_infinity_without_numpy_warnings(
     data_dir: Path, key: str
