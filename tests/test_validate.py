@@ -923,6 +923,25 @@ def test_whole_value_gives_an_enum_member_as_its_int() -> None:
     assert got == 3 and type(got) is int
 
 
+def test_whole_value_refuses_a_decimal_whose_int_has_no_end() -> None:
+    """b87b5fa read a whole Decimal by int(): 9 characters, Decimal('1e1000000'), took 53 s
+    (its int built digit by digit) and '1e999999999999999999' never ended, where its float
+    had been inf, no count. Past 4300 digits (Python's own limit of an int read from a str) it
+    is no count, at once; up to there it is read exactly, and a zero of any exponent is 0."""
+    import time
+
+    from stereovision._validate import positive_whole, whole_value
+
+    start = time.perf_counter()
+    assert whole_value(Decimal("1e100000")) is None  # before: an int of 100001 digits, 0.7 s
+    assert whole_value(Decimal("-1E+999999999999999999")) is None
+    with pytest.raises(ValueError, match=r"^frames: expected a positive number of pairs, got"):
+        positive_whole(Decimal("1e1000000"), "frames", "a positive number of pairs")
+    assert time.perf_counter() - start < 1.0
+    assert whole_value(Decimal("1e4299")) == 10**4299  # 4300 digits: read exactly
+    assert whole_value(Decimal("0E+999999999999999999")) == 0
+
+
 @pytest.mark.parametrize(
     "value", [3.0, np.float32(3), np.int64(3), Fraction(3), Decimal("3"), np.array([3])], ids=repr
 )

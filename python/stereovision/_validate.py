@@ -742,6 +742,11 @@ def _plain_option(value: Any) -> Any:
     return value
 
 
+#: The most digits :func:`whole_value` reads a Decimal's int with: Python's own limit of an int
+#: read from a str (``sys.int_info.default_max_str_digits``), against the same cost.
+_WHOLE_DIGITS = 4300
+
+
 def whole_value(value: object) -> int | None:
     """``value`` as a Python int when it is a whole number, else None: one rule for every
     count (``min_agree``'s, :func:`int_in_range`'s, the matchers' counts).
@@ -749,7 +754,8 @@ def whole_value(value: object) -> int | None:
     A whole number is an int or a NumPy integer, or a finite integral float, Fraction or
     Decimal (``3.0``, ``np.float32(2)``, ``Fraction(2)``: a value read from a config or a
     computation), or a size-1 array of one (a value read from an array) -- never one of
-    :data:`NOT_NUMBERS`.
+    :data:`NOT_NUMBERS`, nor a Decimal of over 4300 digits (``Decimal('1e1000000')``, whose int
+    takes a minute to build).
 
     Examples
     --------
@@ -769,6 +775,10 @@ def whole_value(value: object) -> int | None:
         return int(value.numerator) if value.denominator == 1 else None
     if isinstance(value, decimal.Decimal):
         whole = value.is_finite() and value == value.to_integral_value()  # sNaN: not compared
+        # its int is built digit by digit: Decimal('1e1000000') took 53 s, '1e999999999999999999'
+        # never ends; past the digits Python itself turns a str into an int, no count
+        if whole and value and value.adjusted() >= _WHOLE_DIGITS:
+            return None
         return int(value) if whole else None
     if isinstance(value, (float, np.floating)):
         return int(value) if np.isfinite(value) and value == np.floor(value) else None
