@@ -1208,6 +1208,26 @@ def test_auto_is_read_in_any_case_as_the_dictionary_names_are(tmp_path: Path) ->
     assert "DICT_5X5_50" in run.stdout and out.is_file()
 
 
+def test_the_dpi_named_for_markers_of_a_tiny_square_is_found_at_once() -> None:
+    """ba8ed54 found the dpi to name a dpi at a time from 1.5 px below it, a step being
+    square / 25.4 mm px: 1e-6 mm squares took 9 s and 1e-9 mm ones (``board --square 1e-9
+    --unit mm``) hung past a minute. It is bisected now: the same least dpi, at once."""
+    import time
+
+    from stereovision.charuco import _check_marker_cells
+
+    for square_m, want in ((1e-9, 901_700_000), (1e-12, 901_700_000_000)):
+        board = CharucoBoard((5, 7), 1.0, 0.5, "DICT_4X4_50")
+        start = time.perf_counter()
+        with pytest.raises(ValueError, match=rf"use {want} dpi or more"):
+            board_png(board, square_m, 20 * 0.0254 / square_m)  # 20 px squares, 1.7 px a cell
+        assert time.perf_counter() - start < 1.0
+        with pytest.raises(ValueError, match=rf"use {want} dpi or more"):
+            board_png(board, square_m, want - 1)
+        pix = round(square_m / 0.0254 * want)  # 36 px squares, 3.0 px a cell: taken
+        assert pix == 36 and _check_marker_cells(board, pix, square_m, want) is None
+
+
 def test_the_dpi_named_for_too_small_markers_is_the_least_that_is_taken() -> None:
     """A board refused for markers under 3 px a cell names "use N dpi or more": N was rounded
     up from the whole pixels a square needs, where the square is itself a rounded count, so

@@ -725,9 +725,20 @@ def _check_marker_cells(board: CharucoBoard, pix: int, square_metres: float, dpi
     # here: rounded up from need_px it was often one more (8 mm squares, 4 mm 4X4 markers:
     # "use 115 dpi", and 114 gave the same 36 px squares). From a px lower: need_px's ceil can
     # be one over (3 x 7 / 0.7 is 30.000000000000004, and 30 px squares are taken)
-    need_dpi = max(1, math.floor((need_px - 1.5) * 0.0254 / square_metres))
-    while round(square_metres / 0.0254 * need_dpi) * ratio / cells < MIN_PX_PER_CELL:
-        need_dpi += 1
+    lo = max(1, math.floor((need_px - 1.5) * 0.0254 / square_metres))
+
+    def taken(d: int) -> bool:
+        return round(square_metres / 0.0254 * d) * ratio / cells >= MIN_PX_PER_CELL
+
+    # bisected, not a dpi a step: a step is square / 25.4 mm px, so the 1.5 px from lo were
+    # 38 million steps of 1e-6 mm squares (9 s) and 38 billion of 1e-9 mm (board hung)
+    hi = lo
+    while not taken(hi):  # doubled until taken: a handful of steps at any square
+        lo, hi = hi + 1, 2 * hi
+    while lo < hi:  # the least taken in [lo, hi]: the square grows with the dpi
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if taken(mid) else (mid + 1, hi)
+    need_dpi = lo
     raise ValueError(
         f"marker_size: a {square_metres * ratio * 1000:g} mm marker at {dpi:g} dpi is "
         f"{pix * ratio:.1f} px, {per_cell:.1f} px a cell of {board.dictionary}'s {cells} (its "
