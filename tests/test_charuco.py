@@ -1210,8 +1210,9 @@ def test_auto_is_read_in_any_case_as_the_dictionary_names_are(tmp_path: Path) ->
 
 def test_the_dpi_named_for_markers_of_a_tiny_square_is_found_at_once() -> None:
     """ba8ed54 found the dpi to name a dpi at a time from 1.5 px below it, a step being
-    square / 25.4 mm px: 1e-6 mm squares took 9 s and 1e-9 mm ones (``board --square 1e-9
-    --unit mm``) hung past a minute. It is bisected now: the same least dpi, at once."""
+    square / 25.4 mm px: 1e-6 mm squares took 9 s, 1e-9 mm ones hung past a minute. It is
+    bisected now: the same least dpi, at once. (board_png now refuses past 1.09e8 dpi first,
+    what a PNG stores: the check itself is timed.)"""
     import time
 
     from stereovision.charuco import _check_marker_cells
@@ -1220,12 +1221,25 @@ def test_the_dpi_named_for_markers_of_a_tiny_square_is_found_at_once() -> None:
         board = CharucoBoard((5, 7), 1.0, 0.5, "DICT_4X4_50")
         start = time.perf_counter()
         with pytest.raises(ValueError, match=rf"use {want} dpi or more"):
-            board_png(board, square_m, 20 * 0.0254 / square_m)  # 20 px squares, 1.7 px a cell
+            _check_marker_cells(board, 20, square_m, 20 * 0.0254 / square_m)  # 1.7 px a cell
         assert time.perf_counter() - start < 1.0
+        for dpi, pix in ((want - 1, 35), (want, 36)):  # 35 px squares: 2.9 px a cell
+            assert round(square_m / 0.0254 * dpi) == pix
         with pytest.raises(ValueError, match=rf"use {want} dpi or more"):
-            board_png(board, square_m, want - 1)
-        pix = round(square_m / 0.0254 * want)  # 36 px squares, 3.0 px a cell: taken
-        assert pix == 36 and _check_marker_cells(board, pix, square_m, want) is None
+            _check_marker_cells(board, 35, square_m, want - 1)
+        assert _check_marker_cells(board, 36, square_m, want) is None  # 3.0 px a cell: taken
+
+
+def test_a_dpi_past_what_a_png_stores_is_refused_by_name() -> None:
+    """A board's resolution goes in the PNG as pixels per metre, an unsigned 32-bit count:
+    ``board --square 1e-6 --unit mm --dpi 5.08e8`` (2e10 px/m) was struct.pack's bare
+    "'I' format requires 0 <= number <= 4294967295", said as an internal error."""
+    with pytest.raises(ValueError, match=r"^a 1e-06 mm square at 5\.08e\+08 dpi is 20 px, "
+                       r"2e\+10 px per metre: past the 4294967295 a PNG's resolution holds "
+                       r"\(about 1\.09e\+08 dpi\); use a lower dpi$"):  # fmt: skip
+        board_png((9, 6), 1e-9, 5.08e8)
+    data, _ = board_png((9, 6), 1e-7, 1e8)  # 3.94e9 px per metre: stored
+    assert struct.unpack(">I", data[41:45])[0] == round(394 / 1e-7)
 
 
 def test_the_dpi_named_for_too_small_markers_is_the_least_that_is_taken() -> None:

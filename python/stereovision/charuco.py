@@ -650,7 +650,18 @@ def _board_scale(square_metres: float, dpi: float) -> tuple[int, int]:
             "and dpi giving 10 to 20000 px per square"
         )
     pix = round(p)
-    return pix, round(pix / square_metres)
+    ppm = round(pix / square_metres)
+    if ppm > _PNG_MAX_PPM:  # struct.pack's bare error, said as "internal error" by board
+        raise ValueError(
+            f"a {square_metres * 1000:g} mm square at {dpi:g} dpi is {pix} px, {ppm:.6g} px per "
+            f"metre: past the {_PNG_MAX_PPM} a PNG's resolution holds (about "
+            f"{_PNG_MAX_PPM * 0.0254:.3g} dpi); use a lower dpi"
+        )
+    return pix, ppm
+
+
+#: The most pixels per metre a PNG's ``pHYs`` chunk stores (an unsigned 32-bit count).
+_PNG_MAX_PPM = 2**32 - 1
 
 
 def _png_with_ppm(img: np.ndarray, ppm: int) -> bytes:
