@@ -942,6 +942,21 @@ def test_whole_value_refuses_a_decimal_whose_int_has_no_end() -> None:
     assert whole_value(Decimal("0E+999999999999999999")) == 0
 
 
+def test_a_count_refused_with_no_repr_is_named() -> None:
+    """whole_value reads Fraction(10**5000) as a count (b87b5fa); refused, the message's repr
+    of it was Python's "Exceeds the limit (4300 digits) for integer string conversion",
+    naming no parameter. It is named, the value said by its type."""
+    from stereovision._validate import int_in_range, positive_whole
+
+    want = r"min_agree: expected an integer from 1 to 8, got a Fraction of over 4300 digits$"
+    with pytest.raises(ValueError, match=want):
+        int_in_range(Fraction(10**5000), "min_agree", 1, 8)
+    with pytest.raises(ValueError, match=r"^frames: expected a positive integer, got a Fraction"):
+        positive_whole(Fraction(-(10**5000), 3), "frames")
+    with pytest.raises(ValueError, match=r"got an integer of 5001 digits$"):  # as before
+        int_in_range(10**5000, "min_agree", 1, 8)
+
+
 @pytest.mark.parametrize(
     "value", [3.0, np.float32(3), np.int64(3), Fraction(3), Decimal("3"), np.array([3])], ids=repr
 )

@@ -915,8 +915,15 @@ def float_sized(value: _T, name: str) -> _T:
 
 def _shown(value: object) -> str:
     """``repr(value)``, or for an int beyond a float its size (10**5000 has no repr), in
-    :func:`too_large_for_float`'s words (one wording for every message)."""
-    return too_large_for_float(value, why=False) or repr(value)
+    :func:`too_large_for_float`'s words (one wording for every message); another value with
+    such an int inside (``Fraction(10**5000)``, a count to :func:`whole_value`) by its type."""
+    big = too_large_for_float(value, why=False)
+    if big:
+        return big
+    try:
+        return repr(value)
+    except ValueError:  # Python's limit of an int's str: its message named no parameter
+        return f"a {type(value).__name__} of over 4300 digits"
 
 
 def too_large_for_float(value: object, *, why: bool = True) -> str | None:
