@@ -957,6 +957,21 @@ def test_a_count_refused_with_no_repr_is_named() -> None:
         int_in_range(10**5000, "min_agree", 1, 8)
 
 
+@pytest.mark.parametrize("value", [10**5000, Fraction(10**5000)], ids=["int", "Fraction"])
+def test_the_matchers_name_a_count_with_no_repr(value: object) -> None:
+    """sgm_disparity's and gabor_disparity's counts said the value refused by its repr: for
+    10**5000 (or its Fraction) Python's "Exceeds the limit (4300 digits) for integer string
+    conversion", naming no parameter."""
+    from stereovision.matching.gabor import gabor_disparity
+    from stereovision.matching.sgm import sgm_disparity
+
+    img = np.zeros((40, 60), np.float32)
+    with pytest.raises(ValueError, match=r"^p1: expected an integer in \[1, "):
+        sgm_disparity(img.astype(np.uint8), img.astype(np.uint8), max_disparity=16, p1=value)
+    with pytest.raises(ValueError, match=r"^n_levels must be a non-negative integer, got an? "):
+        gabor_disparity(img, img, max_disparity=16, n_levels=value)
+
+
 @pytest.mark.parametrize(
     "value", [3.0, np.float32(3), np.int64(3), Fraction(3), Decimal("3"), np.array([3])], ids=repr
 )

@@ -22,6 +22,7 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     NOT_NUMBERS,
+    _shown,
     check_index_range,
     check_unit_range,
     disparity_range,
@@ -204,7 +205,8 @@ def gabor_disparity(
         # Fraction(3) was refused here and taken there, 3 ns was the binding's TypeError
         whole = whole_value(v)
         if whole is None or not 0 <= whole < 2**31:
-            raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+            # _shown: 10**5000's repr was Python's "Exceeds the limit (4300 digits)", no name
+            raise ValueError(f"{name} must be a non-negative integer, got {_shown(v)}")
         kw[name] = whole
     # Older kernels checked both radii in one test and named research_radius for either.
     if kw["search_pool_radius"] > 16:

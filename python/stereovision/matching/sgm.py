@@ -22,6 +22,7 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     NOT_NUMBERS,
+    _shown,
     as_gray_float,
     check_pair,
     finite_number,
@@ -212,7 +213,8 @@ def sgm_disparity(
         # Fraction(3) was refused here and taken there, 3 ns was taken as 3
         whole = whole_value(v)
         if whole is None or not bottom <= whole <= top:
-            raise ValueError(f"{name}: expected an integer in [{bottom}, {top}], got {v!r}")
+            # _shown: 10**5000's repr was Python's "Exceeds the limit (4300 digits)", no name
+            raise ValueError(f"{name}: expected an integer in [{bottom}, {top}], got {_shown(v)}")
         p[name] = whole
     if p["p1"] >= p["p2"]:
         raise ValueError(f"p1: expected p1 < p2, got p1 = {p['p1']}, p2 = {p['p2']}")
