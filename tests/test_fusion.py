@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -1511,6 +1512,17 @@ def test_a_vote_no_pixel_can_win_is_refused(
         with pytest.raises(ValueError, match=want):
             sv_depth_map(img, img, max_disparity=8, progress=stages.append, **kw)
         assert stages == []
+
+
+@pytest.mark.parametrize("given", [10**5000, Fraction(10**5000)], ids=["int", "Fraction"])
+def test_a_min_agree_with_no_str_is_named(given: object) -> None:
+    """A min_agree of 10**5000 (or its Fraction, a count to whole_value since b87b5fa) above
+    the channels was said by its str: Python's own "Exceeds the limit (4300 digits) for
+    integer string conversion", naming no parameter."""
+    sparse = {"hopfield": _m([(4, 4, 10.0)]), "mcgm": _m([(4, 4, 10.0)])}
+    want = r"^min_agree: an integer of 5001 digits channels must agree but 2 take part"
+    with pytest.raises(ValueError, match=want):
+        fuse(None, sparse, min_agree=given)
 
 
 def test_an_r_spatial_past_its_bound_is_refused_at_once() -> None:

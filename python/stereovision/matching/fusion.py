@@ -31,6 +31,7 @@ import numpy.typing as npt
 from stereovision._validate import (
     _plain_option,
     _real_array,
+    _shown,
     finite_number,
     float32_reach,
     refuse_unknown,
@@ -299,7 +300,8 @@ def _check_agree(mode: str, min_agree: int, channels: Iterable[str]) -> None:
     names = [n for n in CHANNEL_BITS if n in set(channels)]
     if mode == "vote" and min_agree > len(names):
         raise ValueError(
-            f"min_agree: {min_agree} channels must agree but {len(names)} take part "
+            # _shown: 10**5000 (a count to whole_value) has no str, Python's error named nothing
+            f"min_agree: {_shown(min_agree)} channels must agree but {len(names)} take part "
             f"({', '.join(names)}), so no pixel could be a member: give more channels, a "
             "smaller min_agree or mode='intersection'"
         )
