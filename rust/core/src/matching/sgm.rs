@@ -2481,6 +2481,81 @@ mod tests {
     }
 
     #[test]
+    fn argmin_min_apart_and_right_winners_hold_at_every_level_count_and_the_limit() {
+        // The u16 level counters of argmin, min_apart and right_winners against plain
+        // definitions at every level count 1..=300 and at the 2048-level limit: ties everywhere,
+        // the minimum only at the last level, tied at both ends, or at the last two levels
+        // (where a counter that wrapped, or a last match kept for the first, gives another
+        // winner).
+        let mut s = 5u32;
+        let mut rand = move || {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            s >> 8
+        };
+        for n in (1..=300usize).chain([2047, 2048]) {
+            let mut cells: Vec<Vec<u16>> = vec![
+                (0..n).map(|_| (rand() % 3 + 7) as u16).collect(),
+                vec![9; n],
+            ];
+            for at in [
+                vec![n - 1],
+                vec![0, n - 1],
+                vec![n.saturating_sub(2), n - 1],
+            ] {
+                let mut c: Vec<u16> = (0..n).map(|_| (rand() % 40 + 9) as u16).collect();
+                at.iter().for_each(|&i| c[i] = 3);
+                cells.push(c);
+            }
+            for cell in &cells {
+                let m = *cell.iter().min().unwrap();
+                let first = cell.iter().position(|&v| v == m).unwrap();
+                assert_eq!(argmin(cell), (first, m), "{n} levels");
+                let ks: Vec<usize> = if n <= 300 {
+                    (0..n).collect()
+                } else {
+                    vec![0, 1, 2, first, n / 2, n - 3, n - 2, n - 1]
+                };
+                for k in ks {
+                    let want = (0..n)
+                        .filter(|&i| i.abs_diff(k) > 1)
+                        .map(|i| cell[i])
+                        .min()
+                        .unwrap_or(u16::MAX);
+                    assert_eq!(min_apart(cell, k), want, "{n} levels, k {k}");
+                }
+            }
+        }
+        // right_winners over 2048 levels, the least cost at the last level of each left pixel.
+        let (n, w) = (2048usize, 2060usize);
+        for d_min in [-2047i64, 0, 5] {
+            let s: Vec<u16> = (0..w * n)
+                .map(|i| {
+                    if i % n == n - 1 {
+                        1
+                    } else {
+                        (rand() % 50 + 2) as u16
+                    }
+                })
+                .collect();
+            let (mut rbest, mut rk) = (vec![7u16; w], vec![7u16; w]);
+            right_winners(&s, w, n, d_min, &mut rbest, &mut rk);
+            for xr in 0..w as i64 {
+                let want = (0..n)
+                    .filter_map(|j| {
+                        let xl = xr + d_min + j as i64;
+                        (0..w as i64)
+                            .contains(&xl)
+                            .then(|| (s[xl as usize * n + j], j as u16))
+                    })
+                    .min()
+                    .unwrap_or((u16::MAX, 0));
+                let i = w - 1 - xr as usize;
+                assert_eq!((rbest[i], rk[i]), want, "d_min {d_min}, xr {xr}");
+            }
+        }
+    }
+
+    #[test]
     fn the_avx2_hamming_costs_are_the_compilers() {
         // Whole cost rows by the AVX2 kernel against the compiler's loop, for every level count
         // 1..=200 (32 and more take the kernel; its tail below 16 levels goes one by one,
