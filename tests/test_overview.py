@@ -783,3 +783,24 @@ def test_the_depth_caption_drops_its_reason_only_where_it_would_reach_the_labels
         res.depth[0] = np.nan  # one row of 40 filled: a disparity, confidence 0, no depth
         res.confidence[0] = 0.0
         assert overview_image(res, "t").captions["depth"] == caption
+
+
+@pytest.mark.parametrize("unit", ["m", "mm"])
+def test_the_depth_bar_names_its_far_end_past_a_million_metres(unit: str) -> None:
+    """The bar's bottom row has depth.png's colour of its far end, 1 / (1st percentile of 1 / Z):
+    it was labelled min(that, 1e6 m), so depths of 1e2 to 5e7 m (a disparity near 0 on a
+    long baseline) had a bar from "100 m" down to "1000000 m" where depth.png's blue was
+    5e7 m, and depths of 2e6 to 3e7 m a far end nearer than its near end."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    size = UNIT_TO_METRES[unit]
+    for near, far in ((100.0, 5e7), (2e6, 3e7)):
+        ov = overview_image(_result_with_depth(60, 80, near, far), "t", unit)
+        ticks = ov.bars["depth"].ticks
+        assert (ticks[0][0], ticks[-1][0]) == (
+            pytest.approx(near / size, rel=1e-3),
+            pytest.approx(far / size, rel=1e-3),
+        )
+        assert ticks[-1][1].endswith(f" {unit}")
+        assert _number(ticks[-1][1]) == pytest.approx(far / size, rel=1e-3)
+        _check_labels_inside_their_cells(ov)

@@ -373,7 +373,11 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         if rng is not None:
             lo, hi = rng
             if kind == "inverse":
-                near, far = 1.0 / max(hi, 1e-12), min(1.0 / lo if lo > 0 else 1e6, 1e6)
+                # the ends depth.png colours: a depth's 1 / Z is > 0, so is lo (the old cap of
+                # the far end at 1e6 m labelled a map reaching 5e7 m "1000000 m"); the
+                # fallbacks are for a hand-made map of negative depths only
+                near = 1.0 / hi if hi > 0 else 1e12
+                far = 1.0 / lo if lo > 0 else 1e6
                 near, far = near / size, far / size  # in the bar's unit
                 # a range within a decade in even steps of depth (2.5, 3, 3.5 m), a wider one
                 # in 1-2-5 steps of each decade (1, 2, 5, 10, 20 m)
