@@ -478,6 +478,20 @@ def test_match_keeps_the_disparity_range() -> None:
     assert len(m) > 500 and float(d.min()) >= 6.0 and float(d.max()) <= 8.0
 
 
+def test_match_drops_the_channel_of_each_match_out_of_range_with_it() -> None:
+    """stats["channel"] is one sigma index per match: match(method="mcgm") dropped the 190
+    matches above max_disparity=32 on cones and kept their channels (4760 for 4570 matches,
+    each after the first dropped one naming another match's sigma)."""
+    sc = _scene("middlebury2003/cones")
+    full = mcgm.mcgm_match(sc.left, sc.right, max_disparity=32)
+    m = sv.match(sc.left, sc.right, method="mcgm", max_disparity=32)
+    keep = (full.xl - full.xr) <= 32.0
+    assert m.stats["n_out_of_range"] == int((~keep).sum()) > 50
+    assert m.stats["channel"].shape == (len(m),)
+    assert np.array_equal(m.stats["channel"], full.stats["channel"][keep])
+    assert np.array_equal(m.xl, full.xl[keep])
+
+
 def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     # 4 decimals lost up to 5e-5 px of the float32 sub-pixel positions, and nothing read the
     # file back.
