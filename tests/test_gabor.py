@@ -488,6 +488,28 @@ def test_a_real_parameter_read_from_an_array_is_its_number() -> None:
         np.testing.assert_array_equal(got, base)
 
 
+def test_a_range_read_from_an_array_is_its_number() -> None:
+    """max_disparity / min_disparity of np.array([16.0]) passed the range check (finite_number
+    reads a size-1 array as its value, as sgm_disparity does) and then failed in float() with
+    NumPy's bare TypeError "only 0-dimensional arrays can be converted", naming neither. They
+    give the map of the plain floats, through match(method="gabor") too."""
+    import stereovision as sv
+
+    rng = np.random.default_rng(0)
+    left = rng.random((48, 80), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    base = gabor_disparity(left, right, max_disparity=16.0, min_disparity=1.0).disparity
+    assert np.count_nonzero(np.isfinite(base)) > 1000
+    got = gabor_disparity(
+        left, right, max_disparity=np.array([16.0]), min_disparity=np.array([1.0])
+    ).disparity
+    np.testing.assert_array_equal(got, base)
+    m = sv.match(left, right, method="gabor", max_disparity=np.array([16.0]))
+    plain = sv.match(left, right, method="gabor", max_disparity=16.0)
+    assert len(m) == len(plain) > 1000
+    np.testing.assert_array_equal(m.xr, plain.xr)
+
+
 def test_a_decimal_real_parameter_is_its_number() -> None:
     """A Decimal (a config read with ``json.loads(parse_float=Decimal)``) is no numbers.Real:
     the check of the real parameters refused it as "freq: expected a number, got

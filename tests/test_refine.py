@@ -445,6 +445,21 @@ def test_fills_entries_are_numbers_as_every_other_parameter(fills: object) -> No
     )
 
 
+def test_a_range_read_from_an_array_is_its_number() -> None:
+    """min_disparity / max_disparity of np.array([8.0]) passed disparity_range (a size-1 array
+    is its value) and then failed in float() with NumPy's bare TypeError "only 0-dimensional
+    arrays can be converted", naming neither; they now give the plain floats' map."""
+    rng = np.random.default_rng(0)
+    a = rng.random((30, 40), dtype=np.float32)
+    b = np.roll(a, -3, axis=1)
+    d = np.full(a.shape, 3.0, np.float32)
+    base = refine_disparity(a, b, d, min_disparity=1.0, max_disparity=8.0)
+    assert np.count_nonzero(np.isfinite(base.disparity)) > 300
+    got = refine_disparity(a, b, d, min_disparity=np.array([1.0]), max_disparity=np.array([8.0]))
+    np.testing.assert_array_equal(got.disparity, base.disparity)
+    np.testing.assert_array_equal(got.confidence, base.confidence)
+
+
 @pytest.mark.parametrize("name", ["left", "right", "disparity", "confidence"])
 def test_a_complex_array_is_named_not_cast_to_its_real_part(name: str) -> None:
     """A complex image, map or confidence was cast to float32 with only NumPy's ComplexWarning:

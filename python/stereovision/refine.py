@@ -182,7 +182,8 @@ def refine_disparity(
                 f"{int(bad.sum())} pixels are not (e.g. {float(conf[bad][0])!r})"
             )
         conf = np.where(measured | np.isfinite(conf), conf, np.float32(0))
-    disparity_range(min_disparity, max_disparity)
+    # the checked floats go to the kernel (float() of np.array([8.0]) was NumPy's bare TypeError)
+    lo, hi = disparity_range(min_disparity, max_disparity)
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:
@@ -203,8 +204,8 @@ def refine_disparity(
         rgt,
         dsp,
         conf,
-        float(min_disparity),
-        float(max_disparity),
+        lo,
+        hi,
         f["base_sigma"],
         f["win_sigma"],
         int(i["win_radius"]),

@@ -222,7 +222,8 @@ def gabor_disparity(
     ):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
     kw["orientations_deg"] = [float(float_sized(t, "orientations_deg")) for t in orient]
-    disp, conf = _core.gabor_disparity(lft, rgt, float(min_disparity), float(max_disparity), **kw)
+    # lo, hi: the checked floats (float() of np.array([16.0]) was NumPy's bare TypeError)
+    disp, conf = _core.gabor_disparity(lft, rgt, lo, hi, **kw)
     return GaborResult(disparity=disp, confidence=conf)
 
 
