@@ -510,6 +510,24 @@ def test_a_range_read_from_an_array_is_its_number() -> None:
     np.testing.assert_array_equal(m.xr, plain.xr)
 
 
+def test_match_takes_a_gabor_range_read_from_an_array_as_its_number() -> None:
+    """match(method="gabor") with min_disparity=np.array([1.0]) gave NumPy's bare TypeError
+    "only 0-dimensional arrays can be converted" (its range filter's float()), and a
+    max_disparity of np.array([[4.05]]) a 2-D keep mask, NumPy's IndexError "too many indices
+    for array" once a match was out of range. Both give the matches of the plain floats."""
+    import stereovision as sv
+
+    rng = np.random.default_rng(0)
+    left = rng.random((48, 80), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    plain = sv.match(left, right, method="gabor", max_disparity=4.05, min_disparity=1.0)
+    assert len(plain) > 1000 and plain.stats["n_out_of_range"] > 10
+    for lo, hi in ((np.array([1.0]), 4.05), (1.0, np.array([[4.05]]))):
+        m = sv.match(left, right, method="gabor", max_disparity=hi, min_disparity=lo)
+        np.testing.assert_array_equal(m.xr, plain.xr)
+        assert m.stats["n_out_of_range"] == plain.stats["n_out_of_range"]
+
+
 def test_a_decimal_real_parameter_is_its_number() -> None:
     """A Decimal (a config read with ``json.loads(parse_float=Decimal)``) is no numbers.Real:
     the check of the real parameters refused it as "freq: expected a number, got

@@ -212,6 +212,9 @@ def _in_range(m: Matches, lo: float, hi: float) -> npt.NDArray[np.bool_]:
     (a working volume, a near limit) gets no match outside it.
     """
     d = m.xl - m.xr
+    # a size-1 array is its number, as the matchers read it (float() of np.array([1.0]) was
+    # NumPy's bare TypeError, np.array([[4.05]]) a 2-D mask)
+    lo, hi = (v.reshape(())[()] if isinstance(v, np.ndarray) else v for v in (lo, hi))
     # lo as a Python float, as before (a NumPy float64 would compare in float64)
     lo = float(min(max(lo, -_BOUND_CLIP), _BOUND_CLIP))
     hi = min(max(hi, -_BOUND_CLIP), _BOUND_CLIP)
