@@ -602,3 +602,27 @@ def test_a_complex_disparity_is_named_not_cast_to_its_real_part(fill: str) -> No
             ValueError, match=r"^disparity: expected real values, got dtype complex"
         ):
             call()
+
+
+def test_a_parameter_read_from_an_array_is_its_number(data_dir: Path) -> None:
+    """finite_number reads a size-1 array as its value, so segments' step, offset and blur,
+    fill_planes' blur and side_fill's tau and blur of np.array([16]) passed the checks; the
+    float() or int() after them was NumPy's bare TypeError "only 0-dimensional arrays can be
+    converted", naming none. Each now gives the result of the plain number."""
+    img, _ = _crop(data_dir, "middlebury2003/cones")
+    h, w = img.shape[:2]
+    disp = np.tile(np.linspace(5, 9, w, dtype=np.float32), (h, 1))
+    disp[10:30, 15:40] = np.nan
+    cases = [
+        (lambda **kw: segments(img, **kw), {"step": 16, "offset": 8, "blur": 2.0}),
+        (lambda **kw: fill_planes(disp, img, **kw), {"blur": 2.0}),
+        (lambda **kw: side_fill(disp, img, **kw), {"tau": 5.0, "blur": 1.0}),
+    ]
+    for run, params in cases:
+        for name, value in params.items():
+            want = run(**{name: value})
+            got = run(**{name: np.array([value])})
+            np.testing.assert_array_equal(got, want, err_msg=name)
+    # the plain results are not trivial: holes filled, more than one segment
+    assert np.isfinite(fill_planes(disp, img)).sum() > np.isfinite(disp).sum()
+    assert int(segments(img).max()) > 10

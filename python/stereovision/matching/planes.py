@@ -109,6 +109,7 @@ def segments(
     """
     from stereovision import _core
 
+    step, offset, blur = _number_of(step), _number_of(offset), _number_of(blur)
     im = np.asarray(image)
     if im.ndim not in (2, 3) or im.size == 0 or im.dtype.kind not in "iuf":
         raise ValueError(f"image: expected a real (H, W) or (H, W, C) array, got {im.shape}")
@@ -155,6 +156,16 @@ def _real(value: object, name: str) -> object:
     if not real_number(value):  # a bool, or 3 ns taken as 3
         raise ValueError(f"{name}: expected a number, got {value!r}")
     return float_sized(value, name)
+
+
+def _number_of(value: object) -> Any:
+    """A size-1 real array as its number (``np.array([2.0])``: 2.0, as :func:`finite_number`
+    reads it), anything else unchanged: the checks took such a ``blur``, ``step``, ``offset``
+    or ``tau`` and the ``float()`` after them was NumPy's bare TypeError "only 0-dimensional
+    arrays can be converted", naming none."""
+    if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf":
+        return value.reshape(())[()]
+    return value
 
 
 def _real_map(disparity: npt.ArrayLike) -> F32:
@@ -325,6 +336,7 @@ def fill_planes(
             f"0-{_MAX_COUNT}, got {passes!r}"
         ) from None
     # Checked before the early return: a bad value was accepted whenever the map had no hole.
+    blur = _number_of(blur)
     _check_blur(blur)
     residual = float(finite_number(max_residual, "max_residual"))
     if residual < 0:
@@ -407,6 +419,7 @@ def side_fill(
             f"image: expected (H, W) or (H, W, 3) with (H, W) = {d.shape}, got {im.shape}"
         )
     # Checked before the early return: a bad value was accepted whenever the map had no hole.
+    blur, tau = _number_of(blur), _number_of(tau)
     _check_blur(blur)
     if not finite_number(tau, "tau") >= 0:
         raise ValueError(f"tau: expected a non-negative number, got {tau}")
