@@ -543,3 +543,16 @@ def test_a_decimal_real_parameter_is_its_number() -> None:
     np.testing.assert_array_equal(
         gabor_disparity(left, right, max_disparity=16, **kw).disparity, base
     )
+
+
+def test_gabor_responses_take_a_parameter_read_from_an_array_as_its_number() -> None:
+    """freq=np.array([0.25]) (a value read from an array, which gabor_disparity takes as 0.25)
+    was the binding's bare TypeError "only 0-dimensional arrays can be converted", naming no
+    parameter; each parameter now gives the plain number's response."""
+    img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
+    plain = {"freq": 0.2, "theta_deg": 30.0, "bandwidth_oct": 1.0, "aspect": 0.8}
+    want = gabor_responses(img, **plain)
+    assert np.abs(want).max() > 0.01
+    for name, value in plain.items():
+        got = gabor_responses(img, **{**plain, name: np.array([value])})
+        np.testing.assert_array_equal(got, want, err_msg=name)

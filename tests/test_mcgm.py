@@ -1184,3 +1184,12 @@ def test_matches_complex_positions_are_named_not_cast_to_their_real_part() -> No
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=r"^xr: expected real values, got dtype complex128"):
             sv.Matches(xl=a, yl=a, xr=a + 1j, yr=a, score=a, image_shape=(4, 4))
+
+
+def test_log_filter_takes_a_sigma_read_from_an_array_as_its_number() -> None:
+    """sigma=np.array([2.0]) (as mcgm_match's sigmas take it) was float()'s bare TypeError
+    "only 0-dimensional arrays can be converted"; it gives sigma 2's response."""
+    img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
+    want = mcgm.log_filter(img, 2.0)
+    assert np.abs(want).max() > 0.01
+    np.testing.assert_array_equal(mcgm.log_filter(img, np.array([2.0])), want)

@@ -256,12 +256,17 @@ def gabor_responses(
     numpy.ndarray
         ``(H, W)`` complex64 response ``y = h * image`` (true convolution, reflect-101 borders).
     """
+    values = []
     for name, v in (
         ("freq", freq),
         ("theta_deg", theta_deg),
         ("bandwidth_oct", bandwidth_oct),
         ("aspect", aspect),
     ):
-        float_sized(v, name)  # 10**400: the binding's bare OverflowError
-    re, im = _core.gabor_responses(_as_grey(image, "image"), freq, theta_deg, bandwidth_oct, aspect)
+        if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf":
+            # its number, as gabor_disparity reads freq: np.array([0.25]) was the binding's
+            # bare TypeError "only 0-dimensional arrays can be converted"
+            v = v.reshape(())[()]
+        values.append(float_sized(v, name))  # 10**400: the binding's bare OverflowError
+    re, im = _core.gabor_responses(_as_grey(image, "image"), *values)
     return (re + 1j * im).astype(np.complex64)

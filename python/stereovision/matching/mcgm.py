@@ -260,6 +260,10 @@ def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
     ValueError
         Bad image or sigma.
     """
+    if isinstance(sigma, np.ndarray) and sigma.size == 1 and sigma.dtype.kind in "iuf":
+        # its number, as mcgm_match reads sigmas: float() of np.array([2.0]) was NumPy's bare
+        # TypeError "only 0-dimensional arrays can be converted"
+        sigma = sigma.reshape(())[()]
     # 10**400 was float()'s bare OverflowError
     return _core.mcgm_log(as_gray_float(image, "image"), float(float_sized(sigma, "sigma")))
 
