@@ -1193,3 +1193,16 @@ def test_log_filter_takes_a_sigma_read_from_an_array_as_its_number() -> None:
     want = mcgm.log_filter(img, 2.0)
     assert np.abs(want).max() > 0.01
     np.testing.assert_array_equal(mcgm.log_filter(img, np.array([2.0])), want)
+
+
+@pytest.mark.parametrize("value", ["no", 0.5, 0, None])
+def test_debug_is_a_switch(value: object) -> None:
+    """debug="no" and 0.5 added the per-channel intermediates as debug=True did, 0 and None
+    left them out as False: a switch is True or False, as the kernel's own (subpixel="no" is
+    refused by name)."""
+    img = np.random.default_rng(0).random((30, 40), dtype=np.float32)
+    right = np.roll(img, -2, axis=1)
+    with pytest.raises(ValueError, match=r"^debug: expected True or False, got "):
+        mcgm.mcgm_match(img, right, max_disparity=8, debug=value)
+    assert "channels" in mcgm.mcgm_match(img, right, max_disparity=8, debug=np.True_).stats
+    assert "channels" not in mcgm.mcgm_match(img, right, max_disparity=8, debug=False).stats

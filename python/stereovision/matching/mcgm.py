@@ -336,8 +336,8 @@ def mcgm_match(
     ------
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter, a value
-        out of range, or a ``min_disparity`` not below the image width (as
-        :func:`stereovision.match`: no pixel has a match that far).
+        out of range, a ``debug`` that is not True or False, or a ``min_disparity`` not below
+        the image width (as :func:`stereovision.match`: no pixel has a match that far).
     MemoryError
         When an image-sized buffer of the kernel cannot be allocated (the message names it and
         its size); the process is not aborted.
@@ -352,6 +352,10 @@ def mcgm_match(
     >>> bool(np.median(m.xl - m.xr) - 3.4 < 0.05) and len(m) > 100
     True
     """
+    # a switch, as the kernel's (subpixel="no" is refused by name): "no" and 0.5 were taken
+    # as True and 0 as False
+    if not isinstance(debug, (bool, np.bool_)):
+        raise ValueError(f"debug: expected True or False, got {debug!r}")
     gl, gr = check_pair(left, right)
     kw = _params(max_disparity, min_disparity, params)
     refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
