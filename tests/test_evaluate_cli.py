@@ -413,3 +413,23 @@ def test_eval_of_a_scene_no_higher_than_stereobms_block_scores_ours_and_sgbm(
     assert cells[3].strip() == "" and cells[4].split()[0] == f"{row['sgbm']['bad_2.0']:.1f}"
     assert lines[3].startswith("mean bad-2.0: ours ") and "StereoBM" not in lines[3]
     assert "StereoBM" not in lines[4] and "SGBM-3WAY" in lines[4]
+
+
+def test_eval_mean_line_says_why_stereobm_has_no_mean(data_dir: Path, tmp_path: Path) -> None:
+    """With one scene StereoBM cannot run on beside one it ran on, the mean line left StereoBM
+    out without a word (the other scene's figures dropped from the run's means); it now says
+    so after the other columns' means."""
+    low = _low_scene(data_dir, tmp_path)
+    full = data_dir / "middlebury2001" / "venus"
+    proc = _eval(str(full), str(low), "--method", "fast")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    venus, crop = (line.split("|") for line in lines[2:4])  # in the order given
+    assert venus[0].startswith("middlebury2001/venus") and crop[0].split()[0].endswith("/low")
+    assert crop[3].strip() == "" and venus[3].strip() != ""
+    mean = lines[4]
+    names = [
+        part.rsplit(" ", 2)[0] for part in mean.split(";")[0][len("mean bad-2.0: ") :].split(", ")
+    ]
+    assert names == ["ours", "ours+fill", "SGBM-3WAY", "SGBM+fill"], mean
+    assert mean.endswith("; StereoBM: no mean (no figures for 1 of 2 scenes)"), mean

@@ -1816,7 +1816,15 @@ def cmd_eval(args: argparse.Namespace) -> int:
         for k, name in columns.items()
         if all(k in r for r in rows)
     }
-    print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()))
+    # a scene StereoBM cannot run on drops StereoBM's mean for the run: say so rather than leave
+    # the run's other scenes' figures out without a word
+    bm_missing = sum("sgbm" in r and "bm" not in r for r in rows)
+    bm_note = (
+        f"; StereoBM: no mean (no figures for {bm_missing} of {len(rows)} scenes)"
+        if 0 < bm_missing < len(rows)
+        else ""
+    )
+    print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()) + bm_note)
     for r in rows:
         if args.runs is not None:  # asked for: the medians, as --json has them
             print(_eval_time_line(r))
