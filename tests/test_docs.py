@@ -697,20 +697,37 @@ def test_commands_named_in_the_prose_take_their_options() -> None:
 
 def test_every_option_is_documented_with_its_command() -> None:
     """Every option a command's --help lists is named (by one of its option strings) in a
-    paragraph or code block of the README or docs/ that names that command (`stream`,
-    `stereovision gui ...`): `stream --serve`, `--no-check`, `--no-pipeline`, `gui --port`,
-    `--no-browser` and `board --dpi` were named nowhere."""
+    paragraph of the README or docs/ that names that command (`stream`, `stereovision gui`) or
+    on a code block's line running it (continued lines too): `stream --serve`, `--no-check`,
+    `--no-pipeline`, `gui --port`, `--no-browser` and `board --dpi` were named nowhere. A code
+    block's line counts for the command it runs only: `board --unit` passed as `depth ...
+    --unit ft` two lines below `stereovision board ...` in one block."""
     import argparse
 
     from stereovision.cli import build_parser
 
     parser = build_parser()
     commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    paragraphs = [part for page in PAGES for part in re.split(r"\n\s*\n", page.read_text())]
+    block = re.compile(r"```[a-z]*\n.*?```", re.S)
+    paragraphs, runs = [], []  # prose paragraphs; (command, line) of the code blocks
+    for page in PAGES:
+        text = page.read_text()
+        paragraphs += re.split(r"\n\s*\n", block.sub("\n\n", text))
+        for code in block.findall(text):
+            command, previous = "", ""
+            for line in code.splitlines():
+                start = re.match(r"\s*(?:\S+\$ )?(?:python -m )?stereovision (\w+)", line)
+                if start:
+                    command = start.group(1)
+                elif not previous.split("#")[0].rstrip().endswith("\\"):  # not continued
+                    command = ""
+                runs.append((command, line))
+                previous = line
     unnamed, checked = [], 0
     for command, sub in commands.choices.items():
         names_command = re.compile(rf"(?:`|stereovision )(?:stereovision )?{command}\b")
         with_command = [p for p in paragraphs if names_command.search(p)]
+        with_command += [line for c, line in runs if c == command]
         for action in sub._actions:
             if not action.option_strings or "--help" in action.option_strings:
                 continue
