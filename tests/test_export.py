@@ -93,6 +93,49 @@ def test_pcd_written_colours_are_opaque_and_read_back(result, tmp_path):
     np.testing.assert_array_equal(cols, left[..., ::-1])
 
 
+def test_pcd_opaque_colours_that_are_nan_or_inf_floats_read_back(tmp_path):
+    """With alpha 255 the packed float is NaN for red >= 0x80 (a signalling NaN for 0x80-0xBF,
+    which a float conversion would quiet: red 0x80 read as 0xC0) and -inf for (128, 0, 0):
+    every such colour comes back from binary and from ASCII PCD (PCL's integer tokens)."""
+    rgb = np.array(
+        [
+            [0, 0, 0],
+            [255, 255, 255],
+            [255, 0, 0],
+            [0, 255, 0],
+            [0, 0, 255],
+            [128, 0, 0],
+            [128, 0, 1],
+            [191, 255, 255],
+            [192, 0, 0],
+            [127, 255, 255],
+            [160, 7, 9],
+        ],
+        np.uint8,
+    )
+    bits = export._pack_rgb(rgb).view("<u4")
+    assert np.isnan(bits.view("<f4")).sum() == 6 and np.isneginf(bits.view("<f4")).sum() == 1
+    n = len(rgb)
+    xyz = np.arange(3 * n, dtype=np.float32).reshape(n, 3)
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+        f"WIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA "
+    )
+    rec = np.empty(n, [("xyz", "<f4", (3,)), ("rgb", "<u4")])
+    rec["xyz"], rec["rgb"] = xyz, bits
+    (tmp_path / "b.pcd").write_bytes((head + "binary\n").encode() + rec.tobytes())
+    rows = "".join(
+        f"{x:g} {y:g} {z:g} {b}\n" for (x, y, z), b in zip(xyz, bits.tolist(), strict=True)
+    )
+    (tmp_path / "a.pcd").write_text(head + "ascii\n" + rows)
+    for name in ("b.pcd", "a.pcd"):
+        pts, cols = export.read_pcd(tmp_path / name)
+        np.testing.assert_array_equal(cols.reshape(-1, 3), rgb, err_msg=name)
+        pts, cols = export.load_cloud(tmp_path / name)  # the GUI's and render's reader
+        np.testing.assert_array_equal(pts, xyz, err_msg=name)
+        np.testing.assert_array_equal(cols, rgb, err_msg=name)
+
+
 _COLOURS = np.array([[255, 0, 0], [10, 20, 30], [0, 128, 1]], np.uint8)
 _POINTS = np.array([[1, 2, 3], [4, 5, 6], [np.nan, np.nan, np.nan]], np.float32)
 

@@ -268,7 +268,7 @@ def _pack_rgb(colors: npt.NDArray[np.uint8]) -> npt.NDArray[np.float32]:
 
 
 def _unpack_rgb(packed: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
-    """RGB of PCL's packed colours, ``0x00RRGGBB`` in the bits of 4-byte values.
+    """RGB of PCL's packed colours, ``0xAARRGGBB`` in the bits of 4-byte values (alpha unread).
 
     The bits, whatever the type that holds them: PCL packs ``rgb`` into a float32 (``TYPE F``),
     ``rgba`` and some writers into a uint32 (``TYPE U``); a numeric conversion between the two
@@ -346,10 +346,10 @@ def read_pcd(
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
     """Read a PCD file with ``x y z`` (float) and optional packed ``rgb`` (ascii or binary data).
 
-    The colour is PCL's packed ``0x00RRGGBB`` in a 4-byte ``rgb`` (or ``rgba``) field, read as
-    bits whether the header types it ``F`` (``pcl::PointXYZRGB``), ``U`` or ``I``. In ASCII
-    data an integer is the bits (as PCL writes ``rgb``) and, for ``TYPE F``, any other number
-    the float holding them.
+    The colour is PCL's packed ``0xAARRGGBB`` (alpha unread) in a 4-byte ``rgb`` (or ``rgba``)
+    field, read as bits whether the header types it ``F`` (``pcl::PointXYZRGB``), ``U`` or
+    ``I``. In ASCII data an integer is the bits (as PCL writes ``rgb``) and, for ``TYPE F``, any
+    other number the float holding them.
 
     Parameters
     ----------
