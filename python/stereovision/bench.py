@@ -63,6 +63,12 @@ class BenchCase:
     accuracy : dict
         Dense: ``bad_2.0`` (holes counted), ``bad_2.0_filled`` (after the reference row fill),
         ``density`` (percent). Sparse: ``precision@1.0``, ``count``. Empty without GT.
+    width, height : int
+        The scene's image size, pixels.
+    max_disparity : int
+        The scene's disparity range.
+    runs : int
+        Timed runs the median ``ms`` is taken over.
     """
 
     scene: str

@@ -2608,6 +2608,11 @@ class ChessboardCollector:
     board : stereovision.charuco.CharucoBoard, optional
         A ChArUco board instead of a chessboard: a pair counts when both cameras see at least
         :data:`~stereovision.calibrate.CHARUCO_MIN_COMMON` common corners, not all on one line.
+
+    Attributes
+    ----------
+    kept : list of tuple of float
+        The ``(x, y, size, skew)`` pose of each pair kept, in order.
     """
 
     pattern: tuple[int, int]
@@ -2712,10 +2717,25 @@ class ChessboardCollector:
 class CaptureResult:
     """What :func:`capture` did.
 
-    ``ended`` is ``"count reached"``, ``"end of stream"`` (both sources ended together, as
-    announced), or, when a source ended before the other or a file before its announced frames,
-    what ended (``"right source 'r.avi' ended after 100 frames; the left source still had
-    frames"``).
+    Attributes
+    ----------
+    saved : list of tuple of pathlib.Path
+        The ``(left, right)`` files of each pair saved, in order.
+    frames_read : int
+        Pairs read from the camera (saved or not).
+    skew : dict of str to float
+        Left/right grab skew over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``
+        (NaN without pairs).
+    coverage : dict of str to float or None
+        With a board: each pose parameter's coverage in ``[0, 1]``
+        (:meth:`ChessboardCollector.progress`); None without one.
+    ended : str
+        ``"count reached"``, ``"end of stream"`` (both sources ended together, as announced),
+        or, when a source ended before the other or a file before its announced frames, what
+        ended (``"right source 'r.avi' ended after 100 frames; the left source still had
+        frames"``).
+    removed_temps : list of str
+        Temporary files a killed capture had left in the folder, removed at the start.
     """
 
     saved: list[tuple[Path, Path]]

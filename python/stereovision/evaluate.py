@@ -386,6 +386,8 @@ class Table1Report:
         RMSE as a percentage of the mean GT distance.
     mean_distance : float
         Mean GT distance (m).
+    n_points : int
+        N, the number of points (set from ``x``).
     """
 
     x: npt.NDArray[np.int64]

@@ -212,6 +212,11 @@ class StreamReport:
         when pipelined (its own ``frames`` and ``restarts`` can be higher).
     error : str or None
         With ``ended`` ``"source failed"`` or ``"output failed"``: the error (None otherwise).
+    density : float
+        Mean over the pairs of :attr:`DepthResult.density
+        <stereovision.depth.DepthResult.density>` (share of pixels with a disparity, 0-1).
+    reports : list of dict
+        Every per-second report, as ``on_report`` got them (not in :meth:`as_dict`).
     """
 
     frames: int
