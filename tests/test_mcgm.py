@@ -1195,6 +1195,20 @@ def test_log_filter_takes_a_sigma_read_from_an_array_as_its_number() -> None:
     np.testing.assert_array_equal(mcgm.log_filter(img, np.array([2.0])), want)
 
 
+@pytest.mark.parametrize(
+    "sigma",
+    [np.array([2.0, 1.0]), np.array([2.0], dtype=object), np.array([True]), None, "two"],
+    ids=["two-values", "object", "bool-array", "None", "str"],
+)
+def test_log_filter_names_a_sigma_that_is_no_number(sigma: object) -> None:
+    """A sigma that is no number (an array of 2 values, an object or bool array, None, a str)
+    was NumPy's or float()'s bare TypeError/ValueError ("only 0-dimensional arrays can be
+    converted", "could not convert string to float"), naming no sigma."""
+    img = np.zeros((24, 40), np.float32)
+    with pytest.raises(ValueError, match=r"^sigma: expected a number of pixels, got "):
+        mcgm.log_filter(img, sigma)  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("value", ["no", 0.5, 0, None])
 def test_debug_is_a_switch(value: object) -> None:
     """debug="no" and 0.5 added the per-channel intermediates as debug=True did, 0 and None

@@ -264,8 +264,15 @@ def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
         # its number, as mcgm_match reads sigmas: float() of np.array([2.0]) was NumPy's bare
         # TypeError "only 0-dimensional arrays can be converted"
         sigma = sigma.reshape(())[()]
-    # 10**400 was float()'s bare OverflowError
-    return _core.mcgm_log(as_gray_float(image, "image"), float(float_sized(sigma, "sigma")))
+    try:
+        # 10**400 was float()'s bare OverflowError
+        value = float(float_sized(sigma, "sigma"))
+    except (TypeError, ValueError) as e:
+        if str(e).startswith("sigma: "):
+            raise
+        # np.array([2.0, 1.0]), None, "abc": NumPy's or float()'s bare words, naming no sigma
+        raise ValueError(f"sigma: expected a number of pixels, got {reprlib.repr(sigma)}") from None
+    return _core.mcgm_log(as_gray_float(image, "image"), value)
 
 
 def curves(image: npt.ArrayLike, **params: Any) -> list[ChannelCurves]:
