@@ -492,6 +492,34 @@ def test_match_drops_the_channel_of_each_match_out_of_range_with_it() -> None:
     assert np.array_equal(m.xl, full.xl[keep])
 
 
+def test_a_selection_of_matches_picks_their_per_match_stats() -> None:
+    """m[mask] kept stats["channel"] (and fused's count/sources) whole: after
+    m[m.score > 0.5] the channels named the first matches' sigmas, not the picked ones'.
+    Counters and other entries are kept as they were."""
+    n = 5
+    d = np.arange(n, dtype=np.float32)
+    stats = {
+        "channel": np.array([0, 1, 2, 1, 0]),
+        "count": np.array([3, 2, 2, 3, 2], np.uint8),
+        "sources": np.array([7, 3, 5, 7, 6], np.uint8),
+        "channels": ["mcgm", "gabor", "hopfield"],
+        "n_matches": n,
+    }
+    m = sv.Matches(xl=d + 10, yl=d, xr=d, yr=d, score=d / 4, image_shape=(8, 20), stats=stats)
+    for index, want in (
+        (m.score > 0.5, [3, 4]),
+        (np.array([4, 0]), [4, 0]),
+        (slice(1, 3), [1, 2]),
+        (-1, [4]),
+    ):
+        picked = m[index]
+        for key in ("channel", "count", "sources"):
+            assert np.array_equal(picked.stats[key], stats[key][want]), (index, key)
+        assert picked.stats["channels"] == ["mcgm", "gabor", "hopfield"]
+        assert picked.stats["n_matches"] == n
+    assert np.array_equal(m.stats["channel"], [0, 1, 2, 1, 0])  # the original is untouched
+
+
 def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     # 4 decimals lost up to 5e-5 px of the float32 sub-pixel positions, and nothing read the
     # file back.

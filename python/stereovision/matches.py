@@ -26,6 +26,14 @@ F32 = npt.NDArray[np.float32]
 
 _CSV_HEADER = "x_left,y_left,x_right,y_right,score"
 
+#: The stats with one entry per match, which a selection picks with the matches.
+_PER_MATCH_STATS = ("channel", "count", "sources")
+
+
+def _per_match(value: object, n: int) -> bool:
+    """Whether ``value`` is an array with one row per match (of ``n``)."""
+    return isinstance(value, np.ndarray) and value.ndim >= 1 and value.shape[0] == n
+
 
 def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
     raw = np.asarray(a)
@@ -136,9 +144,10 @@ class Matches:
 
     def __getitem__(self, index: Any) -> Matches:
         """The matches picked by a slice, an integer array or a boolean mask, as ``Matches``
-        (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too. An
-        integer gives that one match; beyond the matches it is an IndexError, as is a boolean
-        scalar."""
+        (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too, the
+        per-match stats (``"mcgm"``'s ``channel``, ``"fused"``'s ``count`` and ``sources``)
+        picked with the matches. An integer gives that one match; beyond the matches it is an
+        IndexError, as is a boolean scalar."""
         if isinstance(index, (bool, np.bool_)) or (
             isinstance(index, np.ndarray) and index.ndim == 0 and index.dtype == bool
         ):
@@ -169,7 +178,12 @@ class Matches:
             self.score[pick],
             self.image_shape,
             self.energy_trace,
-            dict(self.stats),
+            # one entry per match: kept whole, m[m.score > 0.5].stats["channel"] named the
+            # sigmas of the first matches, not of those picked
+            {
+                k: v[pick] if k in _PER_MATCH_STATS and _per_match(v, len(self)) else v
+                for k, v in self.stats.items()
+            },
         )
 
     def to_points(self, calib: Calibration, unit: str = "m") -> npt.NDArray[np.float32]:
