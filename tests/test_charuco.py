@@ -1212,22 +1212,49 @@ def test_the_dpi_named_for_markers_of_a_tiny_square_is_found_at_once() -> None:
     """ba8ed54 found the dpi to name a dpi at a time from 1.5 px below it, a step being
     square / 25.4 mm px: 1e-6 mm squares took 9 s, 1e-9 mm ones hung past a minute. It is
     bisected now: the same least dpi, at once. (board_png now refuses past 1.09e8 dpi first,
-    what a PNG stores: the check itself is timed.)"""
+    what a PNG stores: the check itself is timed; the dpi found is said to be past it.)"""
     import time
 
     from stereovision.charuco import _check_marker_cells
 
     for square_m, want in ((1e-9, 901_700_000), (1e-12, 901_700_000_000)):
         board = CharucoBoard((5, 7), 1.0, 0.5, "DICT_4X4_50")
+        said = rf"{want} dpi gives that, past the about 1\.09e\+08 dpi a PNG"
         start = time.perf_counter()
-        with pytest.raises(ValueError, match=rf"use {want} dpi or more"):
+        with pytest.raises(ValueError, match=said):
             _check_marker_cells(board, 20, square_m, 20 * 0.0254 / square_m)  # 1.7 px a cell
         assert time.perf_counter() - start < 1.0
         for dpi, pix in ((want - 1, 35), (want, 36)):  # 35 px squares: 2.9 px a cell
             assert round(square_m / 0.0254 * dpi) == pix
-        with pytest.raises(ValueError, match=rf"use {want} dpi or more"):
+        with pytest.raises(ValueError, match=said):
             _check_marker_cells(board, 35, square_m, want - 1)
         assert _check_marker_cells(board, 36, square_m, want) is None  # 3.0 px a cell: taken
+
+
+def test_too_small_markers_are_not_told_a_dpi_the_board_refuses() -> None:
+    """The dpi named for too-small markers was one board_png then refused: 3e-9 m squares
+    (2.1e-9 m markers) at 8.5e7 dpi were told "use 249766667 dpi or more", which gives 1e10 px
+    per metre ("past ... a PNG's resolution holds; use a lower dpi"); 0.5 mm markers on 1 m
+    squares at 10 dpi "use 1067 dpi", 42008 px squares ("10 to 20000 px per square"). They
+    now say why no dpi serves; a dpi named is taken."""
+    board = CharucoBoard((5, 4), 3.0, 2.1, "DICT_5X5_50")
+    with pytest.raises(ValueError, match=r"needs 3 to be decoded: 249766667 dpi gives that, "
+                       r"past the about 1\.09e\+08 dpi a PNG's resolution holds: use a larger "
+                       r"square and marker$"):  # fmt: skip
+        board_png(board, 3e-9, 8.5e7)
+    with pytest.raises(ValueError, match=r"PNG's resolution holds"):
+        board_png(board, 3e-9, 249766667)  # the dpi the old message named
+    board = CharucoBoard((5, 4), 1000.0, 0.5, "DICT_5X5_50")
+    with pytest.raises(ValueError, match=r"needs 3 to be decoded: 1067 dpi gives that, with "
+                       r"42008 px squares, past the 20000 a board image takes: use a larger "
+                       r"marker$"):  # fmt: skip
+        board_png(board, 1.0, 10)
+    with pytest.raises(ValueError, match=r"10 to 20000 px per square"):
+        board_png(board, 1.0, 1067)
+    board = CharucoBoard((5, 4), 8.0, 4.0, "DICT_5X5_50")
+    with pytest.raises(ValueError, match=r"use 132 dpi or more, or a larger marker$"):
+        board_png(board, 8e-3, 50)
+    board_png(board, 8e-3, 132)  # named, and taken
 
 
 def test_a_dpi_past_what_a_png_stores_is_refused_by_name() -> None:

@@ -750,12 +750,26 @@ def _check_marker_cells(board: CharucoBoard, pix: int, square_metres: float, dpi
         mid = (lo + hi) // 2
         lo, hi = (lo, mid) if taken(mid) else (mid + 1, hi)
     need_dpi = lo
-    raise ValueError(
+    said = (
         f"marker_size: a {square_metres * ratio * 1000:g} mm marker at {dpi:g} dpi is "
         f"{pix * ratio:.1f} px, {per_cell:.1f} px a cell of {board.dictionary}'s {cells} (its "
-        f"bits and border); a printed marker needs {MIN_PX_PER_CELL:g} to be decoded: use "
-        f"{need_dpi} dpi or more, or a larger marker"
+        f"bits and border); a printed marker needs {MIN_PX_PER_CELL:g} to be decoded: "
     )
+    # a dpi board_png refuses is no advice: it answered "use a lower dpi" (3e-9 m squares: 1e10
+    # px per metre, past a PNG's pHYs) or "10 to 20000 px per square" (0.5 mm markers on 1 m
+    # squares: 42008 px)
+    need_pix = round(square_metres / 0.0254 * need_dpi)
+    if need_pix > 20000:
+        raise ValueError(
+            f"{said}{need_dpi} dpi gives that, with {need_pix} px squares, past the 20000 a "
+            "board image takes: use a larger marker"
+        )
+    if round(need_pix / square_metres) > _PNG_MAX_PPM:
+        raise ValueError(
+            f"{said}{need_dpi} dpi gives that, past the about {_PNG_MAX_PPM * 0.0254:.3g} dpi "
+            "a PNG's resolution holds: use a larger square and marker"
+        )
+    raise ValueError(f"{said}use {need_dpi} dpi or more, or a larger marker")
 
 
 def board_png(
