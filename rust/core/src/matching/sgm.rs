@@ -263,6 +263,8 @@ fn hamming_avx2(_avx2: Avx2, a: u64, right: &[u64], out: &mut [u8]) -> Option<(u
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
+        // Only the AVX2 kernel reads the code.
+        let _ = a;
         None
     }
 }
@@ -501,6 +503,8 @@ fn step4_u8_avx2(
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
+        // Only the AVX2 kernel reads the penalties.
+        let _ = (m, lim, p1);
         None
     }
 }

@@ -380,7 +380,9 @@ fn consecutive(offs: &[f32]) -> bool {
 /// operations are those of [`direct_row`] in the same order, so the output is the same bit for
 /// bit (tested).
 mod avx2 {
-    use super::{LevelData, SUBROWS};
+    use super::LevelData;
+    #[cfg(target_arch = "x86_64")]
+    use super::SUBROWS;
     #[cfg(target_arch = "x86_64")]
     use crate::matching::gabor::gather::win;
     #[cfg(target_arch = "x86_64")]

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use crate::alloc::{try_collect, try_filled, try_grow, try_reserve_len, try_zeroed};
 use crate::error::Result;
+#[cfg(target_arch = "x86_64")]
 use crate::simd::has_avx2;
 
 /// One neuron: left point index, right position and disparity vector `(x_l - x_r, y_l - y_r)`.

@@ -605,7 +605,9 @@ pub fn row_peaks(full: &[f32], d_min: usize, d_hi: usize, s_min: f32, out: &mut 
     let n = c.len();
     let peak =
         |i: usize| c[i] >= s_min && (i == 0 || c[i] >= c[i - 1]) && (i + 1 == n || c[i] > c[i + 1]);
-    // Interior positions 1..=done are tested eight at a time (AVX2), the rest one by one.
+    // Interior positions 1..=done are tested eight at a time (AVX2), the rest one by one; only
+    // the x86 branch sets it.
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
     if has_avx2() && n >= LANES + 2 {
@@ -713,6 +715,7 @@ fn blocks_portable(
 const WIN: usize = LANES + SIDE - 1;
 
 /// Blocks per pass of [`blocks_avx2`]: their nine cells each stay in L1 between template rows.
+#[cfg(target_arch = "x86_64")]
 const CHUNK: usize = 16;
 
 /// AVX2 body of [`blocks_portable`], template row by template row: the row's seven taps stay
