@@ -1368,8 +1368,10 @@ def test_a_folding_model_auto_chose_is_not_answered_with_auto() -> None:
         pytest.skip(f"StereoPi pairs not found at {stereopi}")
     left = [stereopi / f"left_0{i}.png" for i in range(1, 6)]
     right = [stereopi / f"right_0{i}.png" for i in range(1, 6)]
-    with pytest.warns(UserWarning, match="not monotonic") as caught:
-        cal, _ = calibrate(left, right, pattern=(9, 6), square_size=0.025)
+    # these five boards are also close to one tilt (56188f0): said, not leaked to the run
+    with pytest.warns(UserWarning, match=r"at most 10\.4 degrees apart over the 5 pairs"):
+        with pytest.warns(UserWarning, match="not monotonic") as caught:
+            cal, _ = calibrate(left, right, pattern=(9, 6), square_size=0.025)
     assert cal.model == "pinhole"
     (text,) = [str(w.message) for w in caught if "not monotonic" in str(w.message)]
     assert text.startswith("the k1k2p1p2 distortion model of the left and right cameras")
