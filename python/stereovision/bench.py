@@ -336,7 +336,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from stereovision import baselines
-    from stereovision.cli import MAX_RUNS
+    from stereovision.cli import MAX_RUNS, scene_failed_line
     from stereovision.io import load_scene, scene_too_narrow
 
     _check_runs(args.runs, "--runs")
@@ -370,9 +370,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
                 # the run, and without --json the table of the scenes timed before it was never
                 # printed)
                 failed.append(str(d))
-                said = str(e)  # the narrow scene's message names its folder already
-                said = said if said.startswith(f"{d}: ") else f"{d}: {said}"
-                tqdm.write(f"failed {said}", file=sys.stderr)
+                tqdm.write(scene_failed_line(d, e), file=sys.stderr)
                 continue
             all_cases.extend(cases)
             # bench_scene left StereoBM out (too low for its block): say why

@@ -1714,6 +1714,13 @@ def _eval_time_line(row: dict[str, Any]) -> str:
     return line
 
 
+def scene_failed_line(folder: Path, error: BaseException) -> str:
+    """The line saying one damaged scene of many (``eval``, ``bench``) failed, its folder named
+    once: a message that names it already (a scene too narrow for its range) is kept as is."""
+    said = str(error)
+    return f"failed {said if said.startswith(f'{folder}: ') else f'{folder}: {said}'}"
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
     from tqdm import tqdm
@@ -1777,9 +1784,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 raise
             # one damaged scene of many: say so and go on (the exit status says it at the end)
             failed.append(str(d))
-            said = str(e)  # the narrow scene's message names its folder already
-            said = said if said.startswith(f"{d}: ") else f"{d}: {said}"
-            tqdm.write(f"failed {said}", file=sys.stderr)
+            tqdm.write(scene_failed_line(d, e), file=sys.stderr)
             continue
         rows.append(row)
         if "sgbm" in row and "bm" not in row:  # StereoBM cannot run on it: say why it is blank
