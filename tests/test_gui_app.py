@@ -194,6 +194,10 @@ class _App:
         self.server = _Server(fail, after_bind)
         self.ctrl = argparse.Namespace(on_server_ready=self.server.ready)
         self.source = _Source()
+        self.stopped = 0
+
+    def stop_work(self) -> None:
+        self.stopped += 1
 
 
 def _gui_args(*argv: str) -> argparse.Namespace:
@@ -231,7 +235,7 @@ def test_cmd_gui_starts_the_server_as_asked_and_closes_the_cameras(monkeypatch, 
             "argv": ["stereovision"],  # trame parses sys.argv: it sees none of ours
         }
         assert sys.argv == ["stereovision", "gui", *argv]
-        assert app.source.closed == 1
+        assert app.source.closed == 1 and app.stopped == 1
         out, err = capsys.readouterr()
         assert out == f"stereovision gui on {gui.url_for(args.host, 43210)} (Ctrl+C to stop)\n"
         assert err == note
@@ -6104,6 +6108,78 @@ def test_gui_main_as_the_command_ends_past_an_open_it_gave_up(monkeypatch, capsy
         assert gui.main(["--no-browser"]) == 2
     finally:
         release.set()
+
+
+def test_gui_main_ends_past_a_computation_running_when_the_server_stops(monkeypatch):
+    """Ctrl+C while a pair computed: the server stopped, then the interpreter's shutdown waited
+    for the worker thread's computation (135 s for a 3600 x 3000 pair, the "Ctrl+C to stop"
+    seemingly ignored). ``gui.main`` now ends the process past it, as past a camera's read."""
+    import os
+    import threading
+
+    import stereovision.gui as gui
+    from stereovision.gui import bundled_data_dir
+
+    class Ended(Exception):
+        pass
+
+    def exit_(status: int) -> None:
+        raise Ended(status)
+
+    app = _scene_app("test-stop-past-work", [bundled_data_dir()])
+    release, running = threading.Event(), threading.Event()
+    queued: list[Any] = []
+
+    def start(**_: Any) -> None:  # the server runs a computation, then stops (Ctrl+C)
+        app._executor.submit(lambda: (running.set(), release.wait()))
+        assert running.wait(10)
+        queued.append(app._executor.submit(lambda: None))  # a check clicked meanwhile
+
+    monkeypatch.setattr(app.server, "start", start)
+    monkeypatch.setattr(gui, "build_app", lambda _args: app)
+    monkeypatch.setattr(os, "_exit", exit_)
+    monkeypatch.setattr(sys, "argv", ["stereovision gui", "--no-browser"])
+    try:
+        with pytest.raises(Ended) as ended:
+            gui.main()
+        assert ended.value.args == (0,)
+        assert queued[0].cancelled()  # what was queued behind it is dropped, not run
+    finally:
+        release.set()
+
+
+def test_a_save_under_way_when_the_server_stops_is_finished_first(tmp_path):
+    """Stopping the server's work waits for a Save that writes (its folder whole), and a Save
+    not begun then writes nothing."""
+    import threading
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SaveFailed
+
+    app = _scene_app("test-stop-save", [bundled_data_dir()])
+    half, go = threading.Event(), threading.Event()
+
+    def write(into: Path) -> None:
+        (into / "disparity.png").write_bytes(b"a")
+        half.set()
+        assert go.wait(10)
+        (into / "overview.png").write_bytes(b"b")
+
+    names = ["disparity.png", "overview.png"]
+    saving = app._executor.submit(app._write_save, write, tmp_path / "out", names)
+    assert half.wait(10)
+    stopper = threading.Thread(target=app.stop_work)
+    stopper.start()
+    stopper.join(0.3)
+    assert stopper.is_alive()  # waiting for the Save
+    go.set()
+    stopper.join(10)
+    assert not stopper.is_alive()
+    assert set(saving.result(10)) == set(names)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == names
+    with pytest.raises(SaveFailed, match="the server is stopping: nothing was written"):
+        app._write_save(write, tmp_path / "later", names)
+    assert not (tmp_path / "later").exists()
 
 
 def test_gui_main_refuses_a_value_in_one_line_with_the_unit_hint(capsys):

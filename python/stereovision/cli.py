@@ -2518,8 +2518,15 @@ def end_past_native_threads(status: int) -> None:
 
 
 #: The daemon threads that may be left in OpenCV's native code, given up (a hung or slow
-#: camera's open or grab): the process must not shut its interpreter down under them.
-_NATIVE_THREADS = ("stereovision-grab", "stereovision-gui-read", "stereovision-gui-open")
+#: camera's open or grab): the process must not shut its interpreter down under them. And the
+#: GUI's worker (``gui.app.WORK_THREAD_PREFIX``): a computation running when the server stopped
+#: was waited for at the interpreter's shutdown, minutes for a large pair after Ctrl+C.
+_NATIVE_THREADS = (
+    "stereovision-grab",
+    "stereovision-gui-read",
+    "stereovision-gui-open",
+    "stereovision-gui-work_0",
+)
 
 
 def _main(argv: Sequence[str] | None) -> int:

@@ -222,6 +222,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise err from exc
     finally:
         sys.argv = argv
+        app.stop_work()  # the computation under way is not waited for (a Save is)
         if app.source is not None:
             app.source.close()
     return 0

@@ -129,6 +129,10 @@ WIDE_ASPECT = 2.0
 #: cap, :func:`stereovision.render.display_subset`), said in the caption. Files are only read.
 MAX_SHOWN_POINTS = 2_000_000
 
+#: The name of the page's worker thread (computations, checks, Saves), ``_0`` appended: one
+#: the process ends past when the server stops (:data:`stereovision.cli._NATIVE_THREADS`).
+WORK_THREAD_PREFIX = "stereovision-gui-work"
+
 #: Progress (per cent) reached at each stage reported by ``depth_map``.
 _STAGE_PROGRESS = {
     "rectify": 10,
@@ -1486,7 +1490,14 @@ class StereoApp:
         #: ``_choice`` when a Capture was refused for a scene or files on show: another
         #: Capture with no choice since goes back to the source.
         self._capture_back: int | None = None
-        self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
+        #: The one worker thread of computations, checks and Saves, named so that the process
+        #: can end past a computation when the server stops (:meth:`stop_work`).
+        self._executor = concurrent.futures.ThreadPoolExecutor(
+            max_workers=1, thread_name_prefix=WORK_THREAD_PREFIX
+        )
+        #: Held while a Save writes (:meth:`_write_save`); :meth:`stop_work` waits for it.
+        self._save_lock = threading.Lock()
+        self._stopped = False
         self._generation = 0
         self._lock: asyncio.Lock | None = None
         self.plotter = make_plotter((640, 480))
@@ -2846,7 +2857,7 @@ class StereoApp:
             if image is None:  # no render to write
                 order = [n for n in order if n != "render.png"]
             written = await asyncio.get_running_loop().run_in_executor(
-                self._executor, save_all_or_nothing, write, target, order
+                self._executor, self._write_save, write, target, order
             )
         except SaveFailed as exc:
             msg = short_paths(f"save: {exc}; nothing was saved in {label}", target)
@@ -2878,6 +2889,35 @@ class StereoApp:
             self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
             # the lists offer what was just written: its cloud.ply to Show in the 3-D view
             self._refresh_file_lists()
+
+    def _write_save(
+        self, write: Callable[[Path], None], folder: Path, files: Sequence[str]
+    ) -> dict[str, Path]:
+        """:func:`save_all_or_nothing` in the worker thread, unless the server has stopped
+        (:meth:`stop_work` waits for one under way: its files all in place, or none).
+
+        Raises
+        ------
+        SaveFailed
+            The server stopped before the Save began (nothing written).
+        """
+        with self._save_lock:
+            if self._stopped:
+                raise SaveFailed("the server is stopping: nothing was written")
+            return save_all_or_nothing(write, folder, files)
+
+    def stop_work(self) -> None:
+        """The server has stopped: the computations and checks queued are dropped, and the one
+        running is left to the process's end (``gui.main`` ends the process past it,
+        :func:`stereovision.cli.end_past_native_threads`); a Save under way is waited for, so
+        that its folder is whole (or as it was), and one not begun is not begun.
+
+        After Ctrl+C during a computation the server waited for it to finish before the
+        process ended: 135 s of a 3600 x 3000 pair, its "Ctrl+C to stop" seemingly ignored.
+        """
+        self._executor.shutdown(wait=False, cancel_futures=True)
+        with self._save_lock:
+            self._stopped = True
 
     def _render_for_save(self, view: ViewData, camera: Any = None) -> npt.NDArray[np.uint8]:
         """``render.png`` of the pair on show: its 3-D view (the surface, or points in the
