@@ -5630,6 +5630,24 @@ def test_an_emptied_slider_is_said_on_the_page(tmp_path):
     assert app.state.error == "float() argument must be a string or a real number, not 'NoneType'"
 
 
+def test_the_unit_toggle_with_an_emptied_slider_converts_the_others_and_says_it():
+    """The unit toggle with a translation slider the page sent as null raised a TypeError out
+    of its handler half done: the unit was feet, the other sliders' metres read as feet (the
+    view moved) and the captions stayed in metres. The toggle now converts the others and the
+    emptied slider is said, as a slider move says it."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-unit-emptied-slider", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.up = 1.0
+    app.state.forward = None
+    app._on_unit(unit="ft")
+    assert app._unit == "ft" and app.state.up == 3.281 and app.state.forward is None
+    assert app.state.depth_caption.endswith("\u00a0ft") and "m" not in app.state.depth_caption
+    assert app.state.error == "float() argument must be a string or a real number, not 'NoneType'"
+
+
 def test_an_image_sequence_typed_as_a_camera_outside_the_data_folders_is_refused(tmp_path):
     """A pattern's folder is checked against --data like a file: one outside is refused."""
     from stereovision.gui import bundled_data_dir

@@ -3322,7 +3322,13 @@ class StereoApp:
             for name in _TRANSLATIONS:
                 # clamped to the range shown: 5 m is 16.404 ft, past the feet sliders' 16.4
                 # (their thumb stuck at the end); the view is kept below
-                value = round(float(st[name]) * factor, 3)
+                try:
+                    value = round(float(st[name]) * factor, 3)
+                except (TypeError, ValueError):
+                    # an emptied slider is no length in either unit (said below, as a slider
+                    # move says it): it raised here, the toggle half done, the other sliders'
+                    # metres then read as feet and the captions left in metres
+                    continue
                 st[name] = min(max(value, -limit), limit)
             # the sliders' listener sees these values when they are flushed: at this block's
             # end, or (the page's click, itself flushed) after this handler has kept the view
