@@ -5648,6 +5648,48 @@ def test_the_unit_toggle_with_an_emptied_slider_converts_the_others_and_says_it(
     assert app.state.error == "float() argument must be a string or a real number, not 'NoneType'"
 
 
+def test_an_unexpected_error_of_a_computation_or_a_save_is_said_and_frees_the_page(
+    tmp_path, monkeypatch, caplog
+):
+    """An error no handler expected (a bug of ours: IndexError, TypeError) went past the
+    computation's ``except``: the page stayed "computing" under its progress bar for good, and
+    Save and Find floor said "the new pair is being computed"; a Save's said nothing. It is now
+    said in one line, as the CLI says one, its trace in the server's log, and the page works on."""
+    import stereovision.cli as cli
+    import stereovision.gui.app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-unexpected-error", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    shown = app.view
+    compute = gui_app.compute_view
+
+    def broken(*args: Any, **kw: Any) -> Any:
+        raise IndexError("index 3 is out of bounds")
+
+    monkeypatch.setattr(gui_app, "compute_view", broken)
+    app.state.method = "census"
+    _run(app, app.recompute)
+    assert app.state.error == (
+        "internal IndexError: index 3 is out of bounds (please report this) (the page still "
+        "shows fast at full resolution)"
+    )
+    assert (app.state.busy, app.state.status, app.state.method) == (False, "error", "fast")
+    assert app.view is shown and app._page_before is None
+    assert "gui: computing census failed" in caplog.text and "IndexError" in caplog.text
+    monkeypatch.setattr(gui_app, "compute_view", compute)
+
+    def writer(*args: Any, **kw: Any) -> Any:
+        raise TypeError("an odd array")
+
+    monkeypatch.setattr(cli, "write_depth_outputs", writer)
+    app.state.save_dir = str(tmp_path / "out")
+    _run(app, app.save)  # the pair on show is saved, not refused as still computing
+    assert app.state.error == "internal TypeError: an odd array (please report this)"
+    assert not (tmp_path / "out").exists() and app._saving_into == set()
+
+
 def test_an_image_sequence_typed_as_a_camera_outside_the_data_folders_is_refused(tmp_path):
     """A pattern's folder is checked against --data like a file: one outside is refused."""
     from stereovision.gui import bundled_data_dir

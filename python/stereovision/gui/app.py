@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import release_memory
-from stereovision._validate import advice_for, first_line, known_unit
+from stereovision._validate import advice_for, first_line, internal_error, known_unit
 from stereovision.calibration import fit_to_frames
 from stereovision.capture import DEFAULT_READ_TIMEOUT, _camera_device, mask_url_secrets
 from stereovision.gui.sources import (
@@ -1283,6 +1283,26 @@ def _for_the_loop(exc: BaseException, what: str) -> BaseException:
     return out
 
 
+#: What the page's worker thread raises for a failure the page says as it is (bad input, a
+#: file, a pair too large, OpenCV refusing a pair); anything else is a bug (:func:`_as_said`).
+_SAID = (ValueError, OSError, RuntimeError, MemoryError, cv2.error)
+
+
+def _as_said(exc: Exception, what: str) -> Exception:
+    """``exc``, raised by the page's worker thread while ``what`` ("computing census",
+    "saving"), as the page says it: itself when it is one of :data:`_SAID`, else (a bug of
+    ours) a RuntimeError in the CLI's words for one (``internal IndexError: ... (please
+    report this)``), its trace in the server's log.
+
+    Such an error went past the handler's ``except``: a computation's left the page
+    "computing" under its progress bar for good, Save and Find floor then saying "the new pair
+    is being computed"; a Save's, a floor's or a rows check's said nothing at all."""
+    if isinstance(exc, _SAID):
+        return exc
+    log.error("gui: %s failed", what, exc_info=exc)
+    return RuntimeError(internal_error(exc).removeprefix("stereovision: error: "))
+
+
 def _button_and_answer(
     v3: Any, html: Any, text: str, button_id: str, click: Any, answer: str, answer_id: str
 ) -> None:
@@ -2493,9 +2513,10 @@ class StereoApp:
             self._computing = True
             try:
                 view = await loop.run_in_executor(self._executor, work)
-            except (ValueError, OSError, RuntimeError, MemoryError, cv2.error) as exc:
+            except Exception as exc:
                 # MemoryError: the census map's check refused a pair too large for this machine;
                 # cv2.error: an OpenCV reference method on a pair it cannot take.
+                exc = _as_said(exc, f"computing {method}")
                 self._computing = False
                 if gen != self._generation:
                     return  # superseded: the newer request computes (and reports) its own pair
@@ -2588,7 +2609,8 @@ class StereoApp:
 
         try:
             text = await asyncio.get_running_loop().run_in_executor(self._executor, run)
-        except (ValueError, OSError, RuntimeError) as exc:
+        except Exception as exc:
+            exc = _as_said(exc, "checking the rows")
             if self.pair is pair:  # else another pair came meanwhile: not its failure
                 self._fail(exc)
             return
@@ -2636,7 +2658,8 @@ class StereoApp:
 
         try:
             rect = await asyncio.get_running_loop().run_in_executor(self._executor, run)
-        except (ValueError, OSError, RuntimeError) as exc:
+        except Exception as exc:
+            exc = _as_said(exc, "rectifying from features")
             if self.pair is pressed:
                 self._fail(exc)
             return
@@ -2739,7 +2762,8 @@ class StereoApp:
 
         try:
             plane, url, why = await asyncio.get_running_loop().run_in_executor(self._executor, run)
-        except (ValueError, OSError, RuntimeError) as exc:
+        except Exception as exc:
+            exc = _as_said(exc, "finding the floor")
             if self.view is view and self._page_before is None:
                 self._fail(exc)
             return
@@ -2865,8 +2889,8 @@ class StereoApp:
             with self.state:
                 self.state.save_label = msg
             return
-        except (ValueError, OSError, RuntimeError, CliError) as exc:
-            self._fail(exc, target)
+        except Exception as exc:
+            self._fail(exc if isinstance(exc, CliError) else _as_said(exc, "saving"), target)
             return
         finally:
             self._saving_into.discard(target)
