@@ -519,6 +519,14 @@ def test_scene_max_disparity_rule() -> None:
     assert scene_max_disparity(np.full((2, 2), np.nan), width=320) == 80
 
 
+def test_scene_max_disparity_is_exactly_1_1_times_the_gt_max() -> None:
+    """evaluation.md's range is 1.1 x the largest GT disparity rounded up to a multiple of 16: a
+    GT reaching 800 px searches 880, not 896 (1.1 * 800 is 880.0000000000001 in floats)."""
+    for top, want in ((800.0, 880), (1440.0, 1584), (1600.0, 1760), (160.0, 176), (800.5, 896)):
+        gt = np.array([[3.0, top]], np.float32)
+        assert scene_max_disparity(gt, width=4000) == want, top
+
+
 def test_scene_max_disparity_refuses_a_bad_width_or_ndisp(data_dir: Path, tmp_path: Path) -> None:
     """A width of 0 gave 16, an ndisp of NaN or -5 (from calib.txt too) the width's range,
     without a word: each is a ValueError naming the argument, or the file and the key."""

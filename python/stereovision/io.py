@@ -25,6 +25,7 @@ import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
@@ -1615,7 +1616,10 @@ def scene_max_disparity(
     if gt is not None:
         finite = gt[np.isfinite(gt)]
         if finite.size and float(finite.max()) > 0:
-            return round_up16(MAX_DISPARITY_MARGIN * float(finite.max()))
+            # 1.1 x in exact arithmetic: in floats 1.1 * 800 is 880.0000000000001, which
+            # rounded up to 896 where the rule gives 880 (also 1440, 1600, 1760 px ...)
+            margin = Fraction(repr(MAX_DISPARITY_MARGIN)) * Fraction(float(finite.max()))
+            return round_up16(math.ceil(margin))
     if ndisp is not None:
         return round_up16(ndisp)
     return round_up16(width // _WIDTH_FRACTION)
