@@ -1167,6 +1167,28 @@ def test_read_ply_float_colours_with_nan_and_none(tmp_path: Path) -> None:
     assert cols is not None and cols.tolist() == [[255, 255, 255]]
 
 
+def test_read_ply_16_bit_and_signed_colours_do_not_wrap(tmp_path: Path) -> None:
+    """ushort colours (PDAL's PLY of a LAS cloud, 0-65535) wrapped in the uint8 cast: 32768
+    was 0, 65280 was 0, 257 was 1; a short -5 was 251. 16-bit ones are scaled to 0-255, those
+    all within 0-255 kept, negative ones 0."""
+    cases = {
+        ("ushort", "<u2"): (
+            [[65535, 32768, 0], [65280, 257, 12850]],
+            [[255, 128, 0], [254, 1, 50]],
+        ),
+        ("uint", "<u4"): ([[65535, 32768, 0], [65280, 257, 12850]], [[255, 128, 0], [254, 1, 50]]),
+        ("short", "<i2"): ([[-5, 200, 255], [0, 7, 255]], [[0, 200, 255], [0, 7, 255]]),
+    }
+    for (kind, code), (stored, want) in cases.items():
+        props = "property float x\nproperty float y\nproperty float z\n"
+        props += "".join(f"property {kind} {c}\n" for c in ("red", "green", "blue"))
+        fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")] + [(c, code) for c in "rgb"]
+        rec = np.array([(i, 0, 1, *rgb) for i, rgb in enumerate(stored)], fields)
+        (tmp_path / "c.ply").write_bytes(_ply("binary_little_endian", props, 2) + rec.tobytes())
+        _, cols = read_ply(tmp_path / "c.ply")
+        assert cols is not None and cols.tolist() == want, kind
+
+
 def test_write_ply_refuses_a_transposed_colour_image(tmp_path: Path) -> None:
     """(W, H, 3) colours of (H, W, 3) points have the same size: each point got another
     pixel's colour. Two images must have one shape; a flat (N, 3) side pairs by count."""

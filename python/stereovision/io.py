@@ -1356,7 +1356,9 @@ def read_ply(
     Reads the files :func:`write_ply` writes and other ASCII or binary (little- or big-endian)
     PLY files whose first element is ``vertex`` with scalar properties (further elements are
     ignored). Colours of a floating-point type are taken as 0-1 (as some tools write them) and
-    scaled to 0-255, or as 0-255 when any of them is above 1.
+    scaled to 0-255, or as 0-255 when any of them is above 1. Colours of a wider integer type
+    are taken as 0-255 when none is above 255, else as 16-bit 0-65535 (PDAL's ``ushort``
+    colours of a LAS cloud) and scaled to 0-255; negative ones as 0.
 
     Parameters
     ----------
@@ -1453,6 +1455,13 @@ def read_ply(
             # 0-255 then, as Open3D reads float colours (as 0-1 they all came out white)
             top = 1.0 if rgb.size == 0 or float(rgb.max()) <= 1.0 else 255.0
             rgb = np.rint(np.clip(rgb, 0.0, top) * (255.0 / top))
+        elif rgb.dtype != np.uint8:
+            # wider or signed integers wrapped in the uint8 cast (PDAL writes a LAS cloud's
+            # 16-bit colours as ushort: 65535 was 255 but 32768 was 0, 256 was 0, -5 was 251):
+            # 0-255 when none is above 255, else 16-bit 0-65535 scaled to 0-255
+            wide = rgb.astype(np.int64)
+            top = 255.0 if wide.size == 0 or int(wide.max()) <= 255 else 65535.0
+            rgb = np.rint(np.clip(wide, 0, top) * (255.0 / top))
         cols = rgb.astype(np.uint8)
     return pts, cols
 
