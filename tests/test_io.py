@@ -1167,6 +1167,25 @@ def test_read_ply_float_colours_with_nan_and_none(tmp_path: Path) -> None:
     assert cols is not None and cols.tolist() == [[255, 255, 255]]
 
 
+def test_read_ply_bad_count_or_twice_named_property_names_the_file(tmp_path: Path) -> None:
+    """'element vertex abc' was int()'s "invalid literal for int() with base 10", a property
+    named twice NumPy's "field 'x' occurs more than once", -3 "no format or vertex element":
+    none named the file or what was wrong in it."""
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    path = tmp_path / "bad cloud.ply"
+    for count in ("abc", "-3", "2.5"):
+        path.write_bytes(_ply("ascii", xyz, 1).replace(b"vertex 1", f"vertex {count}".encode()))
+        with pytest.raises(ValueError) as err:
+            read_ply(path)
+        assert str(err.value) == (
+            f"PLY file {path}: vertex count '{count}' is not a whole number (>= 0)"
+        )
+    path.write_bytes(_ply("ascii", xyz + "property float x\n", 1) + b"1 2 3 4\n")
+    with pytest.raises(ValueError) as err:
+        read_ply(path)
+    assert str(err.value) == f"PLY file {path}: vertex property 'x' given twice"
+
+
 def test_read_ply_16_bit_and_signed_colours_do_not_wrap(tmp_path: Path) -> None:
     """ushort colours (PDAL's PLY of a LAS cloud, 0-65535) wrapped in the uint8 cast: 32768
     was 0, 65280 was 0, 257 was 1; a short -5 was 251. 16-bit ones are scaled to 0-255, those

@@ -1422,10 +1422,17 @@ def read_ply(
             in_vertex = len(tok) == 3 and tok[1] == "vertex"
             if not in_vertex:
                 raise ValueError(f"PLY file {p}: first element is {tok[1:2]}, expected vertex")
+            # int()'s own "invalid literal" named no file; -3 read as no vertex element
+            if not tok[2].isascii() or not tok[2].isdigit():
+                raise ValueError(
+                    f"PLY file {p}: vertex count {tok[2]!r} is not a whole number (>= 0)"
+                )
             count = int(tok[2])
         elif tok[0] == "property" and in_vertex:
             if len(tok) != 3 or tok[1] not in _PLY_TYPES:
                 raise ValueError(f"PLY file {p}: unsupported vertex property {line!r}")
+            if any(tok[2] == name for name, _ in props):  # NumPy's "occurs more than once"
+                raise ValueError(f"PLY file {p}: vertex property {tok[2]!r} given twice")
             props.append((tok[2], tok[1]))
     if not order or count < 0:
         raise ValueError(f"not a PLY file (no format or vertex element): {p}")
