@@ -1825,6 +1825,42 @@ def test_refuse_an_input_through_a_folder_not_made_yet(tmp_path: Path) -> None:
     refuse_an_input("--plot", tmp_path / "new" / "left.png", inputs)  # another file: accepted
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="links and FIFOs as on POSIX")
+def test_an_output_folder_through_a_link_to_nothing_is_refused_naming_the_link(
+    tmp_path: Path,
+) -> None:
+    """``-o out`` where ``out`` is a link to a moved folder passed check_output_folder (made
+    to refuse before the matching), so the run did its work and then make_folder said
+    "out is a file, not a folder"; of ``out/sub``, "out/sub is a file" (no file at all), and
+    of a folder under a FIFO the same. Both now name the link (or the FIFO) and what it is."""
+    from stereovision.io import check_output_folder
+
+    (tmp_path / "gone").symlink_to(tmp_path / "moved")
+    (tmp_path / "loop1").symlink_to("loop2")
+    (tmp_path / "loop2").symlink_to("loop1")
+    os.mkfifo(tmp_path / "fifo")
+    moved = f"is a link to {tmp_path / 'moved'}, which does not exist"
+    loop = "is a link to loop2, one of a loop of links that never reaches a file"
+    for out, blocker, what in (
+        (tmp_path / "gone", tmp_path / "gone", moved),
+        (tmp_path / "gone" / "sub", tmp_path / "gone", moved),
+        (tmp_path / "loop1" / "sub", tmp_path / "loop1", loop),
+    ):
+        with pytest.raises(ValueError) as refused:
+            check_output_folder(out, "-o")
+        where = "" if out == blocker else f"{blocker} "
+        assert str(refused.value) == f"-o {out}: {where}{what}"
+        with pytest.raises(NotADirectoryError) as err:
+            make_folder(out)
+        assert str(err.value) == f"cannot make the folder {out}: {blocker} {what}"
+    with pytest.raises(NotADirectoryError) as err:
+        make_folder(tmp_path / "fifo" / "sub")
+    assert str(err.value) == (
+        f"cannot make the folder {tmp_path / 'fifo' / 'sub'}: {tmp_path / 'fifo'} is not a folder"
+    )
+    assert sorted(os.listdir(tmp_path)) == ["fifo", "gone", "loop1", "loop2"]  # nothing made
+
+
 def test_check_output_folder_error_classes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A file above the folder is a ValueError naming that file ('is a file, not a folder');
     a folder above it that cannot be written is a PermissionError naming it."""

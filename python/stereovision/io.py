@@ -102,17 +102,33 @@ def make_folder(path: PathLike) -> Path:
     Raises
     ------
     NotADirectoryError
-        If ``path`` or a folder above it is a file.
+        If ``path`` or a folder above it is a file, a FIFO, or a link to nothing or in a loop.
     """
     folder = Path(path)
     try:
         folder.mkdir(parents=True, exist_ok=True)
-    except (FileExistsError, NotADirectoryError):
-        blocker = next((p for p in (folder, *folder.parents) if p.is_file()), folder)
+    except OSError as exc:
+        if exc.errno not in (errno.EEXIST, errno.ENOTDIR, errno.ELOOP):
+            raise
+        # the one in the way, deepest first: a link to nothing (or a FIFO) was not is_file(),
+        # so the folder asked for was named "a file" ("out/sub is a file" of no file at all)
+        blocker = next((p for p in (folder, *folder.parents) if _not_a_folder(p)), None)
+        if blocker is None:  # gone again since (a race): the system's own words
+            raise
         raise NotADirectoryError(
-            f"cannot make the folder {folder}: {blocker} is a file, not a folder"
+            f"cannot make the folder {folder}: {blocker} is {_not_a_folder(blocker)}"
         ) from None
     return folder
+
+
+def _not_a_folder(path: Path) -> str:
+    """What ``path`` is when something other than a folder stands there (``"a file, not a
+    folder"``, a link to nothing or in a loop, ``"not a folder"``), else ``""``."""
+    if path.is_symlink() and not path.exists():
+        return _broken_link(path)
+    if not path.exists() or path.is_dir():
+        return ""
+    return "a file, not a folder" if path.is_file() else "not a folder"
 
 
 def missing_folders(path: PathLike) -> list[Path]:
@@ -234,7 +250,7 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
     Raises
     ------
     ValueError
-        If ``folder``, or a folder above it, is a file.
+        If ``folder``, or a folder above it, is a file or a link to nothing (or in a loop).
     PermissionError
         If the nearest existing folder above it is not writable.
     """
@@ -243,6 +259,9 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
         raise ValueError(f"{flag} {path}: is a file, not a folder")
     above = path
     while not above.exists() and above.parent != above:
+        if above.is_symlink():  # to nothing or in a loop: make_folder refused it after the work
+            where = "" if above == path else f"{above} "
+            raise ValueError(f"{flag} {path}: {where}is {_broken_link(above)}")
         above = above.parent
     if above.exists() and not above.is_dir():
         raise ValueError(f"{flag} {path}: {above} is a file, not a folder")
