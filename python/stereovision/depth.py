@@ -844,7 +844,8 @@ class DepthResult:
         Returns
         -------
         ndarray
-            float32 ``(H, W, 3)``.
+            float32 ``(H, W, 3)``: Z is ``depth`` (and the guesses' own), X and Y are the
+            cloud's (``points`` at ``pixels``, bit for bit).
 
         Raises
         ------
@@ -858,21 +859,33 @@ class DepthResult:
             raise TypeError(f"filled: expected True or False, got {filled!r}")
         if self.depth is None or self.calibration is None:
             raise ValueError(NO_DEPTH.format(what="3-D points"))
-        pts = self.calibration.reproject(self.disparity)
-        keep = np.isfinite(self.depth)
+        cal = self.calibration
+        cal = cal if cal.rectified else cal.rectified_calibration()
+        # Z is ``depth`` itself, X and Y as the cloud computes them: rebuilt from ``disparity``
+        # (clipped to the range) a value measured up to half a pixel past it was 3 % off
+        z = self.depth
         lim = self.limits
         if filled and "max_sigma" not in lim and "max_relative_sigma" not in lim:
-            z = pts[..., 2]
+            z = z.copy()
+            guessed = cal.depth_from_disparity(self.disparity)  # filled pixels have no depth
             # confidence 0 marks a filled disparity; a measured one without a depth was dropped
             # (within sigma_d of infinity, or outside the limits) and stays out
-            guess = ~keep & np.isfinite(z) & (self.confidence == 0)
+            guess = ~np.isfinite(z) & np.isfinite(guessed) & (self.confidence == 0)
             with np.errstate(invalid="ignore"):
                 if "min_depth" in lim:
-                    guess &= z >= lim["min_depth"]
+                    guess &= guessed >= lim["min_depth"]
                 if "max_depth" in lim:
-                    guess &= z <= lim["max_depth"]
-            keep |= guess
-        pts[~keep] = np.nan
+                    guess &= guessed <= lim["max_depth"]
+            z[guess] = guessed[guess]
+        h, w = z.shape
+        k = cal.K1
+        rx, ry, _, _ = _pixel_grids(
+            w, h, float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2])
+        )
+        pts = np.empty((h, w, 3), np.float32)
+        np.multiply(rx.reshape(h, w), z, out=pts[..., 0])  # NaN where z is NaN
+        np.multiply(ry.reshape(h, w), z, out=pts[..., 1])
+        pts[..., 2] = z
         return pts
 
     def filtered(
