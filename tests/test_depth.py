@@ -1399,8 +1399,15 @@ def test_filtered_keeps_limits_inclusive_and_its_cloud_and_maps_its_own() -> Non
     f.confidence[0, 0] = -1.0
     f.left_rectified[0, 0] = 255
     assert k.confidence[0, 0] == 1.0 and k.left_rectified[0, 0, 0] == 0
-    with pytest.raises(ValueError, match="max_sigma: this result has no depth_sigma"):
-        dataclasses.replace(r, depth_sigma=None).filtered(max_sigma=1.0)
+    # and its timings: a stage the caller times on the copy was the original's too
+    f.timings["export"] = 0.25
+    assert k.timings == {} and f.timings == {"export": 0.25}
+    no_sigma = dataclasses.replace(r, depth_sigma=None)
+    with pytest.raises(ValueError, match=r"^max_sigma: this result has no depth_sigma"):
+        no_sigma.filtered(max_sigma=1.0)
+    # the limit given is named (a relative one was told off as max_sigma, never given)
+    with pytest.raises(ValueError, match=r"^max_relative_sigma: this result has no depth_sigma"):
+        no_sigma.filtered(max_relative_sigma=0.1)
 
 
 def test_point_image_guesses_exclude_dropped_pixels_and_keep_the_range_inclusive() -> None:

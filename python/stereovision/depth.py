@@ -953,7 +953,8 @@ class DepthResult:
             if max_sigma is not None or max_relative_sigma is not None:
                 sig = self.depth_sigma
                 if sig is None:
-                    raise ValueError("max_sigma: this result has no depth_sigma")
+                    given = "max_sigma" if max_sigma is not None else "max_relative_sigma"
+                    raise ValueError(f"{given}: this result has no depth_sigma")
                 if max_sigma is not None:
                     keep &= sig <= max_sigma
                 if max_relative_sigma is not None:
@@ -977,6 +978,7 @@ class DepthResult:
             disparity=self.disparity.copy(),
             confidence=self.confidence.copy(),
             left_rectified=None if self.left_rectified is None else self.left_rectified.copy(),
+            timings=dict(self.timings),  # the same dict: a stage timed on one was on both
             depth=np.where(keep, z, nan).astype(np.float32),
             depth_sigma=None if sigma is None else sigma.astype(np.float32),
             points=points,
