@@ -1335,6 +1335,26 @@ def test_an_empty_or_unreachable_range_given_is_named() -> None:
         sv.depth_map(left, left, max_disparity=-64, min_disparity=-80)
 
 
+def test_a_negative_min_disparity_with_the_fused_method_names_the_methods_that_take_it() -> None:
+    """The fused map's graph-matching and Hopfield channels search from 0 px: depth_map's
+    default method refused min_disparity=-2 in their words ("min_disparity must be a
+    non-negative number of pixels, got -2.0"), naming neither the method nor those that take
+    it, which its docstring did not say either."""
+    h, w = 64, 96
+    left = _texture(h, w)
+    right = _shift(left, 6.3)
+    with pytest.raises(
+        ValueError,
+        match=r"^min_disparity: method='fused' searches from 0 px .*, got -2; method='gabor', "
+        r"'census' or 'fast' search a negative range$",
+    ):
+        sv.depth_map(left, right, max_disparity=16, min_disparity=-2)
+    for method in ("gabor", "census", "fast"):
+        res = sv.depth_map(left, right, method=method, max_disparity=16, min_disparity=-2)
+        assert res.min_disparity == -2
+        assert abs(float(np.nanmedian(res.disparity)) - 6.3) < 0.3
+
+
 def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
     from stereovision.depth import estimate_max_disparity
 

@@ -1361,7 +1361,8 @@ def depth_map(
         (:func:`estimate_max_disparity`: the larger of ORB matches' 99th percentile and a
         coarse SGBM map's 99.5th, times 1.15, a multiple of 16).
     min_disparity : float
-        Smallest disparity searched (default 0).
+        Smallest disparity searched (default 0). Negative for ``"gabor"``, ``"census"`` and
+        ``"fast"`` only: ``"fused"``'s graph-matching and Hopfield channels search from 0.
     fill : bool, optional
         Fill holes: first with the plane fitted to the measured pixels of the hole's colour
         segment, where one fits (:func:`stereovision.matching.planes.fill_planes`), then with
@@ -1424,7 +1425,7 @@ def depth_map(
         a parameter the method does not take (the message names those it does);
         a range no pixel can match in (``min_disparity`` not below the image width, or
         ``max_disparity`` not above minus it) or one float32 cannot tell apart (10 to
-        10.0000001).
+        10.0000001), a negative ``min_disparity`` with ``method="fused"``.
     TypeError
         A switch that is no bool: ``fill`` or ``refine`` (which also take None),
         ``return_channels``, ``cloud`` or ``"fused"``'s ``semi_global``, ``check_members`` or
@@ -1556,6 +1557,14 @@ def depth_map(
         raise unreachable
     if max_disparity - min_disparity >= gl.shape[1]:
         raise _range_too_wide(max_disparity - min_disparity, gl.shape[1], min_disparity)
+    if method == "fused" and min_disparity < 0:
+        # the sparse channels' own error ("must be a non-negative number of pixels, got -2.0")
+        # named neither the method nor the ones that search such a range
+        raise ValueError(
+            f"min_disparity: method='fused' searches from 0 px (its graph-matching and Hopfield "
+            f"channels take no negative disparity), got {_px(min_disparity)}; method='gabor', "
+            "'census' or 'fast' search a negative range"
+        )
     stage("prepare")
     channels: DepthChannels | None = {} if return_channels else None
     if refine is None:
