@@ -1939,6 +1939,43 @@ def test_a_camera_info_topic_without_messages_is_no_calibration(cones: Any, tmp_
         np.testing.assert_array_equal(cam.read().left, cones.left)
 
 
+def test_the_camera_info_of_uncalibrated_cameras_is_no_calibration(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A driver without a calibration file (usb_cam, through camera_info_manager) publishes
+    its camera_info all zeros but the size, which ROS takes as uncalibrated (``K[0] == 0``).
+    ``calibration()`` refused it ("rectification_matrix does not hold a rotation"), so
+    ``stream --from-bag`` and ``info`` failed (exit 2) on a bag that reads whole; it is no
+    calibration now (None), as a bag without camera_info, and the commands say why."""
+    zero = {"image_size": (450, 375), "distortion_model": "", "D": np.zeros(0),
+            "K": np.zeros((3, 3)), "R": np.zeros((3, 3)), "P": np.zeros((3, 4))}  # fmt: skip
+    calibrated = parse_ros_camera_info(_raw_rig().to_ros()[1])
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, cones.right) for k in range(2)]
+    for flavour, name, infos in (
+        ("ros2", "rig", (zero, zero)),
+        ("ros1", "rig.bag", (zero, zero)),
+        ("ros2", "half", (zero, calibrated)),  # one camera uncalibrated: no rig either
+        ("ros2", "rect", (zero, zero)),
+    ):
+        topics = ("/stereo/left/image_rect", "/stereo/right/image_rect") if name == "rect" else (
+            LEFT, RIGHT)  # fmt: skip
+        (tmp_path / flavour).mkdir(exist_ok=True)
+        bag = write_bag(tmp_path / flavour / name, frames, flavour=flavour, infos=infos,
+                        topics=topics)  # fmt: skip
+        with BagCamera(bag) as cam:
+            assert None not in cam.info_topics.values()
+            assert cam.calibration() is None, (flavour, name)
+    bag = tmp_path / "ros2" / "rig"
+    code, out, err = run("info", str(bag))
+    assert code == 0, err
+    assert "camera_info say the cameras are uncalibrated (K = 0)" in out
+    code, out, err = run("stream", "--from-bag", str(bag), "--no-display", "--json",
+                         "--method", "gabor", "--max-disparity", "64", "--no-check")  # fmt: skip
+    assert code == 0, err
+    assert json.loads(out.strip().splitlines()[-1])["frames"] == 2
+    assert "are uncalibrated (K = 0): disparity only" in err
+
+
 def test_small_reader_cases_a_third_mutation_round_found_untested(
     cones: Any, tmp_path: Path
 ) -> None:

@@ -1443,7 +1443,13 @@ def cmd_info(args: argparse.Namespace) -> int:
     with cam:
         print(cam.summary())
         calib = cam.calibration()
-    if calib is None:
+    if calib is None and None not in cam.info_topics.values():
+        # camera_info there, all zeros: "no camera_info" was not so
+        print(
+            "its camera_info say the cameras are uncalibrated (K = 0): give the rig's "
+            "calibration to the command that reads the bag (stream --from-bag BAG --calib RIG)"
+        )
+    elif calib is None:
         print(
             "no camera_info beside the image topics: give the rig's calibration to the command "
             "that reads the bag (stream --from-bag BAG --calib RIG)"

@@ -1615,7 +1615,10 @@ class BagCamera(PairSource):
 
     def calibration(self) -> Any:
         """The rig's calibration from the bag's ``camera_info`` messages (the first of each
-        side), in metres; None when the bag has no ``camera_info`` beside both image topics.
+        side), in metres; None when the bag has no ``camera_info`` beside both image topics,
+        or one of them is an uncalibrated camera's (``K[0] = 0``: ROS's own test,
+        ``camera_info_manager``'s ``isCalibrated``; a driver without a calibration file, such as
+        ``usb_cam``, publishes all zeros).
 
         For raw topics it is the rig of :meth:`Calibration.from_ros
         <stereovision.calibration.Calibration.from_ros>`; for rectified topics (``image_rect``)
@@ -1659,6 +1662,10 @@ class BagCamera(PairSource):
                 for n in "kdrp"
             )
             K, R, P = K.reshape(3, 3), R.reshape(3, 3), P.reshape(3, 4)
+            if K[0, 0] == 0:
+                # an uncalibrated camera, as ROS tells it: its zeros were refused ("does not
+                # hold a rotation"), so stream, info and gui failed on a bag that reads whole
+                return None
             roi = msg.roi
             size = (int(msg.width), int(msg.height))
             # ROS: a roi of all zeros is the full image; a zero width or height alone is none

@@ -1404,6 +1404,12 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 raise
             if calib is not None:
                 print(f"calibration: the bag's {' and '.join(cam.info_topics.values())}", file=log)
+            elif None not in cam.info_topics.values():  # camera_info of uncalibrated cameras
+                print(
+                    f"calibration: none; the bag's {' and '.join(cam.info_topics.values())} say "
+                    "the cameras are uncalibrated (K = 0): disparity only (--calib RIG for depth)",
+                    file=log,
+                )
     bag = None
     report: StreamReport | None = None  # None after the try: an error or interrupt is raised
     close_error: str | None = None  # the bag could not be finished (a full disk)
