@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -827,3 +828,42 @@ def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
     with BagWriter(tmp_path / "own_tree", points=False, tf=False) as bag:
         bag.write(res, stamp, ground=plane)
     assert "/tf" not in _read(tmp_path / "own_tree")
+
+
+def test_keywords_that_make_a_bag_ros_cannot_use_are_refused(kitti: tuple, tmp_path: Path) -> None:
+    """A prefix that gives no ROS 2 topic name (``my-rig``: rclcpp refuses it, so ``ros2 bag
+    play`` could not publish the bag), a frame name tf2 refuses (ROS 1's leading ``/``, empty,
+    None written as "None"), the optical frame named as the floor frame (tf2 ignores a frame's
+    transform to itself), and flags or a result of another type were all taken, as were
+    BagCamera's ``realtime="no"`` (played in real time) and ``max_skew_ms=True`` (1 ms). Each
+    is refused by name now, before any folder is made."""
+    from stereovision.rosbag import BagCamera, BagWriter
+
+    run = tmp_path / "run"
+    for kw, error, words in (
+        ({"prefix": "my-rig"}, ValueError, "prefix: 'my-rig' gives no ROS 2 topic name"),
+        ({"prefix": "stereo cam/x"}, ValueError, "'stereo cam': each part is letters"),
+        ({"prefix": "/robot/2cams"}, ValueError, "'2cams': each part"),
+        ({"prefix": "a//b"}, ValueError, "'': each part"),
+        ({"prefix": None}, TypeError, "prefix: expected a topic namespace"),
+        ({"frame_id": "/stereo_left_optical"}, ValueError, "frame_id: expected a tf frame name"),
+        ({"frame_id": None}, ValueError, "got None"),
+        ({"scan_frame_id": ""}, ValueError, "scan_frame_id: expected a tf frame name"),
+        ({"scan_frame_id": "stereo_left_optical"}, ValueError, "are one frame"),
+        ({"points": "no"}, TypeError, "points: expected True or False, got 'no'"),
+        ({"tf": 0}, TypeError, "tf: expected True or False"),
+    ):
+        with pytest.raises(error, match=re.escape(words)):
+            BagWriter(run, **kw)
+        assert not run.exists(), kw
+    with BagWriter(run, prefix="/robot_1/stereo/", frame_id="cam_1", points=False) as bag:
+        for bad in (kitti[0].depth, None):
+            with pytest.raises(TypeError, match="result: expected a DepthResult, got"):
+                bag.write(bad, 1)
+        bag.write(kitti[0], 1)
+    assert "/robot_1/stereo/depth" in _read(run)
+    with pytest.raises(TypeError, match="realtime: expected True or False, got 'no'"):
+        BagCamera(run, realtime="no")
+    for skew in (True, "5"):
+        with pytest.raises(ValueError, match="max_skew_ms: expected a number >= 0"):
+            BagCamera(run, max_skew_ms=skew)

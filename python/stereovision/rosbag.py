@@ -140,6 +140,45 @@ def _stamp(stamp_ns: Any) -> int:
     return stamp
 
 
+#: A part of a ROS 2 topic name (rcl's rule): letters, digits and underscores, no digit first.
+_TOPIC_PART = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _flag(value: object, name: str) -> bool:
+    """``value`` if it is True or False, else a TypeError naming it: ``bool("no")`` is True."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected True or False, got {value!r}")
+    return bool(value)
+
+
+def _frame_name(value: object, name: str) -> str:
+    """``value`` as a tf frame name, or a ValueError naming it: tf2 refuses an empty name and
+    one with a leading ``/`` (ROS 1's habit), so RViz could place none of the bag's messages;
+    ``str(None)`` made a frame named "None"."""
+    if not isinstance(value, str) or not value or value.startswith("/"):
+        raise ValueError(
+            f"{name}: expected a tf frame name (not empty, no leading '/', which tf2 refuses), "
+            f"got {value!r}"
+        )
+    return value
+
+
+def _topic_prefix(prefix: object) -> str:
+    """``prefix`` as the bag's topic namespace (``"/stereo"``, ``""`` for none), or an error
+    naming it: a part ROS 2 does not take in a topic name (``my-rig``, ``stereo cam``,
+    ``2cams``) made a bag ``ros2 bag play`` cannot publish (rclcpp refuses the name)."""
+    if not isinstance(prefix, str):
+        raise TypeError(f"prefix: expected a topic namespace such as '/stereo', got {prefix!r}")
+    parts = prefix.strip("/").split("/") if prefix.strip("/") else []
+    bad = [part for part in parts if not _TOPIC_PART.fullmatch(part)]
+    if bad:
+        raise ValueError(
+            f"prefix: {prefix!r} gives no ROS 2 topic name ({bad[0]!r}: each part is letters, "
+            "digits and underscores, not starting with a digit)"
+        )
+    return "/" + "/".join(parts) if parts else ""
+
+
 def _sqlite(writer: Any) -> sqlite3.Connection | None:
     """A rosbags writer's database connection (its sqlite storage), None for another storage."""
     conn = getattr(getattr(writer, "storage", None), "conn", None)
@@ -177,6 +216,12 @@ ros2_static_transform>`.
 
     Raises
     ------
+    ValueError
+        If ``prefix`` gives no ROS 2 topic name (a part other than letters, digits and
+        underscores, or starting with a digit), ``frame_id`` or ``scan_frame_id`` is no tf
+        frame name (empty, or a leading ``/``), or the two are one frame.
+    TypeError
+        If ``points`` or ``tf`` is not True or False, or ``prefix`` is not a string.
     FileExistsError
         If ``path`` exists.
     FileNotFoundError, NotADirectoryError
@@ -203,6 +248,19 @@ ros2_static_transform>`.
         tf: bool = True,
     ) -> None:
         self.path = Path(path)
+        # checked before the folder is made: a bad keyword left an empty bag folder behind
+        self.prefix = _topic_prefix(prefix)
+        self.frame_id = _frame_name(frame_id, "frame_id")
+        self.scan_frame_id = _frame_name(scan_frame_id, "scan_frame_id")
+        if self.scan_frame_id == self.frame_id:
+            # the optical frame is placed under the floor frame (/tf), and the scan is in the
+            # floor's axes: as one frame, tf2 ignores the transform and the scan is misplaced
+            raise ValueError(
+                f"frame_id and scan_frame_id are one frame ({frame_id!r}): the camera's optical "
+                "frame stands in the floor frame, so they need two names"
+            )
+        self.points = _flag(points, "points")
+        self.tf = _flag(tf, "tf")
         if self.path.exists():
             raise FileExistsError(f"bag folder already exists: {self.path} (choose a new one)")
         if self.path.parent.exists() and not self.path.parent.is_dir():
@@ -213,11 +271,6 @@ ros2_static_transform>`.
         if not self.path.parent.is_dir():
             raise FileNotFoundError(f"bag folder's parent does not exist: {self.path.parent}")
         writer_cls, self._types = _rosbags()
-        self.prefix = "/" + prefix.strip("/") if prefix.strip("/") else ""
-        self.frame_id = str(frame_id)
-        self.points = bool(points)
-        self.scan_frame_id = str(scan_frame_id)
-        self.tf = bool(tf)
         self.messages = 0
         #: Whole frames the bag holds (as :attr:`messages`, read back after a rollback).
         self.frames = 0
@@ -509,7 +562,12 @@ ros2_static_transform>`.
             since the last commit when sqlite rolls its transaction back; the writer's counts
             (and so metadata.yaml, :attr:`messages` and :attr:`frames`) are those the database
             holds.
+        TypeError
+            If ``result`` is not a depth result.
         """
+        if not (hasattr(result, "depth") and hasattr(result, "calibration")):
+            # an image or None gave "'numpy.ndarray' object has no attribute 'depth'"
+            raise TypeError(f"result: expected a DepthResult, got {type(result).__name__}")
         if result.depth is None or result.calibration is None:
             raise ValueError("a bag holds depth: compute the result with a calibration")
         stamp = _stamp(stamp_ns)
@@ -1156,7 +1214,10 @@ class BagCamera(PairSource):
         If ``path`` does not exist.
     ValueError
         If it is not a bag, a given topic is not an image topic of the bag, or the topics
-        cannot be found (the bag's image topics are listed).
+        cannot be found (the bag's image topics are listed); a ``max_skew_ms`` that is not a
+        number from 0 to :data:`MAX_SKEW_MS`.
+    TypeError
+        If ``realtime`` is not True or False.
     ImportError
         Without the ``rosbags`` package.
     """
@@ -1181,11 +1242,15 @@ class BagCamera(PairSource):
             self.path = self.path.parent  # a file of a ROS 2 bag (its .db3, .mcap or metadata)
         if (left_topic is None) != (right_topic is None):
             raise ValueError("give both the left and the right topic, or neither")
-        if max_skew_ms is not None and not (math.isfinite(max_skew_ms) and max_skew_ms >= 0):
+        if max_skew_ms is not None and not (
+            real_number(max_skew_ms) and math.isfinite(max_skew_ms) and max_skew_ms >= 0
+        ):  # "5" was TypeError's "must be real number, not str", True taken as 1 ms
             raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
         if max_skew_ms is not None and max_skew_ms > MAX_SKEW_MS:
             raise ValueError(f"max_skew_ms: expected at most {MAX_SKEW_MS:g}, got {max_skew_ms!r}")
+        skew = None if max_skew_ms is None else float(max_skew_ms)
         self.requested_size = parse_size(image_size, "image_size")
+        realtime = _flag(realtime, "realtime")  # bool("no") played the bag in real time
         try:
             reader = _open_reader(self.path)
         except (ImportError, _UnfinishedBagError):
@@ -1193,7 +1258,7 @@ class BagCamera(PairSource):
         except Exception as exc:  # rosbags' errors name no common base class
             raise ValueError(f"{self.path} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
         self._reader: Any = reader
-        self.realtime = bool(realtime)
+        self.realtime = realtime
         self.skipped = 0
         self._clock: Any = time.monotonic  # the wall clock and the wait (tests replace them)
         self._sleep: Any = time.sleep
@@ -1201,7 +1266,7 @@ class BagCamera(PairSource):
         self._peeked: deque[tuple[int, Any, int, Any]] = deque()
         self._origin: int | None = None  # the bag's start (_start_ns)
         try:
-            self._setup(left_topic, right_topic, max_skew_ms)
+            self._setup(left_topic, right_topic, skew)
         except BaseException:
             self.close()
             raise
