@@ -1976,6 +1976,43 @@ def test_the_camera_info_of_uncalibrated_cameras_is_no_calibration(
     assert "are uncalibrated (K = 0): disparity only" in err
 
 
+def test_a_topic_recorded_with_two_types_is_listed_with_both(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A ROS 1 bag whose ``/status`` was published with two types (two connections, as
+    ``rosbag record -a`` keeps them): rosbags' summary gives that topic no type (None), and
+    ``info`` of the whole bag (``BagCamera.summary``) was "internal TypeError: unsupported
+    format string passed to NoneType.__format__". The topic is listed with both types."""
+    from rosbags.rosbag1 import Writer
+
+    ts = get_typestore(Stores.ROS1_NOETIC)
+    t = ts.types
+    bag = tmp_path / "mixed.bag"
+    with Writer(bag) as w:
+        images = {
+            s: w.add_connection(s, "sensor_msgs/msg/Image", typestore=ts) for s in (LEFT, RIGHT)
+        }
+        status = [w.add_connection("/status", f"std_msgs/msg/{n}", typestore=ts)
+                  for n in ("String", "Int32")]  # fmt: skip
+        for k in range(2):
+            st = T0 + k * PERIOD_NS
+            stamp = t["builtin_interfaces/msg/Time"](sec=st // 10**9, nanosec=st % 10**9)
+            header = t["std_msgs/msg/Header"](seq=k, stamp=stamp, frame_id="cam")
+            for topic, img in ((LEFT, cones.left), (RIGHT, cones.right)):
+                msg = t["sensor_msgs/msg/Image"](header=header, **_image_fields(img, "bgr8"))
+                w.write(images[topic], st, ts.serialize_ros1(msg, "sensor_msgs/msg/Image"))
+            said = (t["std_msgs/msg/String"](data="ok"), t["std_msgs/msg/Int32"](data=k))
+            for conn, msg in zip(status, said, strict=True):
+                w.write(conn, st, ts.serialize_ros1(msg, conn.msgtype))
+    code, out, err = run("info", str(bag))
+    assert code == 0, err
+    line = next(ln for ln in out.splitlines() if ln.startswith("  /status"))
+    assert "std_msgs/msg/Int32 or std_msgs/msg/String" in line and " 4 msgs " in line
+    with BagCamera(bag) as cam:
+        assert "<- left" in cam.summary()
+        np.testing.assert_array_equal(cam.read().left, cones.left)
+
+
 def test_small_reader_cases_a_third_mutation_round_found_untested(
     cones: Any, tmp_path: Path
 ) -> None:

@@ -871,8 +871,11 @@ def _topic_lines(path: Path, reader: Any, roles: dict[str, str]) -> str:
             if topic in unknown
             else (f"{info.msgcount:7d}", f"{_rate(info.msgcount, reader):7.2f}")
         )
+        # a topic recorded with two types (a ROS 1 bag's connections, or split pieces) has none
+        # in rosbags' summary: None's format failed ("internal TypeError", info of a whole bag)
+        msgtype = info.msgtype or " or ".join(sorted({c.msgtype for c in info.connections}))
         lines.append(
-            f"  {topic:<{width}}  {info.msgtype:<31} {count} msgs {rate} Hz{roles.get(topic, '')}"
+            f"  {topic:<{width}}  {msgtype:<31} {count} msgs {rate} Hz{roles.get(topic, '')}"
         )
     return "\n".join(lines)
 
