@@ -1446,7 +1446,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     if calib is None and None not in cam.info_topics.values():
         # camera_info there, all zeros: "no camera_info" was not so
         print(
-            "its camera_info say the cameras are uncalibrated (K = 0): give the rig's "
+            "its camera_info say a camera is uncalibrated (K = 0): give the rig's "
             "calibration to the command that reads the bag (stream --from-bag BAG --calib RIG)"
         )
     elif calib is None:

@@ -1407,7 +1407,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             elif None not in cam.info_topics.values():  # camera_info of uncalibrated cameras
                 print(
                     f"calibration: none; the bag's {' and '.join(cam.info_topics.values())} say "
-                    "the cameras are uncalibrated (K = 0): disparity only (--calib RIG for depth)",
+                    "a camera is uncalibrated (K = 0): disparity only (--calib RIG for depth)",
                     file=log,
                 )
     bag = None
