@@ -278,6 +278,7 @@ def test_surface_mesh_errors(result):
         render.surface_mesh(result, step=0)
     empty = replace(
         result,
+        depth=np.full_like(result.depth, np.nan),
         points=np.zeros((0, 3), np.float32),
         colors=np.zeros((0, 3), np.uint8),
         pixels=np.zeros((0, 2), np.int32),
@@ -1334,12 +1335,39 @@ def test_render_outputs_writes_nothing_for_an_empty_cloud(result, tmp_path):
 
     empty = replace(
         result,
+        depth=np.full_like(result.depth, np.nan),
         points=np.zeros((0, 3), np.float32),
         colors=np.zeros((0, 3), np.uint8),
         pixels=np.zeros((0, 2), np.int32),
     )
     assert render.render_outputs(empty, tmp_path) == {}
     assert not (tmp_path / "render.png").exists()
+
+
+def test_a_result_without_its_cloud_is_rendered_from_its_depth_map(result, mesh, tmp_path):
+    """A ``depth_map(cloud=False)`` result (the stream's) has a depth map but no ``points``:
+    its surface was refused as "the matcher found no depth in this pair" and render_outputs
+    wrote nothing. Its points are rebuilt from the depth map, as ``to_ply`` does."""
+    from dataclasses import replace
+
+    no_cloud = replace(
+        result,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+    )
+    rebuilt = render.surface_mesh(no_cloud)
+    assert rebuilt.n_points == mesh.n_points == syn.W * syn.H - 100
+    np.testing.assert_allclose(rebuilt.points, mesh.points, rtol=1e-6, atol=1e-6)
+    np.testing.assert_array_equal(rebuilt.faces, mesh.faces)
+    np.testing.assert_array_equal(rebuilt.point_data["RGB"], mesh.point_data["RGB"])
+    np.testing.assert_array_equal(
+        rebuilt.active_texture_coordinates, mesh.active_texture_coordinates
+    )
+    written = render.render_outputs(no_cloud, tmp_path / "no_cloud")
+    assert set(written) == {"render.png"}
+    full = render.render_outputs(result, tmp_path / "full")["render.png"]
+    np.testing.assert_array_equal(cv2.imread(str(written["render.png"])), cv2.imread(str(full)))
 
 
 def test_render_png_and_view_screenshots_keep_red_red(tmp_path):

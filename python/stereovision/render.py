@@ -727,10 +727,28 @@ def _pv() -> Any:
     return pv
 
 
+def _cloud_of(
+    result: DepthResult,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8], npt.NDArray[np.int32]]:
+    """``(points, colors, pixels)`` of ``result``, rebuilt from its depth map for a
+    ``depth_map(cloud=False)`` result (empty ``points``, as ``DepthResult.to_ply`` rebuilds
+    them): its surface was refused as "the matcher found no depth" and render.png skipped."""
+    points, colors, pixels = result.points, result.colors, result.pixels
+    calib, depth = result.calibration, result.depth
+    if len(points) == 0 and calib is not None and depth is not None:
+        from stereovision.depth import _cloud
+
+        left = result.left_rectified
+        if left is None or left.ndim != 3:  # black, as DepthResult._cloud_points colours it
+            left = np.zeros((*depth.shape, 3), np.uint8)
+        points, colors, pixels = _cloud(depth, calib, left)
+    return points, colors, pixels
+
+
 def _check_result(result: DepthResult) -> None:
     if result.depth is None or result.calibration is None:
         raise ValueError("no 3-D points: the depth result has no calibration")
-    if len(result.points) == 0:
+    if not np.isfinite(result.depth).any():
         raise ValueError("empty point cloud: the matcher found no depth in this pair")
 
 
@@ -749,7 +767,8 @@ def surface_mesh(
     Parameters
     ----------
     result : DepthResult
-        A result computed with a calibration (metric points).
+        A result computed with a calibration (metric points); of ``depth_map(cloud=False)``
+        too (its points are rebuilt from the depth map, as ``to_ply`` does).
     step : int
         Pixel stride of the vertex grid (1 = every pixel; 2 = a quarter of the vertices).
     max_jump : float
@@ -787,13 +806,14 @@ def surface_mesh(
         raise ValueError(f"max_jump must be positive, got {max_jump!r}")
     max_jump = jump
     h, w = result.disparity.shape[:2]
-    xs, ys = result.pixels[:, 0], result.pixels[:, 1]
+    points, colors, pixels = _cloud_of(result)
+    xs, ys = pixels[:, 0], pixels[:, 1]
     on_grid = (xs % step == 0) & (ys % step == 0)
     sel = np.nonzero(on_grid)[0]
     gh, gw = (h + step - 1) // step, (w + step - 1) // step
     index = np.full((gh, gw), -1, dtype=np.int64)
     index[ys[sel] // step, xs[sel] // step] = np.arange(len(sel))
-    pts = result.points[sel].astype(np.float32)
+    pts = points[sel].astype(np.float32)
     z = pts[:, 2].astype(np.float64)
     a, b = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
     c, d = index[1:, :-1].ravel(), index[1:, 1:].ravel()
@@ -807,7 +827,7 @@ def surface_mesh(
     u = (xs[sel] + 0.5) / w
     v = 1.0 - (ys[sel] + 0.5) / h
     mesh.active_texture_coordinates = np.stack([u, v], axis=1).astype(np.float32)
-    mesh.point_data["RGB"] = result.colors[sel]
+    mesh.point_data["RGB"] = colors[sel]
     img = result.left_rectified
     if img is not None:
         # a grey (H, W) image has no channels to reverse: [..., ::-1] mirrored its columns
@@ -1258,7 +1278,8 @@ def render_outputs(result: DepthResult, out_dir: str | os.PathLike[str]) -> dict
     dict
         ``{"render.png": path}``, or ``{}`` when there is nothing to render.
     """
-    if result.depth is None or result.calibration is None or len(result.points) == 0:
+    # a depth_map(cloud=False) result has no points but a depth map to build them from
+    if result.depth is None or result.calibration is None or not np.isfinite(result.depth).any():
         return {}
     return write_render(render_result(result), out_dir)
 
