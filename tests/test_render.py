@@ -1137,6 +1137,34 @@ def test_apply_camera_without_intrinsics_resets_the_window_centre():
         plotter.close()
 
 
+def test_apply_camera_puts_a_parallel_view_back_in_perspective(result, mesh):
+    """A plotter left in parallel projection (a :class:`render.CameraState` of an orthographic
+    view applied, pyvista's ``enable_parallel_projection``) stayed orthographic under
+    apply_camera: the controls' view ignored the intrinsics' view angle, and a zero-control
+    view was no longer the left image."""
+    intr = render.Intrinsics.from_result(result)
+    expected = render.render_view(mesh, intrinsics=intr)
+    plotter = render.make_plotter((intr.width, intr.height))
+    try:
+        render.add_geometry(plotter, mesh)
+        state = render.CameraState(
+            (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, -1.0, 0.0), 30.0, parallel_projection=True
+        )
+        state.apply(plotter, points=mesh.points)
+        render.apply_camera(
+            plotter,
+            CameraControls(),
+            intrinsics=intr,
+            focal_distance=render.median_depth(mesh),
+            points=mesh.points,
+        )
+        assert not plotter.camera.GetParallelProjection()
+        shown = plotter.screenshot(return_img=True)[..., :3]
+    finally:
+        plotter.close()
+    np.testing.assert_array_equal(shown, expected)
+
+
 def test_apply_camera_survives_the_window_being_shown():
     """``view``'s window: pyvista's show() resets a camera not marked as set to the scene's
     bounds, throwing the controls' pose away."""

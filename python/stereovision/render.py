@@ -390,7 +390,7 @@ def apply_camera(
     focal_distance: float = _DEFAULT_FOCAL_DISTANCE,
     points: npt.ArrayLike | None = None,
 ) -> None:
-    """Place ``plotter``'s camera at the pose of ``controls``.
+    """Place ``plotter``'s camera at the pose of ``controls``, in perspective.
 
     Parameters
     ----------
@@ -415,6 +415,8 @@ def apply_camera(
     cam.position = tuple(pos)
     cam.focal_point = tuple(pos + focal_distance * rot[:, 2])
     cam.up = tuple(-rot[:, 1])
+    # a perspective view: one left orthographic (CameraState.apply) ignored the view angle
+    cam.SetParallelProjection(False)
     if intrinsics is not None:
         fy = intrinsics.focal_y
         cam.view_angle = math.degrees(2 * math.atan(intrinsics.height / (2 * fy)))
