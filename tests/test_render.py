@@ -1358,6 +1358,37 @@ def test_render_result_max_side_bounds_the_longer_side(result):
         render.render_result(result, max_side=15)
 
 
+def test_render_result_of_a_big_image_meshes_about_a_vertex_per_picture_pixel(
+    result, mesh, monkeypatch
+):
+    """render.png is at most max_side pixels, but a big image was meshed at every pixel: a
+    3000 x 2000 result took 52-70 s and 2.1 GB for its 1024 px picture. An image of at least
+    twice max_side is meshed every ``longer side // max_side`` pixels, the texture whole; a
+    smaller one keeps every vertex."""
+    drawn = []
+    render_view = render.render_view
+
+    def spy(geometry, *args, **kwargs):
+        drawn.append(geometry.n_points)
+        return render_view(geometry, *args, **kwargs)
+
+    monkeypatch.setattr(render, "render_view", spy)
+    small = render.render_result(result, max_side=40)  # 160 px wide: every 4th pixel
+    assert small.shape == (30, 40, 3)
+    assert drawn == [render.surface_mesh(result, step=4).n_points] == [40 * 30 - 3 * 3]
+    controls = render.orbit_controls(
+        render.RENDER_YAW_DEG, render.RENDER_PITCH_DEG, render.median_depth(mesh)
+    )
+    whole = render_view(
+        mesh, controls, intrinsics=render.Intrinsics.from_result(result).scaled(0.25)
+    ).astype(np.int16)
+    # the same picture but for edges: far closer than the full mesh's picture one pixel off
+    off = np.abs(small - whole).max(axis=-1).mean()
+    assert off < 0.25 * np.abs(whole - np.roll(whole, 1, axis=1)).max(axis=-1).mean()
+    render.render_result(result, max_side=81)  # under twice: every pixel
+    assert drawn[1] == mesh.n_points == syn.W * syn.H - 100
+
+
 def test_render_outputs_writes_nothing_for_an_empty_cloud(result, tmp_path):
     from dataclasses import replace
 
