@@ -1012,6 +1012,38 @@ def _lit_centroids(img: np.ndarray, expected: np.ndarray) -> np.ndarray:
     return np.array(found)
 
 
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        ((0.0, 79.5, 59.5, 160, 120), "f: expected a positive focal length in pixels, got 0"),
+        ((-150, 79.5, 59.5, 160, 120), "f: expected a positive focal length in pixels, got -150"),
+        ((150.0, 79.5, 59.5, 160, 120, -1), "fy: expected a positive focal length in pixels"),
+        ((math.nan, 79.5, 59.5, 160, 120), "f: expected a finite number, got nan"),
+        ((150.0, math.inf, 59.5, 160, 120), "cx: expected a finite number, got inf"),
+        ((150.0, 79.5, None, 160, 120), "cy: expected a finite number, got None"),
+        ((150.0, 79.5, 59.5, -5, 120), "width: expected a whole number of pixels >= 1, got -5"),
+        ((150.0, 79.5, 59.5, 0, 120), "width: expected a whole number of pixels >= 1, got 0"),
+        (
+            (150.0, 79.5, 59.5, 160.7, 120),
+            "width: expected a whole number of pixels >= 1, got 160.7",
+        ),
+        (
+            (150.0, 79.5, 59.5, 160, True),
+            "height: expected a whole number of pixels >= 1, got True",
+        ),
+    ],
+)
+def test_intrinsics_refuse_a_camera_that_cannot_be_rendered(args, said):
+    """Unchecked, a width of -5 crashed the process in VTK's allocation (std::bad_alloc), a
+    width or focal length of 0 was a ZeroDivisionError at the render, a negative focal length
+    rendered a mirrored picture and NaN an empty one, without a word."""
+    with pytest.raises(ValueError, match=rf"^Intrinsics: {re.escape(said)}"):
+        render.Intrinsics(*args)
+    k = render.Intrinsics(np.float32(150), np.float64(79.5), 59, np.int64(160), np.uint16(120))
+    assert (k.f, k.cx, k.cy, k.width, k.height, k.fy) == (150.0, 79.5, 59.0, 160, 120, None)
+    assert [type(v) for v in dataclasses.astuple(k)[:5]] == [float] * 3 + [int] * 2
+
+
 def test_render_projects_with_an_off_centre_principal_point():
     """The synthetic rig's principal point is the image centre, where VTK's window-centre shift
     is 0 whatever its sign; real calibrations are off centre (x right of, y above)."""

@@ -345,6 +345,14 @@ class Intrinsics:
 
     ``f`` is the horizontal focal length (``fx``); ``fy`` the vertical one, None for square
     pixels (``fy = f``).
+
+    Raises
+    ------
+    ValueError
+        A focal length that is not a positive finite number, a principal point that is not
+        finite, or a width or height that is no whole number of pixels >= 1 (a width of -5
+        crashed the process in VTK's allocation, 0 was a ZeroDivisionError, a negative focal
+        length a mirrored picture without a word).
     """
 
     f: float
@@ -353,6 +361,29 @@ class Intrinsics:
     width: int
     height: int
     fy: float | None = None
+
+    def __post_init__(self) -> None:
+        from stereovision._validate import finite_number
+
+        focal = ("f",) if self.fy is None else ("f", "fy")
+        for name in (*focal, "cx", "cy"):
+            value = finite_number(getattr(self, name), f"Intrinsics: {name}")
+            if name in focal and not value > 0:
+                raise ValueError(
+                    f"Intrinsics: {name}: expected a positive focal length in pixels, got {value:g}"
+                )
+            object.__setattr__(self, name, value)
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, np.integer)) or isinstance(value, NOT_NUMBERS):
+                raise ValueError(
+                    f"Intrinsics: {name}: expected a whole number of pixels >= 1, got {value!r}"
+                )
+            if value < 1:
+                raise ValueError(
+                    f"Intrinsics: {name}: expected a whole number of pixels >= 1, got {value}"
+                )
+            object.__setattr__(self, name, int(value))
 
     @property
     def focal_y(self) -> float:
