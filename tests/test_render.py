@@ -1044,6 +1044,19 @@ def test_intrinsics_refuse_a_camera_that_cannot_be_rendered(args, said):
     assert [type(v) for v in dataclasses.astuple(k)[:5]] == [float] * 3 + [int] * 2
 
 
+@pytest.mark.parametrize("size", [(0, 0), (-5, 10), (10.5, 3), (100,)])
+def test_points_in_view_refuses_a_size_render_view_refuses(size):
+    """points_in_view counted 0 points in a (0, 0) or (-5, 10) picture and 1 in a 10.5 x 3
+    one without a word (with intrinsics, it refused their focal length): it takes the sizes
+    render_view takes."""
+    pts = np.array([[0.0, 0.0, 2.0]])
+    intr = render.Intrinsics(100.0, 49.5, 49.5, 100, 100)
+    for k in (None, intr):
+        with pytest.raises(ValueError, match=r"^size: expected \(width, height\) in whole pixels"):
+            render.points_in_view(pts, CameraControls(), size, k)
+    assert render.points_in_view(pts, CameraControls(), (np.int64(100), 100), intr) == 1
+
+
 def test_render_projects_with_an_off_centre_principal_point():
     """The synthetic rig's principal point is the image centre, where VTK's window-centre shift
     is 0 whatever its sign; real calibrations are off centre (x right of, y above)."""

@@ -1232,8 +1232,15 @@ def points_in_view(
     -------
     int
         Points in front of the camera and inside the picture.
+
+    Raises
+    ------
+    ValueError
+        A ``size`` that is not two whole numbers of pixels >= 1 (as :func:`render_view`): a
+        size of (0, 0) counted 0 points without a word, with intrinsics it was refused as
+        their focal length.
     """
-    w, h = size
+    w, h = _render_size(size)
     if intrinsics is not None:
         k = intrinsics.scaled(w / intrinsics.width)
         f, fy, cx, cy = k.f, k.focal_y, k.cx, k.cy
