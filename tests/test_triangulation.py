@@ -341,6 +341,8 @@ def test_depth_kernel_matches_numpy_reference_on_a_real_scene(data_dir: Path) ->
 
     Tolerance: 1 ulp relative (2.4e-7); NaN exactly where the reference has NaN. A wrong sign of
     doffs or of the confidence slope, or an off-by-one pixel, is orders of magnitude above it.
+    Infinite disparities (no depth) and NaN confidences (read as 0) are in it: the reference
+    gave the former the depth 0 and the latter no depth, where the kernel does not.
     """
     import stereovision as sv
     from stereovision import _core
@@ -355,11 +357,14 @@ def test_depth_kernel_matches_numpy_reference_on_a_real_scene(data_dir: Path) ->
     args = (cal.focal_px * cal.baseline_m, cal.doffs_px, *_SIGMA_REFINED, _SIGMA_FILLED)
     conf = res.confidence.copy()
     conf[100:120] = -1.0  # the mark of a filled pixel
+    disp[5:7], disp[7:9] = np.inf, -np.inf
+    conf[200:220] = np.nan
     z, s = _core.depth_rectified(disp, conf, *args)
     zr, sr = depth_ref.depth_rectified(disp, conf, *args)
     assert int(np.isfinite(zr).sum()) > 100000
     assert np.array_equal(np.isnan(z), np.isnan(zr)) and np.array_equal(np.isnan(s), np.isnan(sr))
-    assert np.isnan(z[:5]).all()
+    assert np.isnan(z[:9]).all()
+    assert np.isfinite(z[200:220]).sum() > 1000  # NaN confidence: a depth, as confidence 0
     np.testing.assert_allclose(z, zr, rtol=2.4e-7, equal_nan=True)
     np.testing.assert_allclose(s, sr, rtol=2.4e-7, equal_nan=True)
     ok = np.isfinite(s[100:120])

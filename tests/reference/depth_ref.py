@@ -3,8 +3,8 @@
 ``Z = f B / (d + doffs)`` and ``sigma_Z = Z sigma_d / (d + doffs)`` with
 ``sigma_d = max(s0 + slope * clip(conf, 0, 1), s_min)`` (``s_fill`` where ``conf < 0``: a pixel
 the refinement filled), in float32, NaN where the disparity is
-NaN, ``d + doffs <= sigma_d`` (or ``<= 0``) or the depth is not finite: the same operations in
-the same order.
+not finite, ``d + doffs <= sigma_d`` (or ``<= 0``) or the depth is not finite; a NaN confidence
+counts as 0: the same operations in the same order.
 """
 
 from __future__ import annotations
@@ -29,9 +29,11 @@ def depth_rectified(
         denom = d + np.float32(doffs)
         z = np.float32(fb) / denom
         raw = np.asarray(conf, np.float32)
-        c = np.clip(raw, np.float32(0), np.float32(1))
+        # The kernel reads a NaN confidence as 0 (26ad946); here it made sigma_d NaN: no depth.
+        c = np.clip(np.where(np.isnan(raw), np.float32(0), raw), np.float32(0), np.float32(1))
         sd = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
         sd = np.where(raw < 0, np.float32(s_fill), sd)
-        ok = (denom > 0) & (denom > sd) & np.isfinite(z)
+        # An infinite disparity is no depth in the kernel (4305c3b); here it was the depth 0.
+        ok = np.isfinite(denom) & (denom > 0) & (denom > sd) & np.isfinite(z)
         s = z * sd / denom
     return np.where(ok, z, np.float32(np.nan)), np.where(ok, s, np.float32(np.nan))
