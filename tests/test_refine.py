@@ -197,6 +197,32 @@ def test_fill_plane_and_residual_test(data_dir: Path) -> None:
     assert float(np.nanmax(rms)) < 1e-6
 
 
+def test_a_smoothing_sigma_past_1e19_px_smooths_as_any_wider_than_the_image(
+    data_dir: Path,
+) -> None:
+    """A sigma of 1e19 px or more made the box half-width usize::MAX, and the box sums'
+    ``x + b`` wrapped: the release build added the wrong pixels (a debug build panicked), so
+    fills of sigma 1e20 differed from those of sigma 1e12, which reaches as far (the whole
+    image). Both are any box wider than the image now, bit for bit."""
+    scene = load_scene(data_dir / "middlebury2003" / "cones")
+    left = as_gray_float(scene.left)[100:140, 200:260]
+    right = as_gray_float(scene.right)[100:140, 200:260]
+    assert scene.gt is not None
+    disp = np.array(scene.gt[100:140, 200:260], np.float32)
+    disp[::3, ::2] = np.nan  # holes for the fills
+    runs = {}
+    for plane in (True, False):
+        for sigma in (1e12, 1e20):
+            params = {"base_sigma": sigma, "fills": ((sigma, 0.3),), "fill_plane": plane}
+            runs[plane, sigma] = refine_disparity(left, right, disp, max_disparity=64, **params)
+    for plane in (True, False):
+        wide, wider = runs[plane, 1e12], runs[plane, 1e20]
+        assert wide.n_filled > 50, wide.n_filled
+        assert wider.n_filled == wide.n_filled
+        np.testing.assert_array_equal(wider.disparity, wide.disparity)
+        np.testing.assert_array_equal(wider.confidence, wide.confidence)
+
+
 def test_constant_pair_gives_nan_not_error() -> None:
     flat = np.full((40, 60), 0.5, np.float32)
     res = refine_disparity(flat, flat, np.full(flat.shape, 3.0, np.float32), max_disparity=16)

@@ -270,6 +270,11 @@ pub fn box3_zero<T: BoxSample>(
     b: usize,
     what: &'static str,
 ) -> Result<Vec<T>> {
+    // A box reaching past both ends sums the whole row (column) whatever its width, so the
+    // half-width is held to the longer side: a sigma of 1e19 px or more made it usize::MAX
+    // (`box3_radius` saturates), and `x + b` wrapped (a debug build panicked, a release build
+    // added the wrong pixels: fills differed from a sigma of 1e15 on the same 20x30 map).
+    let b = b.min(w.max(h));
     let mut rows = a;
     // Rows in groups of ROWS_AT_ONCE: their running sums interleaved, so the adds of one row do
     // not wait on each other (each row's sums in its own order, as box_row).
@@ -1075,6 +1080,32 @@ fn refine_disparity_hot(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_box_wider_than_the_image_sums_it_whole() {
+        // A half-width of usize::MAX (box3_radius of a sigma of 1e19 px or more) wrapped
+        // `x + b`: it must give what any box reaching past both ends gives.
+        let (w, h) = (7, 5);
+        let a: Vec<f64> = (0..w * h).map(|i| ((i * 37) % 11) as f64 - 3.0).collect();
+        let whole = box3_zero(a.clone(), w, h, w.max(h), "test").unwrap();
+        for b in [w.max(h) + 1, 1 << 40, usize::MAX / 2 + 1, usize::MAX] {
+            assert_eq!(
+                box3_zero(a.clone(), w, h, b, "test").unwrap(),
+                whole,
+                "b = {b}"
+            );
+        }
+        assert_eq!(box3_radius(1e20), usize::MAX);
+        let d: Vec<f32> = (0..w * h)
+            .map(|i| if i % 3 == 0 { f32::NAN } else { i as f32 })
+            .collect();
+        let want = nc_smooth(&d, w, h, 1e6).unwrap();
+        assert_eq!(nc_smooth(&d, w, h, 1e20).unwrap(), want);
+        assert_eq!(nc_smooth(&d, w, h, f32::MAX).unwrap(), want);
+        let (pw, rw) = nc_plane(&d, w, h, 1e6, true).unwrap();
+        let (p, r) = nc_plane(&d, w, h, 1e20, true).unwrap();
+        assert_eq!((p, r), (pw, rw));
+    }
 
     #[test]
     fn column_strips_too_large_to_allocate_are_an_error() {
