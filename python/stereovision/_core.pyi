@@ -214,7 +214,8 @@ def fattened(
     """The pixels between a disparity jump (> ``jump``, on the row-filled map) and the strongest
     step of ``guide`` within ``radius`` on its background side, if that step is ``ratio`` times
     the one at the jump; along rows and along columns (a ``radius`` beyond the map: the whole
-    row or column). ``ValueError``: shapes differ, or a negative ``ratio`` / ``jump``."""
+    row or column). ``ValueError``: shapes differ, a negative ``ratio`` / ``jump``, or a NaN or
+    inf in ``guide`` (an image)."""
 
 # --- Triangulation (rust/py/src/triangulation.rs) ------------------------------------------------
 

@@ -79,6 +79,14 @@ pub fn fattened<'py>(
         )));
     }
     let (d, g) = (row_major(&disp, "disp")?, row_major(&guide, "guide")?);
+    // A NaN step never beats another in the kernel's search, where NumPy's argmax (the
+    // reference) stops at it: the two marked different pixels. A guide is an image.
+    let bad = g.iter().filter(|v| !v.is_finite()).count();
+    if bad > 0 {
+        return Err(PyValueError::new_err(format!(
+            "guide: expected finite values (an image), got {bad} NaN or inf"
+        )));
+    }
     let p = FattenParams {
         radius,
         ratio,
