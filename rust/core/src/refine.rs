@@ -497,11 +497,15 @@ fn sample4(row: &[f32], i: i32, q: [f32; 4]) -> f32 {
     }
 }
 
-/// Catmull-Rom sample of `row` at real position `t` (indices clamped to the row).
+/// Catmull-Rom sample of `row` at real position `t` (indices clamped to the row: past either
+/// end, the end's value).
 #[inline]
 pub fn cubic_sample(row: &[f32], t: f32) -> f32 {
-    let fl = t.floor();
-    sample4(row, fl as i32, cubic_weights(t - fl))
+    // Held within two samples of the row, as `warp_row` holds it: a `t` of 2**31 or more (or
+    // -2**31 or less) saturated the i32 index, and `i + 2` (`i - 1`) overflowed (a debug build
+    // panicked, a release build indexed past the row). Every position beyond reads the end.
+    let fl = t.floor().max(-2.0).min(row.len() as f32 + 1.0);
+    sample4(row, fl as i32, cubic_weights((t - fl).clamp(0.0, 1.0)))
 }
 
 simd_fn! {
@@ -1512,6 +1516,19 @@ mod tests {
                     + (3.0 * p1 - p0 - 3.0 * p2 + p3) * f * f * f);
             let got = cubic_sample(&row, t) as f64;
             assert!((got - want).abs() < 1e-5, "t {t}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn cubic_sample_far_past_the_row_reads_its_end() {
+        // The i32 index saturated and `i + 2` / `i - 1` overflowed: a panic in a debug build,
+        // an index past the row in a release build.
+        let row = [3.0f32, 1.0, 4.0, 1.0, 5.0];
+        for t in [-2.5f32, -1e3, -3e9, -1e30, f32::MIN] {
+            assert_eq!(cubic_sample(&row, t), 3.0, "t {t}");
+        }
+        for t in [6.5f32, 1e3, 3e9, 1e30, f32::MAX] {
+            assert_eq!(cubic_sample(&row, t), 5.0, "t {t}");
         }
     }
 
