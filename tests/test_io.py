@@ -1144,7 +1144,7 @@ def test_read_ply_header_and_truncation_errors(tmp_path: Path) -> None:
         read_ply(tmp_path / "nv.ply")
     (tmp_path / "nc.ply").write_bytes(b"ply\nformat ascii 1.0\nelement vertex\n" + xyz.encode())
     (tmp_path / "nc.ply").write_bytes((tmp_path / "nc.ply").read_bytes() + b"end_header\n")
-    with pytest.raises(ValueError, match="first element"):
+    with pytest.raises(ValueError, match="element vertex has no count"):
         read_ply(tmp_path / "nc.ply")
 
 
@@ -1184,6 +1184,25 @@ def test_read_ply_bad_count_or_twice_named_property_names_the_file(tmp_path: Pat
     with pytest.raises(ValueError) as err:
         read_ply(path)
     assert str(err.value) == f"PLY file {path}: vertex property 'x' given twice"
+
+
+def test_read_ply_vertex_element_without_a_count_or_with_two_says_so(tmp_path: Path) -> None:
+    """'element vertex' with no count (or '1 2', two) was told off as "first element is
+    ['vertex'], expected vertex": the element it names is the one it expects."""
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    path = tmp_path / "cloud.ply"
+    for line, said in (
+        ("vertex", "element vertex has no count"),
+        ("vertex 1 2", "vertex count '1 2' is not a whole number (>= 0)"),
+    ):
+        path.write_bytes(_ply("ascii", xyz, 1).replace(b"vertex 1", line.encode()) + b"1 2 3\n")
+        with pytest.raises(ValueError) as err:
+            read_ply(path)
+        assert str(err.value) == f"PLY file {path}: {said}"
+    # the first element that is not vertex is still named as such
+    path.write_bytes(_ply("ascii", xyz, 1).replace(b"vertex 1", b"face 1") + b"1 2 3\n")
+    with pytest.raises(ValueError, match=r"first element is \['face'\], expected vertex"):
+        read_ply(path)
 
 
 def test_read_ply_16_bit_and_signed_colours_do_not_wrap(tmp_path: Path) -> None:

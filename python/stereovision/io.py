@@ -1438,13 +1438,18 @@ def read_ply(
             if count >= 0 and in_vertex:
                 in_vertex = False
                 break
-            in_vertex = len(tok) == 3 and tok[1] == "vertex"
+            in_vertex = len(tok) > 1 and tok[1] == "vertex"
             if not in_vertex:
                 raise ValueError(f"PLY file {p}: first element is {tok[1:2]}, expected vertex")
+            # a vertex line without its one count was told off as "first element is
+            # ['vertex'], expected vertex"
+            if len(tok) == 2:
+                raise ValueError(f"PLY file {p}: element vertex has no count")
             # int()'s own "invalid literal" named no file; -3 read as no vertex element
-            if not tok[2].isascii() or not tok[2].isdigit():
+            given = " ".join(tok[2:])
+            if len(tok) != 3 or not given.isascii() or not given.isdigit():
                 raise ValueError(
-                    f"PLY file {p}: vertex count {tok[2]!r} is not a whole number (>= 0)"
+                    f"PLY file {p}: vertex count {given!r} is not a whole number (>= 0)"
                 )
             count = int(tok[2])
         elif tok[0] == "property" and in_vertex:
