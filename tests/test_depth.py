@@ -1422,6 +1422,14 @@ def test_filtered_keeps_limits_inclusive_and_its_cloud_and_maps_its_own() -> Non
     # and its timings: a stage the caller times on the copy was the original's too
     f.timings["export"] = 0.25
     assert k.timings == {} and f.timings == {"export": 0.25}
+    # and its channels' dict: one dropped from (or put in) the copy's went from the original's
+    sgm = np.zeros((2, 2), np.float32)
+    g = dataclasses.replace(k, channels={"sgm": sgm})
+    h = g.filtered(max_depth=5)
+    assert h.channels == {"sgm": sgm}
+    h.channels.clear()
+    assert g.channels == {"sgm": sgm}
+    assert k.filtered(max_depth=5).channels is None  # none stays none
     no_sigma = dataclasses.replace(r, depth_sigma=None)
     with pytest.raises(ValueError, match=r"^max_sigma: this result has no depth_sigma"):
         no_sigma.filtered(max_sigma=1.0)

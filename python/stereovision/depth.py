@@ -979,6 +979,8 @@ class DepthResult:
             confidence=self.confidence.copy(),
             left_rectified=None if self.left_rectified is None else self.left_rectified.copy(),
             timings=dict(self.timings),  # the same dict: a stage timed on one was on both
+            # so too the channels' dict (their arrays are shared, as return_channels gives them)
+            channels=None if self.channels is None else self.channels.copy(),
             depth=np.where(keep, z, nan).astype(np.float32),
             depth_sigma=None if sigma is None else sigma.astype(np.float32),
             points=points,
