@@ -1880,6 +1880,33 @@ def test_an_output_folder_through_a_link_to_nothing_is_refused_naming_the_link(
     assert sorted(os.listdir(tmp_path)) == ["fifo", "gone", "loop1", "loop2"]  # nothing made
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs as on POSIX")
+def test_an_output_folder_at_or_under_a_fifo_is_refused_as_no_folder_not_as_a_file(
+    tmp_path: Path,
+) -> None:
+    """3dc4258 had make_folder call a FIFO in the way "not a folder" (it was "a file"), but
+    check_output_folder, which the CLI runs first, still said "-o fifo/sub: fifo is a file,
+    not a folder" of it (and "-o fifo: is a file"): the words the commit took back."""
+    from stereovision.io import check_output_folder
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    (tmp_path / "plain").write_bytes(b"")
+    for out, said in (
+        (fifo, f"-o {fifo}: is not a folder"),
+        (fifo / "sub", f"-o {fifo / 'sub'}: {fifo} is not a folder"),
+        # a regular file is still named one
+        (tmp_path / "plain", f"-o {tmp_path / 'plain'}: is a file, not a folder"),
+        (
+            tmp_path / "plain" / "sub",
+            f"-o {tmp_path / 'plain' / 'sub'}: {tmp_path / 'plain'} is a file, not a folder",
+        ),
+    ):
+        with pytest.raises(ValueError) as refused:
+            check_output_folder(out, "-o")
+        assert str(refused.value) == said
+
+
 def test_check_output_folder_error_classes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A file above the folder is a ValueError naming that file ('is a file, not a folder');
     a folder above it that cannot be written is a PermissionError naming it."""

@@ -250,13 +250,15 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
     Raises
     ------
     ValueError
-        If ``folder``, or a folder above it, is a file or a link to nothing (or in a loop).
+        If ``folder``, or a folder above it, is a file (or a FIFO: "not a folder") or a link
+        to nothing (or in a loop).
     PermissionError
         If the nearest existing folder above it is not writable.
     """
     path = Path(folder)
     if path.exists() and not path.is_dir():
-        raise ValueError(f"{flag} {path}: is a file, not a folder")
+        # a FIFO is no file either: "not a folder", as make_folder says it
+        raise ValueError(f"{flag} {path}: is {_not_a_folder(path)}")
     above = path
     while not above.exists() and above.parent != above:
         if above.is_symlink():  # to nothing or in a loop: make_folder refused it after the work
@@ -264,7 +266,7 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
             raise ValueError(f"{flag} {path}: {where}is {_broken_link(above)}")
         above = above.parent
     if above.exists() and not above.is_dir():
-        raise ValueError(f"{flag} {path}: {above} is a file, not a folder")
+        raise ValueError(f"{flag} {path}: {above} is {_not_a_folder(above)}")
     why = cannot_write_in(above) if above.exists() else None
     if why:
         raise PermissionError(f"{flag} {path}: cannot write in {above} ({why})")
