@@ -1335,7 +1335,9 @@ def test_an_empty_or_unreachable_range_given_is_named() -> None:
         sv.depth_map(left, left, max_disparity=-64, min_disparity=-80)
 
 
-def test_a_negative_min_disparity_with_the_fused_method_names_the_methods_that_take_it() -> None:
+def test_a_negative_min_disparity_with_the_fused_method_names_the_methods_that_take_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     """The fused map's graph-matching and Hopfield channels search from 0 px: depth_map's
     default method refused min_disparity=-2 in their words ("min_disparity must be a
     non-negative number of pixels, got -2.0"), naming neither the method nor those that take
@@ -1349,6 +1351,20 @@ def test_a_negative_min_disparity_with_the_fused_method_names_the_methods_that_t
         r"'census' or 'fast' search a negative range$",
     ):
         sv.depth_map(left, right, max_disparity=16, min_disparity=-2)
+    # refused before the images' work: it came after the automatic range's estimate (1.4 s of
+    # a 3600 x 3000 pair) and the rectification
+    import stereovision.depth as depth_mod
+
+    def estimated(*_: object) -> float:
+        raise AssertionError("the range was estimated before the refusal")
+
+    with monkeypatch.context() as m:
+        m.setattr(depth_mod, "estimate_max_disparity", estimated)
+        with pytest.raises(ValueError, match=r"^min_disparity: method='fused' searches from 0"):
+            sv.depth_map(left, right, min_disparity=-2)
+        # NaN, too, is refused in its own words before that work
+        with pytest.raises(ValueError, match=r"^min_disparity"):
+            sv.depth_map(left, right, min_disparity=float("nan"))
     for method in ("gabor", "census", "fast"):
         res = sv.depth_map(left, right, method=method, max_disparity=16, min_disparity=-2)
         assert res.min_disparity == -2

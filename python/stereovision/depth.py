@@ -1309,6 +1309,17 @@ def _cloud(
     return points, colors, pixels
 
 
+def _fused_from_zero(min_disparity: float) -> ValueError:
+    """The refusal of a negative ``min_disparity`` with ``method="fused"``: the sparse
+    channels' own error ("must be a non-negative number of pixels, got -2.0") named neither
+    the method nor the ones that search such a range."""
+    return ValueError(
+        f"min_disparity: method='fused' searches from 0 px (its graph-matching and Hopfield "
+        f"channels take no negative disparity), got {_px(min_disparity)}; method='gabor', "
+        "'census' or 'fast' search a negative range"
+    )
+
+
 def depth_map(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
@@ -1492,6 +1503,13 @@ def depth_map(
         # real_number: a timedelta (an np.integer) passed here, refused later in other words
         if not real_number(value):
             raise TypeError(f"{name}: expected a number of pixels, got {value!r}")
+    # NaN, inf or an int beyond 64 bits refused in its own words (finite_number, as below for
+    # max_disparity), before the images' work as the refusal after it
+    finite_number(min_disparity, "min_disparity")
+    if method == "fused" and min_disparity < 0 and max_disparity is None:
+        # no range given to be refused first: up front, not after the rectification and the
+        # automatic range's estimate (1.4 s of a 3600 x 3000 pair, for nothing)
+        raise _fused_from_zero(min_disparity)
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
     # Each image is validated by as_bgr_uint8; the pair check without check_pair's grey
@@ -1532,7 +1550,6 @@ def depth_map(
         max_disparity = estimate_max_disparity(gl, gr)
     # a ValueError naming the argument for NaN, inf and ints beyond 64 bits (2**70 was NumPy's
     # TypeError "ufunc 'isfinite' not supported")
-    finite_number(min_disparity, "min_disparity")
     finite_number(max_disparity, "max_disparity")
     if max_disparity <= min_disparity and automatic:
         # "max_disparity (16) must be larger than min_disparity (20)" named a value never given;
@@ -1559,14 +1576,8 @@ def depth_map(
         raise unreachable
     if max_disparity - min_disparity >= gl.shape[1]:
         raise _range_too_wide(max_disparity - min_disparity, gl.shape[1], min_disparity)
-    if method == "fused" and min_disparity < 0:
-        # the sparse channels' own error ("must be a non-negative number of pixels, got -2.0")
-        # named neither the method nor the ones that search such a range
-        raise ValueError(
-            f"min_disparity: method='fused' searches from 0 px (its graph-matching and Hopfield "
-            f"channels take no negative disparity), got {_px(min_disparity)}; method='gabor', "
-            "'census' or 'fast' search a negative range"
-        )
+    if method == "fused" and min_disparity < 0:  # a range given: once it is known searchable
+        raise _fused_from_zero(min_disparity)
     stage("prepare")
     channels: DepthChannels | None = {} if return_channels else None
     if refine is None:
