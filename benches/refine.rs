@@ -23,7 +23,7 @@ fn pair(w: usize, h: usize) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
             let i = y * w + x;
             l[i] = tex(x as f32, y as f32);
             r[i] = tex(x as f32 + dd, y as f32);
-            d[i] = if (i / 40) % 5 == 0 {
+            d[i] = if (i / 40).is_multiple_of(5) {
                 f32::NAN
             } else {
                 dd.round()

@@ -442,7 +442,7 @@ mod tests {
         let small = Layout::from_size_align(MIN_CACHED - 1, 64).unwrap();
         unsafe {
             let a = cache.alloc(big);
-            assert!(!a.is_null() && a as usize % 64 == 0);
+            assert!(!a.is_null() && (a as usize).is_multiple_of(64));
             a.write_bytes(7, big.size());
             cache.dealloc(a, big);
             assert_eq!(cache.kept(), (1, MIN_CACHED));

@@ -132,7 +132,7 @@ pub fn graph_segments(
     let ends = |key: u64| -> (u32, u32) {
         let e = (key & 0xffff_ffff) as usize;
         let p = e / 2;
-        let q = if e % 2 == 0 { p + 1 } else { p + w };
+        let q = if e.is_multiple_of(2) { p + 1 } else { p + w };
         (p as u32, q as u32)
     };
     let mut f = Forest::new(n, k)?;

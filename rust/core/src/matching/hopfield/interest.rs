@@ -392,7 +392,7 @@ mod tests {
             let h = 22;
             let m: Vec<f32> = (0..w * h)
                 .map(|i| {
-                    if (i % w) % 2 == 0 && (i / w) % 2 == 0 {
+                    if (i % w).is_multiple_of(2) && (i / w).is_multiple_of(2) {
                         2.0
                     } else {
                         1.0

@@ -2013,7 +2013,7 @@ mod tests {
                 .map(|a| [0.25, -0.5, 0.0, 1.0, -0.125][(a + seed as usize) % 5])
                 .collect();
             let init: Vec<u8> = (0..m)
-                .map(|a| u8::from((a * 7 + seed as usize) % 3 == 0))
+                .map(|a| u8::from((a * 7 + seed as usize).is_multiple_of(3)))
                 .collect();
             let (v, trace, sweeps, converged) =
                 reference_dynamics(&csr, &input, &init, seed, max_sweeps);

@@ -1094,7 +1094,7 @@ fn sads_fit_mask<const J: usize>(
     limit: (f32, f32),
 ) -> u32 {
     #[cfg(target_arch = "x86_64")]
-    if J % 8 == 0 && crate::simd::has_avx2() {
+    if J.is_multiple_of(8) && crate::simd::has_avx2() {
         // SAFETY: AVX2 is present; every element's `J + 1` samples from `o + j0` lie in `r`
         // (checked by the slice below).
         return unsafe { sads_fit_mask_avx2::<J>(r, els, j0, n, mean_free, limit) };

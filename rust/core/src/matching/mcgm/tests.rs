@@ -350,7 +350,7 @@ fn spread_prior_equals_the_dilations() {
         let map: Vec<f32> = (0..w * h)
             .map(|_| {
                 let r = rng.next_u64();
-                if density > 0 && r % density == 0 {
+                if density > 0 && r.is_multiple_of(density) {
                     (r >> 40) as f32 / 1000.0
                 } else if r % 97 == 1 {
                     f32::INFINITY
@@ -1982,7 +1982,7 @@ fn windows_equal_the_lower_median_of_the_prior_at_pixel_centres() {
             })
             .collect();
         v.sort_by(f32::total_cmp);
-        n_even += usize::from(v.len() % 2 == 0);
+        n_even += usize::from(v.len().is_multiple_of(2));
         let med = v[(v.len() - 1) / 2];
         let want = ((med - width).floor() as i32, (med + width).ceil() as i32);
         assert_eq!(*g, Some(want));
