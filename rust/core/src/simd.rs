@@ -48,3 +48,23 @@ pub(crate) fn has_avx2() -> bool {
         false
     }
 }
+
+/// Does the running CPU have AVX-512 F, BW, VL and VPOPCNTDQ (Ice Lake, Zen 4 and later; the
+/// answer is cached by std)? For the census matcher's `vpopcntq` Hamming costs.
+#[inline]
+pub(crate) fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx512f")
+            && std::is_x86_feature_detected!("avx512bw")
+            && std::is_x86_feature_detected!("avx512vl")
+            && std::is_x86_feature_detected!("avx512vpopcntdq")
+            && std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("fma")
+            && std::is_x86_feature_detected!("popcnt")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}

@@ -179,10 +179,8 @@ pub fn census(img: ImageView<'_>) -> Result<Vec<u64>> {
 }
 
 simd_fn! {
-    /// One row of the cost volume, `n` levels per pixel. `simd`: take [`hamming_avx2`] where a
-    /// pixel has at least 32 levels inside the image (the same integers; the compiler's loop
-    /// otherwise, which the AVX2 build vectorises by a nibble table as well, 16 levels a step).
-    fn cost_row_as(
+    /// [`cost_row_impl`] for the baseline and AVX2.
+    fn cost_row_simd(
         cl: &[u64],
         cr_rev: &[u64],
         d_min: i64,
@@ -190,48 +188,179 @@ simd_fn! {
         out: &mut [u8],
         simd: Option<Avx2>,
     ) {
-        let w = cl.len() as i64;
-        for (x, cell) in out.chunks_exact_mut(n).enumerate() {
-            let a = cl[x];
-            // Levels whose right pixel x - d_min - k lies in [0, w).
-            let hi = (x as i64 - d_min).min(n as i64 - 1);
-            let lo = (x as i64 - d_min - w + 1).max(0);
-            if lo > hi {
-                cell.fill(OUTSIDE);
-                continue;
-            }
-            let (lo, hi) = (lo as usize, hi as usize);
-            // Level k pairs with right pixel x - d_min - k, i.e. entry w - 1 - x + d_min + k of the
-            // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
-            let start = (w - 1 - x as i64 + d_min + lo as i64) as usize; // >= 0 by lo's bound
-            let right = &cr_rev[start..start + hi + 1 - lo];
-            let inside = &mut cell[lo..=hi];
-            let (best, worst) = match simd.and_then(|t| hamming_avx2(t, a, right, inside)) {
-                Some(bw) => bw,
-                None => {
-                    for (v, &b) in inside.iter_mut().zip(right) {
-                        *v = (a ^ b).count_ones() as u8;
-                    }
-                    let best = inside.iter().fold(OUTSIDE, |m, &v| m.min(v));
-                    (best, inside.iter().fold(0, |m, &v| m.max(v)))
-                }
-            };
-            // Levels whose right pixel is outside the image cost a little more than the best
-            // inside level: nearly neutral, so the paths from the left edge carry only a slight
-            // preference for the levels that stay inside (with a high cost a flat region took
-            // d_min from the edge, far along the rows; with none, the band's pixels followed the
-            // levels outside).
-            // Where every inside level costs the same (a flat patch) they stay neutral: nothing
-            // to prefer, and a margin there would carry d_min from the edge across a flat image.
-            let out = if worst == best {
-                best
-            } else {
-                best.saturating_add(OUTSIDE_MARGIN).min(OUTSIDE)
-            };
-            cell[..lo].fill(out);
-            cell[hi + 1..].fill(out);
-        }
+        cost_row_impl(cl, cr_rev, d_min, n, out, simd, None)
     }
+}
+
+/// One row of the cost volume, `n` levels per pixel. `wide`: take [`hamming_avx512`] (compiled
+/// for AVX-512 as a whole, so that it inlines); else `simd`: [`hamming_avx2`] where a pixel has
+/// at least 32 levels inside the image; the compiler's loop otherwise, which the AVX2 build
+/// vectorises by a nibble table as well, 16 levels a step. The same integers every way.
+fn cost_row_as(
+    cl: &[u64],
+    cr_rev: &[u64],
+    d_min: i64,
+    n: usize,
+    out: &mut [u8],
+    simd: Option<Avx2>,
+    wide: Option<Avx512>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(t) = wide {
+        #[target_feature(enable = "avx2,fma,popcnt,avx512f,avx512bw,avx512vl,avx512vpopcntdq")]
+        unsafe fn avx512(
+            cl: &[u64],
+            cr_rev: &[u64],
+            d_min: i64,
+            n: usize,
+            out: &mut [u8],
+            t: Avx512,
+        ) {
+            cost_row_impl(cl, cr_rev, d_min, n, out, None, Some(t))
+        }
+        // SAFETY: `t` proves the running CPU has every feature enabled on `avx512`.
+        return unsafe { avx512(cl, cr_rev, d_min, n, out, t) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = wide; // no AVX-512 off x86
+    cost_row_simd(cl, cr_rev, d_min, n, out, simd)
+}
+
+/// [`cost_row_as`]'s body.
+#[inline(always)]
+fn cost_row_impl(
+    cl: &[u64],
+    cr_rev: &[u64],
+    d_min: i64,
+    n: usize,
+    out: &mut [u8],
+    simd: Option<Avx2>,
+    wide: Option<Avx512>,
+) {
+    let w = cl.len() as i64;
+    for (x, cell) in out.chunks_exact_mut(n).enumerate() {
+        let a = cl[x];
+        // Levels whose right pixel x - d_min - k lies in [0, w).
+        let hi = (x as i64 - d_min).min(n as i64 - 1);
+        let lo = (x as i64 - d_min - w + 1).max(0);
+        if lo > hi {
+            cell.fill(OUTSIDE);
+            continue;
+        }
+        let (lo, hi) = (lo as usize, hi as usize);
+        // Level k pairs with right pixel x - d_min - k, i.e. entry w - 1 - x + d_min + k of the
+        // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
+        let start = (w - 1 - x as i64 + d_min + lo as i64) as usize; // >= 0 by lo's bound
+        let right = &cr_rev[start..start + hi + 1 - lo];
+        let inside = &mut cell[lo..=hi];
+        let fast = match wide {
+            Some(t) => hamming_avx512(t, a, right, inside),
+            None => simd.and_then(|t| hamming_avx2(t, a, right, inside)),
+        };
+        let (best, worst) = match fast {
+            Some(bw) => bw,
+            None => {
+                for (v, &b) in inside.iter_mut().zip(right) {
+                    *v = (a ^ b).count_ones() as u8;
+                }
+                let best = inside.iter().fold(OUTSIDE, |m, &v| m.min(v));
+                (best, inside.iter().fold(0, |m, &v| m.max(v)))
+            }
+        };
+        // Levels whose right pixel is outside the image cost a little more than the best
+        // inside level: nearly neutral, so the paths from the left edge carry only a slight
+        // preference for the levels that stay inside (with a high cost a flat region took
+        // d_min from the edge, far along the rows; with none, the band's pixels followed the
+        // levels outside).
+        // Where every inside level costs the same (a flat patch) they stay neutral: nothing
+        // to prefer, and a margin there would carry d_min from the edge across a flat image.
+        let out = if worst == best {
+            best
+        } else {
+            best.saturating_add(OUTSIDE_MARGIN).min(OUTSIDE)
+        };
+        cell[..lo].fill(out);
+        cell[hi + 1..].fill(out);
+    }
+}
+
+/// The Hamming costs `out[k] = popcount(a ^ right[k])` of one pixel in AVX-512 (`vpopcntq`,
+/// 16 levels a step, the last step masked), and their minimum and maximum; `None` for no
+/// levels. [`hamming_avx2`] counts by a nibble table, eleven instructions for four levels.
+#[inline(always)]
+fn hamming_avx512(_avx512: Avx512, a: u64, right: &[u64], out: &mut [u8]) -> Option<(u8, u8)> {
+    let n = out.len();
+    if n == 0 || right.len() < n {
+        return None;
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY: `_avx512` proves the CPU has AVX-512 F, BW, VL and VPOPCNTDQ;
+        // `hamming_kernel512` reads `right[..n]` and writes `out[..n]` (the last step through
+        // masks), within the lengths checked above.
+        Some(unsafe { hamming_kernel512(a, right.as_ptr(), out.as_mut_ptr(), n) })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        // Only the AVX-512 kernel reads the code.
+        let _ = a;
+        None
+    }
+}
+
+/// [`hamming_avx512`]'s loop.
+///
+/// # Safety
+/// The CPU has AVX-512 F, BW, VL and VPOPCNTDQ; `right` holds `n` codes and `out` `n` bytes,
+/// `n >= 1`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512bw,avx512vl,avx512vpopcntdq")]
+#[inline]
+unsafe fn hamming_kernel512(a: u64, right: *const u64, out: *mut u8, n: usize) -> (u8, u8) {
+    use std::arch::x86_64::*;
+    let av = _mm512_set1_epi64(a as i64);
+    let mut best = _mm_set1_epi8(-1);
+    let mut worst = _mm_setzero_si128();
+    let whole = n / 16 * 16;
+    let mut k = 0;
+    while k < whole {
+        let x0 = _mm512_xor_si512(_mm512_loadu_si512(right.add(k).cast()), av);
+        let x1 = _mm512_xor_si512(_mm512_loadu_si512(right.add(k + 8).cast()), av);
+        // Counts of at most 64: each u64 truncated to its low byte, levels in order.
+        let b = _mm_unpacklo_epi64(
+            _mm512_cvtepi64_epi8(_mm512_popcnt_epi64(x0)),
+            _mm512_cvtepi64_epi8(_mm512_popcnt_epi64(x1)),
+        );
+        _mm_storeu_si128(out.add(k).cast(), b);
+        best = _mm_min_epu8(best, b);
+        worst = _mm_max_epu8(worst, b);
+        k += 16;
+    }
+    let rest = n - whole;
+    if rest > 0 {
+        // Masked-off codes are not read (no fault past the row) and their bytes not stored nor
+        // counted in the minimum and maximum.
+        let km = ((1u32 << rest) - 1) as __mmask16; // rest < 16
+        let x0 = _mm512_maskz_loadu_epi64(km as __mmask8, right.add(whole).cast());
+        let x1 =
+            _mm512_maskz_loadu_epi64((km >> 8) as __mmask8, right.wrapping_add(whole + 8).cast());
+        let b = _mm_unpacklo_epi64(
+            _mm512_cvtepi64_epi8(_mm512_popcnt_epi64(_mm512_xor_si512(x0, av))),
+            _mm512_cvtepi64_epi8(_mm512_popcnt_epi64(_mm512_xor_si512(x1, av))),
+        );
+        _mm_mask_storeu_epi8(out.add(whole).cast(), km, b);
+        best = _mm_mask_min_epu8(best, km, best, b);
+        worst = _mm_mask_max_epu8(worst, km, worst, b);
+    }
+    let lo = _mm_min_epu8(best, _mm_srli_si128::<8>(best));
+    let hi = _mm_max_epu8(worst, _mm_srli_si128::<8>(worst));
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<4>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<4>(hi));
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<2>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<2>(hi));
+    let lo = _mm_min_epu8(lo, _mm_srli_si128::<1>(lo));
+    let hi = _mm_max_epu8(hi, _mm_srli_si128::<1>(hi));
+    (_mm_cvtsi128_si32(lo) as u8, _mm_cvtsi128_si32(hi) as u8)
 }
 
 /// The Hamming costs `out[k] = popcount(a ^ right[k])` of one pixel in AVX2, 32 levels a
@@ -360,7 +489,15 @@ pub fn cost_volume_into(cl: &[u64], cr: &[u64], w: usize, d_min: i64, n: usize, 
         .for_each_init(Vec::new, |rev, (y, row)| {
             rev.clear();
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
-            cost_row_as(&cl[y * w..(y + 1) * w], rev, d_min, n, row, Avx2::detect())
+            cost_row_as(
+                &cl[y * w..(y + 1) * w],
+                rev,
+                d_min,
+                n,
+                row,
+                Avx2::detect(),
+                Avx512::detect(),
+            )
         });
 }
 
@@ -466,6 +603,17 @@ struct Avx2(());
 impl Avx2 {
     fn detect() -> Option<Self> {
         crate::simd::has_avx2().then_some(Avx2(()))
+    }
+}
+
+/// Proof that the running CPU has AVX-512 F, BW, VL and VPOPCNTDQ (made only by
+/// [`Avx512::detect`]): the `vpopcntq` Hamming costs need them.
+#[derive(Clone, Copy)]
+struct Avx512(());
+
+impl Avx512 {
+    fn detect() -> Option<Self> {
+        crate::simd::has_avx512().then_some(Avx512(()))
     }
 }
 
@@ -1531,6 +1679,7 @@ fn three_paths_as<T: PathCost + Send>(
                 n,
                 &mut c,
                 Avx2::detect(),
+                Avx512::detect(),
             );
             horizontal(&c, &img[y * w..(y + 1) * w], n, p, lut, &mut acc, &mut hp);
             let waiting = {
@@ -2590,13 +2739,85 @@ mod tests {
                             (&c[..w], c[w..].iter().rev().copied().collect());
                         let mut want = vec![0u8; w * n];
                         let mut got = vec![1u8; w * n];
-                        cost_row_as(cl, &rev, d_min, n, &mut want, None);
-                        cost_row_as(cl, &rev, d_min, n, &mut got, Some(avx2));
+                        cost_row_as(cl, &rev, d_min, n, &mut want, None, None);
+                        cost_row_as(cl, &rev, d_min, n, &mut got, Some(avx2), None);
                         assert_eq!(got, want, "{n} levels, width {w}, d_min {d_min}");
                     }
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_avx512_hamming_costs_are_the_compilers() {
+        // Whole cost rows by the AVX-512 kernel against the compiler's loop, for every level
+        // count 1..=300 (every tail 0..=15 of the masked last step) and 2047, 2048, odd and even
+        // widths, ranges past either edge, on random 64-bit codes, census-like 62-bit ones and
+        // equal codes (a flat patch: every inside level ties).
+        let Some(avx512) = Avx512::detect() else {
+            eprintln!("no AVX-512 (F, BW, VL, VPOPCNTDQ) on this CPU: nothing to compare");
+            return;
+        };
+        let mut s = 11u64;
+        let mut rand = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            s
+        };
+        for n in (1..=300usize).chain([2047, 2048]) {
+            for w in [1usize, 2, 31, 64, 97, 230] {
+                for d_min in [-40i64, 0, 5] {
+                    let codes: [Vec<u64>; 3] = [
+                        (0..2 * w).map(|_| rand()).collect(),
+                        (0..2 * w).map(|_| rand() >> 2).collect(),
+                        vec![0x0123_4567_89ab_cdef; 2 * w],
+                    ];
+                    for c in &codes {
+                        let (cl, rev): (&[u64], Vec<u64>) =
+                            (&c[..w], c[w..].iter().rev().copied().collect());
+                        let mut want = vec![0u8; w * n];
+                        let mut got = vec![1u8; w * n];
+                        cost_row_as(cl, &rev, d_min, n, &mut want, None, None);
+                        cost_row_as(cl, &rev, d_min, n, &mut got, None, Some(avx512));
+                        assert_eq!(got, want, "{n} levels, width {w}, d_min {d_min}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_avx512_hamming_costs_count_every_bit() {
+        // As the AVX2 test below: every count 0..=64 (64 kills a count capped or wrapped at 63)
+        // in every lane of a step and of the masked tail, at every length, from either end of
+        // the codes, and the minimum and maximum it returns (a reduction that drops a lane, or
+        // counts a masked-off one, fails).
+        let Some(avx512) = Avx512::detect() else {
+            eprintln!("no AVX-512 (F, BW, VL, VPOPCNTDQ) on this CPU: nothing to compare");
+            return;
+        };
+        let a = 0xf0f0_0000_ffff_1234u64;
+        let mut b: Vec<u64> = (0..=64u32)
+            .map(|p| a ^ 1u64.checked_shl(p).map_or(u64::MAX, |v| v - 1))
+            .collect();
+        b.extend((0..16u64).map(|v| a ^ (v * 0x1111_1111_1111_1111)));
+        for n in 1..=b.len() {
+            for right in [&b[..n], &b[b.len() - n..]] {
+                let rev: Vec<u64> = right.iter().rev().copied().collect();
+                for r in [right, &rev[..]] {
+                    let want: Vec<u8> = r.iter().map(|&x| (a ^ x).count_ones() as u8).collect();
+                    // Bytes past `n` must stay as they were (the tail's store is masked).
+                    let mut got = vec![0xaa; n + 16];
+                    let bw = hamming_avx512(avx512, a, r, &mut got[..n]);
+                    assert_eq!(got[..n], want, "{n} levels");
+                    assert!(got[n..].iter().all(|&v| v == 0xaa), "{n} levels");
+                    let (lo, hi) = (*want.iter().min().unwrap(), *want.iter().max().unwrap());
+                    assert_eq!(bw, Some((lo, hi)), "{n} levels");
+                }
+            }
+        }
+        assert_eq!(hamming_avx512(avx512, a, &b[..0], &mut []), None);
     }
 
     #[test]
