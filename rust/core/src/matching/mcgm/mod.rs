@@ -915,15 +915,18 @@ fn half_better(
     // Block by block (8 lanes): the bound first, then the exact sums of the lanes it leaves
     // open (a lane's sum is the same in a block of 8 as alone: the same terms in the same
     // order); the scan stops at the first lane that fits better.
+    if bound.shared_weight {
+        bound.lane_sums(&mut scratch.rows, nk.div_ceil(8) * 8, mean_free);
+    }
     for j0 in (0..nk).step_by(8) {
         let lanes = (nk - j0).min(8);
-        let open = bound.open_lanes(
-            (&scratch.v_top, &scratch.v_bot),
-            &mut scratch.tb,
-            j0,
-            mean_free,
-            open_below,
-        )
+        let open = if bound.shared_weight {
+            let mut acc = [0.0f32; 8];
+            acc.copy_from_slice(&scratch.rows.lane_acc[j0..j0 + 8]);
+            bound.lane_bits(&acc, open_below)
+        } else {
+            bound.open_lanes(&scratch.rows, &mut scratch.tb, j0, mean_free, open_below)
+        }
             & ((1u32 << lanes) - 1)
             & !near(j0);
         if open == 0 {
@@ -953,7 +956,7 @@ fn half_better(
 /// any grouping of the window's differences `e_i` (their mean `m` removed with `mean_free`,
 /// else `m = 0`), `sum |e_i - m| >= sum over groups |sum_g e_i - n_g m|`; the groups are each
 /// column's upper and lower half. Their right sums are interpolated from the column-wise sums
-/// of the right rows (`v_top`, `v_bot` in the scratch), a few operations per lane where the
+/// of the right rows ([`BoundRows`] in the scratch), a few operations per lane where the
 /// exact sums take a few hundred. On 600 of cloth3's MCGM matches it leaves 0.3 % of the lanes
 /// open and 1.5 % of the blocks of 8 (each column whole: 5.9 % and 20 %). A lane it rules out
 /// cannot fit better, so [`half_better`]'s answer is the same as without it.
@@ -966,6 +969,25 @@ struct SidesBound {
     /// Rows in the upper and lower half.
     rows: (f32, f32),
     n: f32,
+    /// Every column has the same interpolation weight (the usual case: `x - d` rounds alike
+    /// for all columns unless they straddle a power of two): its interpolated sums were
+    /// computed once per window ([`BoundRows`]'s `lerp_*`), not once per column and block.
+    shared_weight: bool,
+}
+
+/// The right rows' column-wise sums of [`SidesBound`], and with one interpolation weight
+/// for every column, those sums interpolated (`v[p] + f (v[p + 1] - v[p])`, the bound's
+/// operation) and their upper + lower total.
+#[derive(Default)]
+struct BoundRows {
+    v_top: Vec<f32>,
+    v_bot: Vec<f32>,
+    lerp_top: Vec<f32>,
+    lerp_bot: Vec<f32>,
+    lerp_sum: Vec<f32>,
+    /// [`SidesBound::lane_sums`]' per-lane mean and bound sums.
+    lane_m: Vec<f32>,
+    lane_acc: Vec<f32>,
 }
 
 impl SidesBound {
@@ -1008,7 +1030,8 @@ impl SidesBound {
         // p0 + o + j and the next one (inside the row: half_better's lane range ensures it).
         let span = (b_max - b_min) as usize + nk + 1;
         let p0 = (b_min - k_hi) as usize;
-        let (v_top, v_bot) = (&mut scratch.v_top, &mut scratch.v_bot);
+        let rows = &mut scratch.rows;
+        let (v_top, v_bot) = (&mut rows.v_top, &mut rows.v_bot);
         for v in [&mut *v_top, &mut *v_bot] {
             v.clear();
             v.resize(span + nk.div_ceil(8) * 8 - nk, 0.0);
@@ -1021,12 +1044,32 @@ impl SidesBound {
                 *a += x;
             }
         }
+        // One weight for all columns: each sum interpolated once here (every column and
+        // block then reads it), the same operation on the same values as per column.
+        let f0 = cols[0].1;
+        let shared_weight = cols[..nc].iter().all(|c| c.1.to_bits() == f0.to_bits());
+        if shared_weight {
+            let lerp = |v: &[f32], out: &mut Vec<f32>| {
+                out.clear();
+                out.extend(v.iter().zip(&v[1..]).map(|(&a, &b)| a + f0 * (b - a)));
+            };
+            lerp(&rows.v_top, &mut rows.lerp_top);
+            lerp(&rows.v_bot, &mut rows.lerp_bot);
+            rows.lerp_sum.clear();
+            rows.lerp_sum.extend(
+                rows.lerp_top
+                    .iter()
+                    .zip(&rows.lerp_bot)
+                    .map(|(&t, &b)| t + b),
+            );
+        }
         Self {
             nc,
             cols,
             ltot,
             rows: (n_top as f32, (nr - n_top) as f32),
             n: (nc * nr) as f32,
+            shared_weight,
         }
     }
 
@@ -1035,12 +1078,13 @@ impl SidesBound {
     #[allow(clippy::type_complexity)]
     fn open_lanes(
         &self,
-        (v_top, v_bot): (&[f32], &[f32]),
+        sums: &BoundRows,
         tb: &mut [([f32; 8], [f32; 8]); MAX_SIDES_WIDTH],
         j0: usize,
         mean_free: bool,
         open_below: f32,
     ) -> u32 {
+        let (v_top, v_bot) = (&sums.v_top[..], &sums.v_bot[..]);
         let interp = |v: &[f32], o: usize, f: f32| -> [f32; 8] {
             let v = &v[o + j0..o + j0 + 9];
             std::array::from_fn(|t| v[t] + f * (v[t + 1] - v[t]))
@@ -1070,6 +1114,54 @@ impl SidesBound {
                 acc[q] += (lt - t[q] - wt * m[q]).abs() + (lb - b[q] - wb * m[q]).abs();
             }
         }
+        self.lane_bits(&acc, open_below)
+    }
+
+    /// With one interpolation weight for every column ([`Self::shared_weight`]): the bound's
+    /// sums of every lane `0..nl` at once, into `sums.lane_acc` (`nl`: the lane count rounded
+    /// up to a block). Per lane the same values are added in the same order as
+    /// [`Self::open_lanes`] adds them (columns in order), so `lane_bits` of a block of them
+    /// gives its bits; a column's lanes are one run of loads, not a block of 8 at a time.
+    #[inline(always)]
+    fn lane_sums(&self, sums: &mut BoundRows, nl: usize, mean_free: bool) {
+        let cols = &self.cols[..self.nc];
+        let BoundRows {
+            lerp_top,
+            lerp_bot,
+            lerp_sum,
+            lane_m: m,
+            lane_acc: acc,
+            ..
+        } = sums;
+        m.clear();
+        m.resize(nl, 0.0);
+        if mean_free {
+            for &(o, _, _, _) in cols {
+                for (q, &s) in m.iter_mut().zip(&lerp_sum[o..o + nl]) {
+                    *q += s;
+                }
+            }
+            for q in m.iter_mut() {
+                *q = (self.ltot - *q) / self.n;
+            }
+        }
+        acc.clear();
+        acc.resize(nl, 0.0);
+        let (wt, wb) = self.rows;
+        for &(o, _, lt, lb) in cols {
+            let lanes = acc
+                .iter_mut()
+                .zip(&m[..])
+                .zip(lerp_top[o..o + nl].iter().zip(&lerp_bot[o..o + nl]));
+            for ((a, &q), (&t, &b)) in lanes {
+                *a += (lt - t - wt * q).abs() + (lb - b - wb * q).abs();
+            }
+        }
+    }
+
+    /// Bit `t` set when `acc[t] / n` is below `open_below`.
+    #[inline(always)]
+    fn lane_bits(&self, acc: &[f32; 8], open_below: f32) -> u32 {
         // Compares first, then the bits (a vector compare and a mask, not eight branches).
         let below: [bool; 8] = std::array::from_fn(|t| acc[t] / self.n < open_below);
         below
@@ -1214,8 +1306,7 @@ unsafe fn sads_fit_mask_avx2<const J: usize>(
 struct SidesScratch {
     els: Vec<(usize, f32, f32)>,
     /// [`SidesBound`]'s column-wise sums of the right rows' upper and lower halves.
-    v_top: Vec<f32>,
-    v_bot: Vec<f32>,
+    rows: BoundRows,
     /// [`SidesBound::open_lanes`]' interpolated column sums (upper, lower half) of a block.
     tb: [([f32; 8], [f32; 8]); MAX_SIDES_WIDTH],
     /// [`half_mad`]'s differences of one half-window.

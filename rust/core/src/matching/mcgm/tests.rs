@@ -525,7 +525,7 @@ fn bound_keeps_every_lane(
     for &(k, v) in &values {
         let j = (k_hi - k) as usize;
         let bits = bound.open_lanes(
-            (&scratch.v_top, &scratch.v_bot),
+            &scratch.rows,
             &mut scratch.tb,
             j / 8 * 8,
             mean_free,
@@ -2545,10 +2545,17 @@ fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
         *e = ([f32::NAN; 8], [f32::NAN; 8]);
     }
     let (mut ones, mut zeros) = (0u32, 0u32);
-    for geom in [(1, 16, 3), (1, 1, 0), (3, 9, 2), (1, 2, 1)] {
+    // Windows whose columns share one interpolation weight (half_better then sums every lane
+    // at once from the window's interpolated sums) and windows whose `x - d` straddles 64,
+    // where the weight's rounding differs between columns (each column interpolated on its
+    // own, block by block).
+    let mut shared = [0u32; 2];
+    for (geom, at) in [(1, 16, 3), (1, 1, 0), (3, 9, 2), (1, 2, 1)]
+        .into_iter()
+        .flat_map(|g| [(g, (45, 8, 8, 5.3f32)), (g, (63, 8, 8, 2e-5f32))])
+    {
         for side in [-1, 1] {
             for ks in [(-7, 40), (-3, 13), (-2, 6)] {
-                let at = (45, 8, 8, 5.3f32);
                 let (base, b_range, (k_lo, k_hi)) = window_bases(at, side, geom, ks, w);
                 assert!(k_hi >= k_lo, "{geom:?} {side} {ks:?}");
                 let nk = (k_hi - k_lo + 1) as usize;
@@ -2562,19 +2569,30 @@ fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
                     (&base, b_range),
                     &mut scratch,
                 );
+                shared[usize::from(bound.shared_weight)] += 1;
                 for mean_free in [false, true] {
+                    if bound.shared_weight {
+                        bound.lane_sums(&mut scratch.rows, nk.div_ceil(8) * 8, mean_free);
+                    }
                     for j0 in (0..nk).step_by(8) {
                         for open_below in [0.0f32, 0.02, 0.05, 0.1, 0.2, f32::INFINITY] {
-                            let vs = (&scratch.v_top[..], &scratch.v_bot[..]);
+                            let vs = (&scratch.rows.v_top[..], &scratch.rows.v_bot[..]);
                             let want = open_lanes_twice(&bound, vs, j0, mean_free, open_below);
                             let got = bound.open_lanes(
-                                (&scratch.v_top, &scratch.v_bot),
+                                &scratch.rows,
                                 &mut scratch.tb,
                                 j0,
                                 mean_free,
                                 open_below,
                             );
                             assert_eq!(got, want, "{geom:?} {side} {ks:?} {j0} {mean_free}");
+                            if bound.shared_weight {
+                                // half_better's path: every lane's sums at once, then a block.
+                                let mut acc = [0.0f32; 8];
+                                acc.copy_from_slice(&scratch.rows.lane_acc[j0..j0 + 8]);
+                                let all = bound.lane_bits(&acc, open_below);
+                                assert_eq!(all, want, "{geom:?} {side} {ks:?} {j0} {mean_free}");
+                            }
                             ones += got.count_ones();
                             zeros += got.count_zeros();
                         }
@@ -2584,6 +2602,7 @@ fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
         }
     }
     assert!(ones > 100 && zeros > 100, "{ones} {zeros}");
+    assert!(shared[0] >= 6 && shared[1] >= 24, "{shared:?}");
 }
 
 /// Run by [`an_rtable_too_large_to_allocate_is_an_error`] in a child process: one segment of
