@@ -1976,6 +1976,33 @@ def test_the_camera_info_of_uncalibrated_cameras_is_no_calibration(
     assert "say a camera is uncalibrated (K = 0): disparity only" in err
 
 
+def test_rectified_topics_whose_camera_info_fills_p_only_keep_their_calibration(
+    cones: Any, tmp_path: Path
+) -> None:
+    """``image_rect`` topics are calibrated by their ``P`` matrices alone (K, D and R are
+    replaced by P's, as ``stereo_image_proc`` reads them): a camera_info with ``K`` all zeros
+    but a valid ``P`` gave that calibration, until c10a691 took ``K[0] == 0`` as an
+    uncalibrated camera for rectified topics too (None: disparity only, without a word).
+    For them the test is ``P[0] == 0``; raw topics, which need K, keep ``K[0] == 0``."""
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    p_only = tuple(c | {"K": np.zeros((3, 3)), "R": np.zeros((3, 3)), "D": np.zeros(0),
+                        "distortion_model": ""} for c in cams)  # fmt: skip
+    frames = [(T0, cones.left, T0, cones.right)]
+    rect = ("/stereo/left/image_rect", "/stereo/right/image_rect")
+    with BagCamera(write_bag(tmp_path / "rect", frames, topics=rect, infos=p_only)) as cam:
+        got = cam.calibration()
+    assert got is not None and got.rectified
+    np.testing.assert_allclose(got.K1, cams[0]["P"][:, :3])
+    assert got.baseline_m == pytest.approx(-cams[1]["P"][0, 3] / cams[1]["P"][0, 0])
+    # raw topics cannot be rectified without K: no calibration, as before
+    with BagCamera(write_bag(tmp_path / "raw", frames, infos=p_only)) as cam:
+        assert cam.calibration() is None
+    # rectified topics with a P of zeros (an uncalibrated camera's, K valid) are none too
+    no_p = (cams[0] | {"P": np.zeros((3, 4))}, cams[1])
+    with BagCamera(write_bag(tmp_path / "rect0", frames, topics=rect, infos=no_p)) as cam:
+        assert cam.calibration() is None
+
+
 def test_a_topic_recorded_with_two_types_is_listed_with_both(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

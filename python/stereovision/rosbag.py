@@ -1686,7 +1686,8 @@ class BagCamera(PairSource):
         side), in metres; None when the bag has no ``camera_info`` beside both image topics,
         or one of them is an uncalibrated camera's (``K[0] = 0``: ROS's own test,
         ``camera_info_manager``'s ``isCalibrated``; a driver without a calibration file, such as
-        ``usb_cam``, publishes all zeros).
+        ``usb_cam``, publishes all zeros). For rectified topics, which use ``P`` alone, the
+        test is ``P[0] = 0``.
 
         For raw topics it is the rig of :meth:`Calibration.from_ros
         <stereovision.calibration.Calibration.from_ros>`; for rectified topics (``image_rect``)
@@ -1730,9 +1731,11 @@ class BagCamera(PairSource):
                 for n in "kdrp"
             )
             K, R, P = K.reshape(3, 3), R.reshape(3, 3), P.reshape(3, 4)
-            if K[0, 0] == 0:
-                # an uncalibrated camera, as ROS tells it: its zeros were refused ("does not
-                # hold a rotation"), so stream, info and gui failed on a bag that reads whole
+            # an uncalibrated camera, as ROS tells it (K[0] == 0): its zeros were refused ("does
+            # not hold a rotation"), so stream, info and gui failed on a bag that reads whole.
+            # Rectified topics need P alone (K, D, R are replaced below): K's zeros beside a
+            # valid P (a driver that fills P only) are a calibration there, P's zeros are none
+            if (P[0, 0] if self.rectified_topics else K[0, 0]) == 0:
                 return None
             roi = msg.roi
             size = (int(msg.width), int(msg.height))
