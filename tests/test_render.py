@@ -271,6 +271,51 @@ def test_surface_mesh_step_subsamples(result):
     assert 0 < coarse.n_cells < render.surface_mesh(result).n_cells / 3
 
 
+def _ground_result(result):
+    """``result`` made a flat floor seen from 1.6 m: the horizon at row 40, depth
+    ``f * 1.6 / (y - 40)`` below it (NaN above), 64 columns; points rebuilt from the depth map."""
+    h, w, f, cy = 400, 64, 2000.0, 40.0
+    k = np.array([[f, 0, w / 2 - 0.5], [0, f, cy], [0, 0, 1]])
+    rows = np.arange(h, dtype=np.float64)[:, None] - cy
+    with np.errstate(divide="ignore"):
+        depth = np.where(rows > 0, f * 1.6 / rows, np.nan) * np.ones((1, w))
+    empty = {"points": np.zeros((0, 3), np.float32), "colors": np.zeros((0, 3), np.uint8),
+             "pixels": np.zeros((0, 2), np.int32)}  # fmt: skip
+    return dataclasses.replace(
+        result, **empty, calibration=dataclasses.replace(result.calibration, K1=k, K2=k),
+        depth=depth.astype(np.float32), depth_sigma=None, disparity=np.zeros((h, w), np.float32),
+        confidence=np.zeros((h, w), np.float32), left_rectified=np.zeros((h, w, 3), np.uint8),
+    )  # fmt: skip
+
+
+def test_surface_mesh_keeps_a_slanted_floor_at_any_step(result):
+    """render_result meshes an image of at least twice max_side every ``side // max_side``
+    pixels, but the depth-jump test took ``1 + max_jump`` over a triangle ``step`` pixels
+    wide: a floor changes by ``step`` times more across it, and the floor 12.5-25 rows under
+    the horizon (depth 1 / row: 4-8 % a row) vanished from the step-2 mesh (3.9 % of a
+    2400 x 400 picture's floor). The jump is per pixel now; an edge of 100 % is still cut."""
+    ground = _ground_result(result)
+    rows = {}
+    for step in (1, 2, 3, 4):
+        tris = np.asarray(render.surface_mesh(ground, step=step).faces).reshape(-1, 4)[:, 1:]
+        tc = np.asarray(render.surface_mesh(ground, step=step).active_texture_coordinates)
+        top = (1 - tc[tris.ravel(), 1]) * 400 - 0.5  # each triangle's pixel rows
+        rows[step] = int(top.min())
+    # every pixel: from row 53 (12.5 rows under the horizon, 8 % a row); every step pixels:
+    # within a step of it (was from row 66 at step 2, 91 at step 4)
+    assert rows[1] == 53
+    assert all(rows[1] - step < rows[step] < rows[1] + step for step in (2, 3, 4)), rows
+    # the box (2 m) before the wall (4 m) is cut at step 4 too: 1.08 ** 4 < 2
+    z = np.asarray(render.surface_mesh(result, step=4).points)[:, 2]
+    tris = np.asarray(render.surface_mesh(result, step=4).faces).reshape(-1, 4)[:, 1:]
+    assert (z[tris].max(axis=1) <= 1.5 * z[tris].min(axis=1)).all()
+    # a max_jump whose power overflows a float is no limit, as inf
+    assert (
+        render.surface_mesh(result, step=4, max_jump=1e200).n_cells
+        == render.surface_mesh(result, step=4, max_jump=math.inf).n_cells
+    )
+
+
 def test_surface_mesh_errors(result):
     from dataclasses import replace
 

@@ -794,8 +794,9 @@ def surface_mesh(
     """Textured triangle mesh of the depth map, one vertex per (sub-sampled) pixel with a depth.
 
     Neighbouring pixels ``(x, y), (x+s, y), (x, y+s), (x+s, y+s)`` form two triangles; a triangle
-    is kept only if its three pixels have a depth and ``max(Z) / min(Z) - 1 <= max_jump`` (no
-    triangle spans a depth discontinuity or a hole).
+    is kept only if its three pixels have a depth and ``max(Z) / min(Z) <= (1 + max_jump) ** s``
+    (``max_jump`` per pixel of its side: no triangle spans a depth discontinuity or a hole, and
+    a slanted surface is kept at any step).
 
     Parameters
     ----------
@@ -805,7 +806,7 @@ def surface_mesh(
     step : int
         Pixel stride of the vertex grid (1 = every pixel; 2 = a quarter of the vertices).
     max_jump : float
-        Relative depth jump above which a triangle is dropped (default
+        Relative depth jump per pixel above which a triangle is dropped (default
         :data:`MAX_RELATIVE_DEPTH_JUMP`).
 
     Returns
@@ -854,7 +855,14 @@ def surface_mesh(
     tris = tris[(tris >= 0).all(axis=1)]
     if len(tris):
         zt = z[tris]
-        tris = tris[zt.max(axis=1) <= zt.min(axis=1) * (1 + max_jump)]
+        # max_jump per pixel: a triangle spans `step` of them, and a slanted surface (the
+        # floor towards the horizon) changes by that much more across it; 1 + max_jump alone
+        # cut the floor 12-25 rows under the horizon from render.png's step-2 mesh
+        try:
+            limit = (1 + max_jump) ** step
+        except OverflowError:  # (1e200) ** 2: no limit, as inf
+            limit = math.inf
+        tris = tris[zt.max(axis=1) <= zt.min(axis=1) * limit]
     faces = np.hstack([np.full((len(tris), 1), 3, np.int64), tris]).ravel()
     mesh = pv.PolyData(pts, faces=faces) if len(tris) else pv.PolyData(pts)
     u = (xs[sel] + 0.5) / w
