@@ -867,3 +867,21 @@ def test_keywords_that_make_a_bag_ros_cannot_use_are_refused(kitti: tuple, tmp_p
     for skew in (True, "5"):
         with pytest.raises(ValueError, match="max_skew_ms: expected a number >= 0"):
             BagCamera(run, max_skew_ms=skew)
+    # a Fraction or Decimal is its number (it was "expected a number >= 0, got Fraction(5,
+    # 1)"); an int beyond a float is too large, not math.isfinite's OverflowError
+    from decimal import Decimal
+    from fractions import Fraction
+
+    for skew in (Fraction(5), Decimal("5")):  # taken: the bag's own words come next
+        with pytest.raises(ValueError, match="no left/right pair among the bag's image topics"):
+            BagCamera(run, max_skew_ms=skew)
+    with pytest.raises(
+        ValueError, match=r"max_skew_ms: expected at most \S+, got an integer of 401"
+    ):
+        BagCamera(run, max_skew_ms=10**400)
+    with pytest.raises(ValueError, match="max_skew_ms: expected a number >= 0, got a negative"):
+        BagCamera(run, max_skew_ms=-(10**400))
+    with pytest.raises(
+        ValueError, match=r"max_skew_ms: expected a number >= 0, got Decimal\('NaN'\)"
+    ):
+        BagCamera(run, max_skew_ms=Decimal("NaN"))

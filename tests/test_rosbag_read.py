@@ -428,6 +428,11 @@ def test_max_skew_and_end_of_recording(cones: Any, tmp_path: Path) -> None:
     # only frames within 2.5 ms pair; the others are dropped on both sides
     want = [k for k in range(14) if k not in (5, 9) and abs(jitter[k]) <= 2_500_000]
     assert [f.index for f in got] == list(range(len(want)))
+    # a Fraction is its number (it was "expected a number >= 0, got Fraction(5, 2)")
+    from fractions import Fraction
+
+    with BagCamera(bag, max_skew_ms=Fraction(5, 2)) as cam:
+        assert [f.index for f in cam.frames()] == list(range(len(want)))
     assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in want]
     assert cam.dropped == {"left": 13 - len(want), "right": 13 - len(want)}
 

@@ -81,7 +81,14 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
-from stereovision._validate import real_number, renamed_keyword, source_warning
+from stereovision._validate import (
+    _plain_real,
+    number_shown,
+    real_number,
+    renamed_keyword,
+    source_warning,
+    too_large_for_float,
+)
 from stereovision.capture import PairSource, SourceError, StereoFrame, _pairs, resize_frame
 
 __all__ = [
@@ -1245,13 +1252,23 @@ class BagCamera(PairSource):
             self.path = self.path.parent  # a file of a ROS 2 bag (its .db3, .mcap or metadata)
         if (left_topic is None) != (right_topic is None):
             raise ValueError("give both the left and the right topic, or neither")
+        # a Fraction or Decimal as its float (refused as "expected a number"), as the
+        # library's other numbers; 10**400 is a number, too large (math.isfinite's
+        # OverflowError)
+        skew_in = _plain_real(max_skew_ms)
         if max_skew_ms is not None and not (
-            real_number(max_skew_ms) and math.isfinite(max_skew_ms) and max_skew_ms >= 0
+            real_number(skew_in)
+            and (too_large_for_float(skew_in) or math.isfinite(skew_in))
+            and skew_in >= 0
         ):  # "5" was TypeError's "must be real number, not str", True taken as 1 ms
-            raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
-        if max_skew_ms is not None and max_skew_ms > MAX_SKEW_MS:
-            raise ValueError(f"max_skew_ms: expected at most {MAX_SKEW_MS:g}, got {max_skew_ms!r}")
-        skew = None if max_skew_ms is None else float(max_skew_ms)
+            raise ValueError(
+                f"max_skew_ms: expected a number >= 0, got {number_shown(max_skew_ms)}"
+            )
+        if max_skew_ms is not None and skew_in > MAX_SKEW_MS:
+            raise ValueError(
+                f"max_skew_ms: expected at most {MAX_SKEW_MS:g}, got {number_shown(max_skew_ms)}"
+            )
+        skew = None if max_skew_ms is None else float(skew_in)
         self.requested_size = parse_size(image_size, "image_size")
         realtime = _flag(realtime, "realtime")  # bool("no") played the bag in real time
         try:
