@@ -862,6 +862,15 @@ def test_keywords_that_make_a_bag_ros_cannot_use_are_refused(kitti: tuple, tmp_p
                 bag.write(bad, 1)
         bag.write(kitti[0], 1)
     assert "/robot_1/stereo/depth" in _read(run)
+    # rmw takes topic names of at most 247 characters: a prefix of 225 gives that many at most,
+    # one of 226 was taken and made a bag ros2 bag play cannot publish
+    long = tmp_path / "long"
+    with pytest.raises(ValueError, match="prefix: 226 characters make topic names longer than"):
+        BagWriter(long, prefix="/" + "a" * 225)
+    assert not long.exists()
+    with BagWriter(long, prefix="/" + "a" * 224) as bag:
+        bag.write(kitti[0], 1)
+    assert max(len(topic) for topic in _read(long)) == 247
     with pytest.raises(TypeError, match="realtime: expected True or False, got 'no'"):
         BagCamera(run, realtime="no")
     for skew in (True, "5"):

@@ -149,6 +149,10 @@ def _stamp(stamp_ns: Any) -> int:
 
 #: A part of a ROS 2 topic name (rcl's rule): letters, digits and underscores, no digit first.
 _TOPIC_PART = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+#: The longest topic name ROS 2 takes (rmw's RMW_TOPIC_MAX_NAME_LENGTH: 255 less 8 for DDS's
+#: prefixes); :class:`BagWriter`'s longest topic under its prefix.
+_MAX_TOPIC_NAME = 247
+_LONGEST_TOPIC = "left/image_rect_color"
 
 
 def _flag(value: object, name: str) -> bool:
@@ -183,7 +187,15 @@ def _topic_prefix(prefix: object) -> str:
             f"prefix: {prefix!r} gives no ROS 2 topic name ({bad[0]!r}: each part is letters, "
             "digits and underscores, not starting with a digit)"
         )
-    return "/" + "/".join(parts) if parts else ""
+    out = "/" + "/".join(parts) if parts else ""
+    if len(f"{out}/{_LONGEST_TOPIC}") > _MAX_TOPIC_NAME:
+        # rmw refuses the name as too long: a bag ros2 bag play cannot publish, as above
+        raise ValueError(
+            f"prefix: {len(out)} characters make topic names longer than ROS 2's "
+            f"{_MAX_TOPIC_NAME} (.../{_LONGEST_TOPIC}): at most "
+            f"{_MAX_TOPIC_NAME - len(_LONGEST_TOPIC) - 1}"
+        )
+    return out
 
 
 def _sqlite(writer: Any) -> sqlite3.Connection | None:
@@ -225,7 +237,8 @@ ros2_static_transform>`.
     ------
     ValueError
         If ``prefix`` gives no ROS 2 topic name (a part other than letters, digits and
-        underscores, or starting with a digit), ``frame_id`` or ``scan_frame_id`` is no tf
+        underscores, or starting with a digit; over 225 characters, so that a topic name is
+        over ROS 2's 247), ``frame_id`` or ``scan_frame_id`` is no tf
         frame name (empty, or a leading ``/``), or the two are one frame.
     TypeError
         If ``points`` or ``tf`` is not True or False, or ``prefix`` is not a string.
@@ -610,7 +623,7 @@ ros2_static_transform>`.
             left = np.asarray(result.left_rectified, np.uint8)
             enc = "bgr8" if left.ndim == 3 else "mono8"
             self._put(
-                "left/image_rect_color",
+                _LONGEST_TOPIC,
                 "sensor_msgs/msg/Image",
                 self._image(header, left, enc),
                 stamp,
