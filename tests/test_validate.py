@@ -1022,3 +1022,141 @@ def test_mutation_audit_positive_whole_refuses_zero_in_any_type() -> None:
             positive_whole(bad, "every")
     got = [positive_whole(v, "every") for v in (1.0, np.float32(2.0), np.int64(3), 4)]
     assert got == [1, 2, 3, 4] and all(type(v) is int for v in got)
+
+
+def test_mutation_audit_whole_value_decimal_digits_limit_is_inclusive() -> None:
+    """Mutation audit: a Decimal of 4300 digits is a count (its int as exact), one of 4301 is
+    not (Python's own limit of an int read from text); ``> 4300`` passed the first refused."""
+    from stereovision._validate import whole_value
+
+    assert whole_value(Decimal("9e4299")) == 9 * 10**4299
+    assert whole_value(Decimal("1e4300")) is None
+    assert whole_value(Decimal("-1e4300")) is None
+
+
+def test_mutation_audit_whole_value_reads_another_real_by_its_float() -> None:
+    """Mutation audit: a numbers.Real that is no int, float, Fraction or Decimal is a count when
+    its float is whole, else none (the branch's is_integer() check was untested)."""
+    import numbers
+
+    from stereovision._validate import whole_value
+
+    class Real:
+        def __init__(self, v: float) -> None:
+            self.v = v
+
+        def __float__(self) -> float:
+            return self.v
+
+    numbers.Real.register(Real)
+    assert whole_value(Real(3.0)) == 3
+    assert whole_value(Real(2.5)) is None
+    assert whole_value(Real(float("inf"))) is None
+
+
+def test_mutation_audit_float32_reach_keeps_float32s_largest_value() -> None:
+    """Mutation audit: float32's largest value is within its range and returned as given (its
+    cast warns of nothing); only values beyond it are its signed infinity."""
+    from stereovision._validate import float32_reach
+
+    top = float(np.finfo(np.float32).max)
+    assert float32_reach(top) == top and float32_reach(-top) == -top
+    assert float32_reach(top * 2) == np.inf and float32_reach(-top * 2) == -np.inf
+
+
+def test_mutation_audit_empty_float32_range_shows_whole_numbers_without_point() -> None:
+    """Mutation audit: the float32-empty range's message shows 1e8 and 1e8 + 1 as the whole
+    numbers they are (every digit, no ".0") and names both arguments in order."""
+    from stereovision._validate import disparity_range
+
+    with pytest.raises(ValueError) as exc:
+        disparity_range(1e8, 1e8 + 1)
+    assert str(exc.value) == (
+        "empty disparity range in float32, the matchers' precision: max_disparity (100000001) "
+        "and min_disparity (100000000) are the same float32 number (100000000); give a wider "
+        "range"
+    )
+
+
+def test_mutation_audit_known_unit_returns_a_str_and_refuses_a_0d_array() -> None:
+    """Mutation audit: an np.str_ unit comes back as a plain str (it would reach later
+    messages as np.str_('m')); a 0-d array equal to a unit is no str and refused by name."""
+    from stereovision._validate import known_unit
+
+    got = known_unit(np.str_("mm"), ["m", "mm"])
+    assert got == "mm" and type(got) is str
+    with pytest.raises(ValueError, match=r"^depth_unit: expected one of \['m', 'mm'\], got arr"):
+        known_unit(np.array("m"), ["m", "mm"], "depth_unit")
+
+
+def test_mutation_audit_same_aspect_is_within_one_percent() -> None:
+    """Mutation audit: a halved odd side (450x375 -> 225x188) is one scale; 5 rows more of
+    375 (1.3 %) is another aspect ratio, so no crop-or-pad hint is given for it either."""
+    from stereovision._validate import crop_or_pad_hint, same_aspect
+
+    assert same_aspect((450, 375), (225, 188))
+    assert not same_aspect((1242, 375), (1242, 380))
+    assert crop_or_pad_hint((1242, 375), (1242, 380)) is None
+    assert crop_or_pad_hint((1242, 375), (1242, 376)) is not None
+
+
+def test_mutation_audit_figure_shown_switches_to_whole_units_at_999_5() -> None:
+    """Mutation audit: from 999.5 on a figure is shown in whole units ("1000", never "1e+03"),
+    below it with three significant digits."""
+    from stereovision._validate import figure_shown
+
+    assert [figure_shown(v) for v in (999.4, 999.5, 999.7, -999.7, 2270.4, 0.01234)] == [
+        "999",
+        "1000",
+        "1000",
+        "-1000",
+        "2270",
+        "0.0123",
+    ]
+
+
+def test_mutation_audit_first_line_skips_blank_lines_of_spaces() -> None:
+    """Mutation audit: a message opening with a line of spaces says its first line with text."""
+    from stereovision._validate import first_line
+
+    assert first_line(ValueError("   \n\t\nthe pair differs in size\nmore")) == (
+        "the pair differs in size"
+    )
+    assert first_line(ValueError("  \n ")) == "ValueError"
+
+
+def test_mutation_audit_refuse_unknown_suggests_only_a_close_spelling() -> None:
+    """Mutation audit: a key far from every valid one ('kcx' to 'k_cand': 0.44) gets no "did
+    you mean"; a close one ('k_cnad') does."""
+    from stereovision._validate import refuse_unknown
+
+    with pytest.raises(ValueError) as exc:
+        refuse_unknown("MCGM parameter", {"kcx": 1}, ["k_cand", "zeta"])
+    assert str(exc.value) == "unknown MCGM parameter(s) ['kcx']: expected one of k_cand, zeta"
+    with pytest.raises(ValueError, match=r"\(did you mean 'k_cand'\?\)"):
+        refuse_unknown("MCGM parameter", {"k_cnad": 1}, ["k_cand", "zeta"])
+
+
+def test_mutation_audit_not_a_result_names_the_array_to_pass() -> None:
+    """Mutation audit: a whole DepthResult where one of its arrays goes is a TypeError naming
+    the argument and the field; an array passes."""
+    import stereovision as sv
+    from stereovision._validate import not_a_result
+
+    res = sv.DepthResult(
+        disparity=np.ones((2, 2), np.float32),
+        confidence=np.ones((2, 2), np.float32),
+        depth=None,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fused",
+        max_disparity=16,
+        calibration=None,
+        depth_sigma=None,
+    )
+    with pytest.raises(
+        TypeError, match=r"^depth: got a DepthResult; pass its array, result\.depth$"
+    ):
+        not_a_result(res, "depth", "depth")
+    not_a_result(res.disparity, "disparity", "disparity")
