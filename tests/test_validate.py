@@ -1160,3 +1160,57 @@ def test_mutation_audit_not_a_result_names_the_array_to_pass() -> None:
     ):
         not_a_result(res, "depth", "depth")
     not_a_result(res.disparity, "disparity", "disparity")
+
+
+def test_mutation_audit_advice_for_carries_numbers_of_several_digits() -> None:
+    """Mutation audit: a size of 640x480 in the API's advice is carried whole into the CLI's."""
+    from stereovision._validate import advice_for
+
+    got = advice_for("depth_map: images resized, not cropped: calib.scaled_to((640, 480))", "cli")
+    assert got == (
+        "depth_map: images resized, not cropped: resize them back to the calibration's size, or "
+        "save it scaled to them once in Python with "
+        "Calibration.from_file(path).scaled_to((640, 480)).save('rig.yaml') and give rig.yaml"
+    )
+
+
+def test_mutation_audit_negative_levels_are_not_called_8_bit_data() -> None:
+    """Mutation audit: a float image reaching -0.25 and 200 is no 8-bit data to divide by 255
+    (nor clipped overshoot): the advice is to scale both images alike."""
+    from stereovision._validate import _unit_range_error
+
+    assert _unit_range_error(-0.25, 200.0, "left") == (
+        "left: float image values must lie in [0, 1], got range [-0.25, 200] "
+        "(scale both images of the pair to [0, 1] alike)"
+    )
+
+
+def test_mutation_audit_positive_finite_says_a_bool_is_a_bool() -> None:
+    """Mutation audit: True is refused as a bool ("got bool True"), not as the number it is."""
+    with pytest.raises(ValueError) as exc:
+        positive_finite(True, "blur")
+    assert str(exc.value) == "blur: expected a positive finite number, got bool True"
+
+
+def test_mutation_audit_pair_shape_error_says_which_image_has_alpha() -> None:
+    """Mutation audit: a colour image beside one with alpha is said as such (not "both are
+    grey"); a pair of two sizes gets the shapes alone, no hint of channels."""
+    from stereovision._validate import pair_shape_error
+
+    assert str(pair_shape_error((4, 5, 3), (4, 5, 4))) == (
+        "left and right images must have the same shape, got left (4, 5, 3) and right (4, 5, 4): "
+        "left is colour, right is colour with alpha; read both alike (cv2.imread(path) reads "
+        "both in colour)"
+    )
+    assert str(pair_shape_error((4, 5, 3), (4, 6))) == (
+        "left and right images must have the same shape, got left (4, 5, 3) and right (4, 6)"
+    )
+
+
+def test_mutation_audit_xy_points_keeps_float64() -> None:
+    """Mutation audit: points are float64 as given (0.1 and 1e300 are not float32's)."""
+    from stereovision._validate import xy_points
+
+    got = xy_points([[0.1, 1e300], [2, 3]])
+    assert got.dtype == np.float64
+    assert got[0, 0] == 0.1 and got[0, 1] == 1e300
