@@ -1192,6 +1192,22 @@ def test_mutation_audit_positive_finite_says_a_bool_is_a_bool() -> None:
     assert str(exc.value) == "blur: expected a positive finite number, got bool True"
 
 
+def test_mutation_audit_real_scalar_refuses_a_bool_as_documented() -> None:
+    """_real_scalar, documented to raise TypeError for a bool, read True as 1.0 (its callers
+    each refused bools before it, so no public result changed); np.bool_ was refused."""
+    from stereovision._validate import _real_scalar
+
+    for bad in (True, False, np.True_, np.array([True])):
+        with pytest.raises(TypeError):
+            _real_scalar(bad)
+    assert [_real_scalar(v) for v in (2, np.float32(0.5), np.array([3]), 2**70)] == [
+        2.0,
+        0.5,
+        3.0,
+        2.0**70,
+    ]
+
+
 def test_mutation_audit_pair_shape_error_says_which_image_has_alpha() -> None:
     """Mutation audit: a colour image beside one with alpha is said as such (not "both are
     grey"); a pair of two sizes gets the shapes alone, no hint of channels."""

@@ -804,7 +804,7 @@ def _real_scalar(value: object) -> float:
     array); a TypeError otherwise (a bool, a string, a list: a slider's ``[1.0]`` is no
     number). One rule for :func:`positive_finite` and :func:`finite_number` (the second refused
     ``np.array(3.0)`` and the first ``2**70``, each taken by the other)."""
-    if isinstance(value, bool) or real_number(value):  # 2**70: an object array
+    if real_number(value):  # not np.asarray: 2**70 is an object array there
         return float(value)
     if not isinstance(value, np.ndarray) or value.size != 1 or value.dtype.kind not in "iuf":
         raise TypeError(type(value).__name__)
