@@ -1230,3 +1230,37 @@ def test_mutation_audit_xy_points_keeps_float64() -> None:
     got = xy_points([[0.1, 1e300], [2, 3]])
     assert got.dtype == np.float64
     assert got[0, 0] == 0.1 and got[0, 1] == 1e300
+
+
+def test_mutation_audit_float_range_shows_nine_figures_of_a_float64_level() -> None:
+    """Mutation audit: a float64 level that neither ``:g`` nor float32 reads back is shown with
+    9 figures (1.00001235), not 6 (1.00001, which reads as within the tolerance's reach)."""
+    from stereovision._validate import _unit_range_error
+
+    assert _unit_range_error(0.0, 1.0000123456789, "left") == (
+        "left: float image values must lie in [0, 1], got range [0, 1.00001235] "
+        "(clip an overshoot of resampling with numpy.clip(img, 0, 1))"
+    )
+
+
+def test_mutation_audit_a_pathlib_path_is_said_to_be_a_path() -> None:
+    """Mutation audit: a pathlib.Path where an image goes is named as the path it is (NumPy
+    made it an object array: "converting to dtype object" said nothing of reading it)."""
+    with pytest.raises(ValueError) as exc:
+        as_gray_float(Path("scene/left.png"), "left")
+    assert str(exc.value) == (
+        "left: got the path 'scene/left.png', not an image: read it first "
+        "(cv2.imread(path) or stereovision.io.imread(path))"
+    )
+
+
+def test_mutation_audit_refuse_not_numbers_names_the_first_and_spares_switches() -> None:
+    """Mutation audit: the first numeric parameter given a bool or a timedelta is named; a
+    switch's True (its default a bool) is its own."""
+    from stereovision._validate import refuse_not_numbers
+
+    defaults = {"flag": False, "A": 1.0, "k_cand": 3}
+    with pytest.raises(ValueError) as exc:
+        refuse_not_numbers({"flag": True, "A": True, "k_cand": np.timedelta64(3)}, defaults)
+    assert str(exc.value) == "A: expected a number, got True"
+    refuse_not_numbers({"flag": True, "A": 2.0, "k_cand": 3}, defaults)
