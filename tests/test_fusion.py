@@ -656,6 +656,45 @@ def test_fattened_kernel_refuses_a_guide_that_is_not_finite(bad: float) -> None:
         _core.fattened(d, g, 3, 2.0, 2.0)
 
 
+@pytest.mark.parametrize(
+    ("bad", "said"),
+    [
+        (np.nan, "got 1 NaN or inf$"),
+        (-np.inf, "got 1 NaN or inf$"),
+        (1e39, r"got 1 value\(s\) past float32's range \(3\.40282e\+38\)$"),
+    ],
+)
+def test_fused_dense_refuses_a_guide_step_7_cannot_read_before_the_steps_run(
+    monkeypatch: pytest.MonkeyPatch, bad: float, said: str
+) -> None:
+    """The kernel refuses a guide with NaN or inf, but fused_dense reached it only after steps
+    1-6 had run, and a float64 guide of finite values past float32's range (the guide is "any
+    scale") was cast to inf with NumPy's overflow warning and called "NaN or inf". Now the
+    guide is checked first, and its message says which; unused (edge_radius 0) it is not."""
+    import warnings
+
+    from stereovision.matching import fusion
+
+    d = np.full((20, 30), 10.0, np.float32)
+    d[5:15, 10:20] = 20.0
+    conf = np.full(d.shape, 0.8, np.float32)
+    none = np.full(d.shape, np.nan, np.float32)
+    guide = np.full(d.shape, 0.2)
+    guide[5:15, 12:18] = 0.8
+    guide[3, 4] = bad
+    ran: list[str] = []
+    real = fusion._drop_speckles
+    monkeypatch.setattr(fusion, "_drop_speckles", lambda *a: ran.append("6") or real(*a))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "overflow encountered in cast"
+        with pytest.raises(ValueError, match=f"^guide: expected a finite grey image, {said}"):
+            fused_dense(d, conf, none, guide=guide)
+    assert ran == []  # refused before step 6
+    out, _ = fused_dense(d, conf, none, guide=guide, edge_radius=0)
+    np.testing.assert_array_equal(out, d)
+    assert ran == ["6"]
+
+
 def test_fused_dense_drops_speckles() -> None:
     """Step 6: a 3x3 island off its surroundings (9 px, fewer than 5e-5 of 400x500 = 10) becomes
     a hole; a 5x50 strip (250 px) and the slanted background stay."""

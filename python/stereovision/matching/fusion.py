@@ -1089,7 +1089,8 @@ def fused_dense(
     ValueError
         Maps of different shapes, a negative radius / tolerance, ``fill_confidence`` or
         ``second_confidence`` not a number in (0, 1] (0 is the filled pixels' mark), an
-        ``edge_ratio`` or ``edge_jump`` past float32's largest value.
+        ``edge_ratio`` or ``edge_jump`` past float32's largest value, or (when step 7 runs) a
+        ``guide`` with NaN, inf or values past float32's range.
     """
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
@@ -1134,10 +1135,10 @@ def fused_dense(
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
     has = np.isfinite(a)
     anchored = has.copy()
-    g = None if guide is None else _check_map(guide, "guide", shape)
     opinion = (b, second_tol, second_confidence, occlusion_tau, _only_second)
     # A look past the map's sides finds nothing more: the cap keeps it in the kernel's integers.
     reach = min(int(edge_radius), max(shape))
+    g = None if guide is None else _check_guide(guide, shape, reach >= 1)
     finish = (speckle_area, speckle_diff, g, reach, edge_ratio, edge_jump, _only_second)
     if not has.any():
         _second_opinion(out, conf, has, anchored, *opinion)
@@ -1155,6 +1156,25 @@ def fused_dense(
     anchored |= hole
     _second_opinion(out, conf, has, anchored, *opinion)
     return _finish(out, conf, has, *finish)
+
+
+def _check_guide(guide: npt.ArrayLike, shape: tuple[int, int], used: bool) -> F32:
+    """Step 7's ``guide`` as a float32 map of ``shape``; if the step runs (``used``), refused
+    unless every value is finite in float32 (the kernel's edge search cannot read NaN or inf).
+
+    The kernel refused it only after steps 1-6 had run, and counted a float64 guide's finite
+    values past float32's range ("any scale") as "NaN or inf", after NumPy's overflow warning.
+    """
+    with np.errstate(over="ignore"):  # a value past float32's range: named below
+        g = _check_map(guide, "guide", shape)
+    if used and not np.isfinite(g).all():
+        with np.errstate(over="ignore"):
+            n_bad = int(np.count_nonzero(~np.isfinite(np.asarray(guide, np.float64))))
+        n_big = int(np.count_nonzero(~np.isfinite(g))) - n_bad
+        got = [f"{n_bad} NaN or inf"] if n_bad else []
+        got += [f"{n_big} value(s) past float32's range ({_F32_MAX:.6g})"] if n_big else []
+        raise ValueError(f"guide: expected a finite grey image, got {' and '.join(got)}")
+    return g
 
 
 def _finish(
