@@ -497,8 +497,9 @@ fn sample4(row: &[f32], i: i32, q: [f32; 4]) -> f32 {
     }
 }
 
-/// Catmull-Rom sample of `row` at real position `t` (indices clamped to the row: past either
-/// end, the end's value).
+/// Catmull-Rom sample of `row` at real position `t` (indices clamped to the row: from a whole
+/// sample past either end on, `t <= -1` or `t >= row.len()`, the end's value to within float32
+/// rounding; nearer, the curve still bends towards the end's neighbour).
 #[inline]
 pub fn cubic_sample(row: &[f32], t: f32) -> f32 {
     // Held within two samples of the row, as `warp_row` holds it: a `t` of 2**31 or more (or
@@ -1516,6 +1517,25 @@ mod tests {
                     + (3.0 * p1 - p0 - 3.0 * p2 + p3) * f * f * f);
             let got = cubic_sample(&row, t) as f64;
             assert!((got - want).abs() < 1e-5, "t {t}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn cubic_sample_reads_an_end_from_a_whole_sample_past_it() {
+        // Half a sample past an end the clamped indices still weigh its neighbour: 5.25 and
+        // 3.125, not the ends' 5 and 3; from a whole sample on, the end up to rounding.
+        let row = [3.0f32, 1.0, 4.0, 1.0, 5.0];
+        assert_eq!(cubic_sample(&row, 4.5), 5.25);
+        assert_eq!(cubic_sample(&row, -0.5), 3.125);
+        for k in 0..=60 {
+            let t = k as f32 * 0.05;
+            let (hi, lo) = (cubic_sample(&row, 5.0 + t), cubic_sample(&row, -1.0 - t));
+            assert!((hi - 5.0).abs() <= 5.0 * f32::EPSILON, "t {} {hi}", 5.0 + t);
+            assert!(
+                (lo - 3.0).abs() <= 3.0 * f32::EPSILON,
+                "t {} {lo}",
+                -1.0 - t
+            );
         }
     }
 
