@@ -2545,6 +2545,23 @@ def test_check_plot_of_the_same_plot_again_keeps_no_copy(
     assert plot.read_bytes() == first
 
 
+def test_check_plot_names_the_picture_it_wrote(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check L R --plot PNG`` wrote the picture without a word (``view -o`` and ``--fix`` name
+    the file they write): its last line now says where it is; with --json stdout stays the one
+    JSON object."""
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    plot = tmp_path / "plot.png"
+    argv = ["check", str(scene / "left.png"), str(scene / "right.png"), "--plot", str(plot)]
+    assert main(argv) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("rectification ok: ") and out[-1] == f"plot written to {plot}"
+    assert len(out) == 2 and cv2.imread(str(plot)) is not None
+    assert main([*argv, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ok"] is True
+
+
 @pytest.mark.parametrize("blocked", ["file above", "read-only above"])
 def test_rectify_checks_its_output_folder_before_the_work(
     data_dir: Path,

@@ -1093,6 +1093,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             else "  these images are not rectified: give the rig's calibration (--calib), or "
             "rectify them from their own features (stereovision rectify LEFT RIGHT -o DIR)"
         )
+    if args.plot and not args.json:  # the picture asked for is named, as view -o names its own
+        print(f"plot written to {args.plot}")
     if res.ok is None:
         # Not an error of the command line (2), nor a verdict on the rig (1): the pair could
         # not be judged, so there is nothing to correct either.
