@@ -530,3 +530,27 @@ def test_bench_interrupted_prints_the_scenes_it_timed(
     assert main(["bench", "--json", str(tmp_path)]) == 130  # its lines went out as it went
     objects = [json.loads(ln) for ln in capsys.readouterr().out.splitlines()]
     assert [o["scene"].split("/")[-1] for o in objects] == ["a_first"]
+
+
+def test_bench_of_one_scene_on_a_terminal_says_it_is_timing(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The progress bar counts scenes and is off for one, so `stereovision bench` on one scene
+    (the bundled cones: 12 s) was silent until its table. On a terminal a line on stderr now
+    says what runs first; --json (stdout read by a program) and a piped stderr get none."""
+    import sys
+
+    import stereovision.bench as bench
+
+    monkeypatch.setattr(bench, "bench_scene", lambda scene, runs: [])
+    scene = data_dir / SCENE
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    assert main(["bench", str(scene), "--runs", "7"]) == 0
+    assert capsys.readouterr().err == (
+        f"{scene}: timing every case, a warm-up and 7 rounds (the table follows) ...\n"
+    )
+    assert main(["bench", str(scene), "--json"]) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
+    assert main(["bench", str(scene)]) == 0
+    assert capsys.readouterr().err == ""

@@ -353,6 +353,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
             for c in all_cases:
                 print(json_line(c.as_dict()))
 
+    if len(dirs) == 1 and not args.json and sys.stderr.isatty():
+        # the bar counts scenes, so one scene had none: 10-30 s of timing without a word
+        print(
+            f"{dirs[0]}: timing every case, a warm-up and {args.runs} rounds "
+            "(the table follows) ...",
+            file=sys.stderr,
+            flush=True,
+        )
     try:
         for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
             try:
