@@ -204,6 +204,32 @@ def test_help_texts_state_the_defaults() -> None:
     assert not unsaid, f"--help does not say these defaults: {unsaid}"
 
 
+def test_help_texts_say_what_the_option_is_beside_its_default() -> None:
+    """`gui --port` said only "default 8080", `stream --max-disparity` only "default: estimated
+    from the first pair" and `batch --max-disparity` "for every pair (default: per pair)": not
+    what the option is, nor its unit. Each option's help says more than its default, and each
+    --max-disparity that it is the range searched, in pixels."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    bare, no_unit = [], []
+    for command, sub in commands.choices.items():
+        for action in sub._actions:
+            if isinstance(action, argparse._HelpAction):
+                continue
+            text = action.help or ""
+            rest = re.sub(r"\(?\bdefault\b[^;)]*\)?", "", text).strip(" ;,.:")
+            if len(rest.split()) < 2:
+                bare.append(f"{command} {action.option_strings or action.dest}: {text!r}")
+            if "--max-disparity" in action.option_strings and "in pixels" not in text:
+                no_unit.append(f"{command}: {text!r}")
+    assert not bare, f"--help gives only the default of: {bare}"
+    assert not no_unit, f"--max-disparity without its unit: {no_unit}"
+
+
 def test_batch_help_names_both_scene_calibrations() -> None:
     """batch reads a scene's calib.txt, else its Q.dat (batch.md); its --help says both."""
     import argparse

@@ -2086,7 +2086,13 @@ def cmd_batch(args: argparse.Namespace) -> int:
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision batch`` on the CLI's sub-parsers."""
     # cli builds its parser
-    from stereovision.cli import CALIB_FILES_HELP, add_calib_unit, metres, positive_pixels
+    from stereovision.cli import (
+        _METHOD_HELP,
+        CALIB_FILES_HELP,
+        add_calib_unit,
+        metres,
+        positive_pixels,
+    )
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -2112,12 +2118,12 @@ def add_cli(subparsers: Any) -> None:
         help="LocalCluster worker processes (default: cores; at most one per pair)",
     )
     p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://...")
-    p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
+    p.add_argument("--method", choices=METHODS, help=_METHOD_HELP)
     p.add_argument(
         "--max-disparity",
         type=positive_pixels,
         metavar="N",
-        help="for every pair (default: per pair)",
+        help="disparity range to search, in pixels, for every pair (default: estimated per pair)",
     )
     p.add_argument(
         "--calib",

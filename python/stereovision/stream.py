@@ -1663,7 +1663,7 @@ def add_cli(subparsers: Any) -> None:
         "--max-disparity",
         type=positive_pixels,
         metavar="N",
-        help="default: estimated from the first pair",
+        help="disparity range to search, in pixels (default: estimated once, from the first pair)",
     )
     p.add_argument(
         "--method",

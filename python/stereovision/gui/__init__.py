@@ -257,7 +257,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="folder the page may open files from (repeatable; the demo data is always allowed)",
     )
-    p.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"default {DEFAULT_PORT}")
+    p.add_argument(
+        "--port",
+        type=int,
+        default=DEFAULT_PORT,
+        help=f"port the page is served on (default {DEFAULT_PORT})",
+    )
     p.add_argument("--host", default=DEFAULT_HOST, help=f"listen address (default {DEFAULT_HOST})")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
 
