@@ -943,9 +943,9 @@ def test_readme_set_up_is_the_build_files() -> None:
 
 def test_readme_quotes_the_gui_captions_of_the_method_pictured() -> None:
     """The README gave the stereo panel's captions on the cones (red 52.3 px, blue 6.50 m) "as
-    pictured below", but gui-methods.png shows the Gabor method, whose captions read 51.6 px and
-    6.20 m: those figures were the fused default's. Both are quoted now, each computed here as
-    the page computes it (full size, range from the images)."""
+    pictured below", without the method: gui-3d.png shows them (fused), gui-methods.png, the
+    Gabor method, 51.6 px and 6.20 m. Each picture's are quoted now with its method, computed
+    here as the page computes them (full size, range from the images)."""
     pytest.importorskip("trame")
     import stereovision as sv
     from stereovision.gui.app import compute_view
@@ -953,8 +953,8 @@ def test_readme_quotes_the_gui_captions_of_the_method_pictured() -> None:
 
     scene = load_scene(Path(sv.__file__).parent / "data" / "cones")
     readme = " ".join((ROOT / "README.md").read_text().split())
-    for method, said in (("fused", "on the cones with the fused default"),
-                         ("gabor", "the Gabor method, as pictured below:")):  # fmt: skip
+    for method, said in (("fused", "on the cones with the fused default, as in the first"),
+                         ("gabor", "the Gabor method, as in the second:")):  # fmt: skip
         view = compute_view(scene.left, scene.right, scene.calib, method)
         # the page's captions keep a number and its unit together (no-break spaces)
         quoted = " ".join(f"`{view.disparity_caption}`, `{view.depth_caption}`".split())
