@@ -230,6 +230,25 @@ def test_help_texts_say_what_the_option_is_beside_its_default() -> None:
     assert not no_unit, f"--max-disparity without its unit: {no_unit}"
 
 
+def test_board_side_options_say_their_unit() -> None:
+    """`capture --square` said "--charuco: square side", no unit, where calibrate's and board's
+    say "in --unit" (capture has none: any unit does, only the ratio to --marker is used)."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    unsaid = [
+        f"{command} {action.option_strings[0]}: {action.help!r}"
+        for command, sub in commands.choices.items()
+        for action in sub._actions
+        if {"--square", "--marker"} & set(action.option_strings)
+        and not re.search(r"\bunit\b", action.help or "")
+    ]
+    assert not unsaid, f"a board side without its unit: {unsaid}"
+
+
 def test_batch_help_names_both_scene_calibrations() -> None:
     """batch reads a scene's calib.txt, else its Q.dat (batch.md); its --help says both."""
     import argparse

@@ -3270,8 +3270,12 @@ def add_cli(subparsers: Any) -> None:
         metavar="COLSxROWS",
         help="auto-capture distinct poses of a ChArUco board of COLSxROWS squares",
     )
-    p.add_argument("--square", type=board_side, help="--charuco: square side")
-    p.add_argument("--marker", type=board_side, help="--charuco: marker side (same unit)")
+    p.add_argument(
+        "--square",
+        type=board_side,
+        help="--charuco: square side, in any unit (only its ratio to --marker finds the board)",
+    )
+    p.add_argument("--marker", type=board_side, help="--charuco: marker side, in --square's unit")
     p.add_argument(
         "--dictionary", default="auto", help="--charuco: ArUco dictionary (default: found)"
     )
