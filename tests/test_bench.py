@@ -373,6 +373,25 @@ def test_bench_times_a_scene_given_twice_once(
     )
 
 
+def test_bench_says_which_folders_it_skipped_and_skips_hidden_ones(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """bench dropped a folder with right.png and no left.png without a word, and timed a hidden
+    copy of a scene (.git) as a scene of its own."""
+    from stereovision.bench import _scene_dirs
+
+    for name in ("s", ".git/s", "half"):
+        (tmp_path / name).mkdir(parents=True)
+        (tmp_path / name / "right.png").write_bytes(b"")
+    for name in ("s", ".git/s"):
+        (tmp_path / name / "left.png").write_bytes(b"")
+    assert _scene_dirs([str(tmp_path)]) == [tmp_path / "s"]
+    assert capsys.readouterr().err == (
+        f"stereovision: skipped {tmp_path / 'half'}: has right.png but no left.png"
+        " (a scene folder holds both)\n"
+    )
+
+
 def test_bench_median_of_an_even_count_interleaved_and_milliseconds_to_3_decimals(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -1392,6 +1392,27 @@ def test_eval_counts_a_scene_given_twice_once(data_dir: Path) -> None:
     assert proc.stderr == f"stereovision: {tsukuba} given more than once: evaluated once\n"
 
 
+def test_eval_says_which_folders_it_skipped_and_skips_hidden_ones(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A folder with left.png and no right.png among scenes was dropped without a word, and a
+    hidden copy of a scene (.Trash) was evaluated a second time."""
+    import json
+
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    shutil.copytree(tsukuba, tmp_path / "tsukuba")
+    shutil.copytree(tsukuba, tmp_path / ".Trash" / "tsukuba")
+    (tmp_path / "half").mkdir()
+    shutil.copy(tsukuba / "left.png", tmp_path / "half" / "left.png")
+    assert main(["eval", str(tmp_path), "--json", "--no-opencv", "--method", "fast"]) == 0
+    cap = capsys.readouterr()
+    assert len([json.loads(line) for line in cap.out.splitlines()]) == 1
+    assert cap.err == (
+        f"stereovision: skipped {tmp_path / 'half'}: has left.png but no right.png"
+        " (a scene folder holds both)\n"
+    )
+
+
 def test_rectify_refuses_to_overwrite_its_input_images(data_dir: Path, tmp_path: Path) -> None:
     """`rectify rect/left_rect.png rect/right_rect.png -o rect` wrote its outputs over the
     images it was given, without a word."""

@@ -25,6 +25,7 @@ from stereovision.io import (
     read_image,
     read_pfm,
     read_ply,
+    scan_scenes,
     scene_max_disparity,
     write_pfm,
     write_ply,
@@ -1052,6 +1053,31 @@ def test_find_scenes_needs_both_images(tmp_path: Path) -> None:
     (tmp_path / "a/pair/right.png").write_bytes(b"")
     (tmp_path / "a/left_only/right.png").mkdir()  # a folder is not an image
     assert find_scenes(tmp_path) == [tmp_path / "a/pair"]
+
+
+def test_scan_scenes_names_half_scenes_and_skips_hidden_folders(tmp_path: Path) -> None:
+    """eval and bench dropped a folder with left.png and no right.png without a word, and
+    searched hidden folders batch skips (a scene's copy in .Trash was evaluated twice)."""
+    for name in ("a", "b_left", "c_right", "d_dir", ".Trash/a", "e/.git/x"):
+        (tmp_path / name).mkdir(parents=True)
+    for name in ("a", "b_left", "d_dir", ".Trash/a", "e/.git/x"):
+        (tmp_path / name / "left.png").write_bytes(b"")
+    for name in ("a", "c_right", ".Trash/a", "e/.git/x"):
+        (tmp_path / name / "right.png").write_bytes(b"")
+    (tmp_path / "d_dir/right.png").mkdir()
+    both = "(a scene folder holds both)"
+    assert scan_scenes(tmp_path) == (
+        [tmp_path / "a"],
+        [
+            (tmp_path / "b_left", f"has left.png but no right.png {both}"),
+            (tmp_path / "c_right", f"has right.png but no left.png {both}"),
+            (tmp_path / "d_dir", f"has left.png but right.png is a folder {both}"),
+        ],
+    )
+    assert find_scenes(tmp_path) == [tmp_path / "a"]
+    # a hidden root given is searched, as given
+    assert find_scenes(tmp_path / ".Trash") == [tmp_path / ".Trash/a"]
+    assert scan_scenes(tmp_path / "e/.git") == ([tmp_path / "e/.git/x"], [])
 
 
 def test_scene_max_disparity_ignores_a_gt_without_positive_disparity() -> None:

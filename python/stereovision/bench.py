@@ -291,7 +291,7 @@ def format_table(cases: Sequence[BenchCase]) -> str:
 
 
 def _scene_dirs(paths: Sequence[str]) -> list[Path]:
-    from stereovision.io import distinct_scenes, find_scenes
+    from stereovision.io import distinct_scenes, scan_scenes
 
     if not paths:
         return [Path(str(resources.files("stereovision") / "data" / "cones"))]
@@ -299,9 +299,12 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
     for d in paths:
         if Path(d).exists() and not Path(d).is_dir():  # find_scenes: "scene root not found"
             raise ValueError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
-        found = find_scenes(d)  # FileNotFoundError for a missing folder
+        found, half = scan_scenes(d)  # FileNotFoundError for a missing folder
         if not found:
             raise ValueError(f"no scene (left.png + right.png) under {d}")
+        # as eval: half a scene among scenes was left out without a word
+        for folder, reason in half:
+            print(f"stereovision: skipped {folder}: {reason}", file=sys.stderr)
         dirs.extend(found)
     # as eval: a scene named twice (its folder and one holding it) was timed twice
     dirs, dropped = distinct_scenes(dirs)

@@ -1734,7 +1734,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from stereovision.baselines import bm_reference_refusal
-    from stereovision.io import distinct_scenes, find_scenes, load_scene, scene_too_narrow
+    from stereovision.io import distinct_scenes, load_scene, scan_scenes, scene_too_narrow
 
     dirs: list[Path] = []
     for d in args.scenes:
@@ -1743,9 +1743,12 @@ def cmd_eval(args: argparse.Namespace) -> int:
             raise FileNotFoundError(f"scene folder not found: {d}")
         if not p.is_dir():  # find_scenes said "scene root not found" of an existing image
             raise CliError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
-        found = find_scenes(p)
+        found, half = scan_scenes(p)
         if not found:
             raise CliError(_no_scene_under(p, d))
+        # half a scene among scenes was left out without a word (batch says it is unpaired)
+        for folder, reason in half:
+            print(f"stereovision: skipped {folder}: {reason}", file=sys.stderr)
         dirs.extend(found)
     # a scene named twice (its folder and a folder holding it) is evaluated once: twice, it
     # counted twice in the mean line

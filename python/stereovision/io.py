@@ -1813,7 +1813,7 @@ def distinct_scenes(dirs: Sequence[Path]) -> tuple[list[Path], list[Path]]:
 
 def find_scenes(root: PathLike) -> list[Path]:
     """Scene directories under ``root`` (any depth, through links to folders outside it, each
-    once) that contain ``left.png`` and ``right.png``.
+    once, hidden folders excepted) that contain ``left.png`` and ``right.png``.
 
     Parameters
     ----------
@@ -1830,6 +1830,35 @@ def find_scenes(root: PathLike) -> list[Path]:
     FileNotFoundError
         If ``root`` is not a directory.
     """
+    return scan_scenes(root)[0]
+
+
+def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
+    """:func:`find_scenes`'s scenes, and the folders left out as half a scene, each with why.
+
+    ``eval`` and ``bench`` dropped a folder holding ``left.png`` without ``right.png`` without
+    a word (``batch`` reports such an image as unpaired): they now say so from this list.
+    Hidden folders (``.git``, ``.Trash``) under ``root`` are not searched, as ``batch`` does
+    not (a hidden copy of a scene was evaluated twice); ``root`` itself is searched even if
+    hidden, as given.
+
+    Parameters
+    ----------
+    root : str or os.PathLike
+        Directory to search.
+
+    Returns
+    -------
+    scenes : list of pathlib.Path
+        Sorted scene directories.
+    skipped : list of (pathlib.Path, str)
+        Sorted folders holding one image of a scene's two, and why they are no scene.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``root`` is not a directory.
+    """
     r = Path(root)
     if not r.is_dir():
         raise FileNotFoundError(f"scene root not found: {r}")
@@ -1839,13 +1868,24 @@ def find_scenes(root: PathLike) -> list[Path]:
     # run3's scenes twice and `bench` counted them twice in its mean.
     from stereovision.batch import _walk
 
-    # a right.png that is a link to nothing is listed, as such a left.png is: load_scene says
-    # which link is broken (the scene was left out without a word, so eval skipped it)
-    found = [
-        Path(folder)
-        for folder, _, files, _ in _walk(r)
-        if "left.png" in files
-        and os.path.lexists(right := os.path.join(folder, "right.png"))
-        and not os.path.isdir(right)
-    ]
-    return sorted(found)
+    found: list[Path] = []
+    skipped: list[tuple[Path, str]] = []
+    for folder, dirs, files, _ in _walk(r):
+        dirs[:] = [x for x in dirs if not x.startswith(".")]
+        # a right.png that is a link to nothing is listed, as such a left.png is: load_scene
+        # says which link is broken (the scene was left out without a word, so eval skipped it)
+        right = os.path.join(folder, "right.png")
+        has_left = "left.png" in files
+        has_right = os.path.lexists(right) and not os.path.isdir(right)
+        if has_left and has_right:
+            found.append(Path(folder))
+        elif has_left or has_right:
+            why = (
+                "has right.png but no left.png"
+                if has_right
+                else "has left.png but right.png is a folder"
+                if os.path.isdir(right)
+                else "has left.png but no right.png"
+            )
+            skipped.append((Path(folder), f"{why} (a scene folder holds both)"))
+    return sorted(found), sorted(skipped)
