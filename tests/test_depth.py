@@ -1371,6 +1371,43 @@ def test_a_negative_min_disparity_with_the_fused_method_names_the_methods_that_t
         assert abs(float(np.nanmedian(res.disparity)) - 6.3) < 0.3
 
 
+def test_match_names_the_method_that_takes_a_negative_min_disparity_as_depth_map_does(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """match(method='mcgm'|'hopfield'|'best'|'fused', min_disparity=-2) said "min_disparity
+    must be a non-negative number of pixels, got -2", naming neither the method nor 'gabor',
+    the one that takes it; depth_map says both."""
+    import importlib
+
+    match_mod = importlib.import_module("stereovision.match")
+
+    left = _texture(64, 96)
+    right = _shift(left, 6.3)
+    why = {
+        "mcgm": "graph matching takes",
+        "hopfield": "the Hopfield network takes",
+        "best": "the best-match search takes",
+        "fused": "its graph-matching and Hopfield channels take",
+    }
+    for method, channel in why.items():
+        said = (
+            f"^min_disparity: method='{method}' searches from 0 px \\({channel} no negative "
+            r"disparity\), got -2; method='gabor' searches a negative range$"
+        )
+        with pytest.raises(ValueError, match=said):
+            sv.match(left, right, method=method, max_disparity=16, min_disparity=-2)
+
+        def estimated(*_: object) -> float:
+            raise AssertionError("the range was estimated before the refusal")
+
+        with monkeypatch.context() as m:  # no range given: refused before the estimate
+            m.setattr(match_mod, "estimate_max_disparity", estimated)
+            with pytest.raises(ValueError, match=said):
+                sv.match(left, right, method=method, min_disparity=-2)
+    got = sv.match(left, right, method="gabor", max_disparity=16, min_disparity=-2)
+    assert len(got) > 100 and abs(float(np.nanmedian(got.dispx)) - 6.3) < 0.3
+
+
 def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
     from stereovision.depth import estimate_max_disparity
 

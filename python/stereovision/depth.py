@@ -1309,14 +1309,27 @@ def _cloud(
     return points, colors, pixels
 
 
-def _fused_from_zero(min_disparity: float) -> ValueError:
-    """The refusal of a negative ``min_disparity`` with ``method="fused"``: the sparse
-    channels' own error ("must be a non-negative number of pixels, got -2.0") named neither
-    the method nor the ones that search such a range."""
+# Why each method searching from 0 px does: the words of :func:`_from_zero`.
+_FROM_ZERO = {
+    "fused": "its graph-matching and Hopfield channels take no negative disparity",
+    "mcgm": "graph matching takes no negative disparity",
+    "hopfield": "the Hopfield network takes no negative disparity",
+    "best": "the best-match search takes no negative disparity",
+}
+
+
+def _from_zero(method: str, min_disparity: float, takers: tuple[str, ...]) -> ValueError:
+    """The refusal of a negative ``min_disparity`` by a method searching from 0 px
+    (:data:`_FROM_ZERO`), naming the methods that take one (``takers``: depth_map's and
+    match()'s differ): the sparse matchers' own error ("must be a non-negative number of
+    pixels, got -2.0") named neither the method nor those."""
+    names = ", ".join(repr(t) for t in takers[:-1])
+    alternatives = (
+        f"method={names} or {takers[-1]!r} search" if names else f"method={takers[-1]!r} searches"
+    )
     return ValueError(
-        f"min_disparity: method='fused' searches from 0 px (its graph-matching and Hopfield "
-        f"channels take no negative disparity), got {_px(min_disparity)}; method='gabor', "
-        "'census' or 'fast' search a negative range"
+        f"min_disparity: method={method!r} searches from 0 px ({_FROM_ZERO[method]}), "
+        f"got {_px(min_disparity)}; {alternatives} a negative range"
     )
 
 
@@ -1509,7 +1522,7 @@ def depth_map(
     if method == "fused" and min_disparity < 0 and max_disparity is None:
         # no range given to be refused first: up front, not after the rectification and the
         # automatic range's estimate (1.4 s of a 3600 x 3000 pair, for nothing)
-        raise _fused_from_zero(min_disparity)
+        raise _from_zero("fused", min_disparity, ("gabor", "census", "fast"))
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
     # Each image is validated by as_bgr_uint8; the pair check without check_pair's grey
@@ -1577,7 +1590,7 @@ def depth_map(
     if max_disparity - min_disparity >= gl.shape[1]:
         raise _range_too_wide(max_disparity - min_disparity, gl.shape[1], min_disparity)
     if method == "fused" and min_disparity < 0:  # a range given: once it is known searchable
-        raise _fused_from_zero(min_disparity)
+        raise _from_zero("fused", min_disparity, ("gabor", "census", "fast"))
     stage("prepare")
     channels: DepthChannels | None = {} if return_channels else None
     if refine is None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -11,11 +12,13 @@ from stereovision._validate import (
     as_bgr_uint8,
     check_pair,
     finite_number,
+    real_number,
     refuse_unreachable_range,
     too_large_for_float,
 )
 from stereovision.calibration import Calibration
 from stereovision.depth import (
+    _from_zero,
     _rectify_grey,
     _rig_to_warp_by,
     estimate_max_disparity,
@@ -99,11 +102,20 @@ def match(
         ``max_disparity`` that is not a finite number >= 0 (or below ``min_disparity``; equal
         to it, ``"gabor"`` and ``"fused"`` refuse it, the others search that one level), a
         ``min_disparity`` not below the image width (no pixel has a match that far: a pair with
-        no edges in a range it can match in still returns zero matches, not an error).
+        no edges in a range it can match in still returns zero matches, not an error), a
+        negative ``min_disparity`` with a method other than ``"gabor"`` (they search from 0 px).
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     gl, gr = check_pair(left, right)
+    # a negative min_disparity the method cannot search: said as depth_map says it (the
+    # matchers' own words named neither the method nor the one that takes it), before the
+    # rectification and the automatic range's estimate when no range is given to check first;
+    # anything not a finite number is left to the matchers' own words
+    lo = params.get("min_disparity", 0)
+    from_zero = method != "gabor" and real_number(lo) and -math.inf < lo < 0
+    if from_zero and max_disparity is None:
+        raise _from_zero(method, lo, ("gabor",))
     uint8 = np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8
     h, w = gl.shape
     # a calibrated rig not yet rectified, or an uncalibrated one: as depth_map does
@@ -118,6 +130,8 @@ def match(
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
     _refuse_unreachable(params.get("min_disparity", 0), max_disparity, gl.shape[1], automatic)
+    if from_zero:  # a range given: once it is known searchable
+        raise _from_zero(method, lo, ("gabor",))
     if method == "mcgm":
         m = _mcgm.mcgm_match(gl, gr, max_disparity=max_disparity, **params)
         keep = _in_range(m, params.get("min_disparity", 0), max_disparity)
