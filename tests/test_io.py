@@ -1227,8 +1227,13 @@ def test_read_ply_vertex_element_without_a_count_or_with_two_says_so(tmp_path: P
         assert str(err.value) == f"PLY file {path}: {said}"
     # the first element that is not vertex is still named as such
     path.write_bytes(_ply("ascii", xyz, 1).replace(b"vertex 1", b"face 1") + b"1 2 3\n")
-    with pytest.raises(ValueError, match=r"first element is \['face'\], expected vertex"):
+    with pytest.raises(ValueError, match=r"first element is 'face', expected vertex$"):
         read_ply(path)
+    # a bare element line, no name: it said "first element is [], expected vertex"
+    path.write_bytes(_ply("ascii", xyz, 1).replace(b"element vertex 1", b"element") + b"1 2 3\n")
+    with pytest.raises(ValueError) as err:
+        read_ply(path)
+    assert str(err.value) == f"PLY file {path}: an element line names no element (expected vertex)"
 
 
 def test_read_ply_16_bit_and_signed_colours_do_not_wrap(tmp_path: Path) -> None:

@@ -1441,8 +1441,13 @@ def read_ply(
                 in_vertex = False
                 break
             in_vertex = len(tok) > 1 and tok[1] == "vertex"
+            # the name as written, not a list: a bare `element` said "first element is []"
+            if len(tok) == 1:
+                raise ValueError(
+                    f"PLY file {p}: an element line names no element (expected vertex)"
+                )
             if not in_vertex:
-                raise ValueError(f"PLY file {p}: first element is {tok[1:2]}, expected vertex")
+                raise ValueError(f"PLY file {p}: first element is {tok[1]!r}, expected vertex")
             # a vertex line without its one count was told off as "first element is
             # ['vertex'], expected vertex"
             if len(tok) == 2:
