@@ -1826,6 +1826,28 @@ def test_port_number_refuses_what_is_no_port(text: str) -> None:
         port_number(text)
 
 
+@pytest.mark.parametrize("error", [RecursionError, NotImplementedError])
+def test_a_recursion_or_not_implemented_error_is_said_as_a_bug_of_ours(
+    error: type[Exception],
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """RecursionError and NotImplementedError are RuntimeErrors, but no command raises them on
+    purpose: they were said as an expected error ("stereovision: error: maximum recursion
+    depth exceeded"), not as the bug they are."""
+    import stereovision.cli as cli
+
+    def broken(args: object) -> int:
+        raise error("deep")
+
+    monkeypatch.setattr(cli, "cmd_info", broken)
+    assert main(["info", "--size", "640x480", "--hfov", "60", "--baseline", "0.1"]) == 2
+    cap = capsys.readouterr()
+    assert cap.err == (
+        f"stereovision: error: internal {error.__name__}: deep (please report this)\n"
+    )
+
+
 def test_a_bug_of_ours_is_one_line_on_stderr_and_exit_2(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

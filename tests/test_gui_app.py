@@ -5690,6 +5690,44 @@ def test_an_unexpected_error_of_a_computation_or_a_save_is_said_and_frees_the_pa
     assert not (tmp_path / "out").exists() and app._saving_into == set()
 
 
+def test_a_recursion_or_not_implemented_error_is_said_as_a_bug_of_ours(
+    tmp_path, monkeypatch, caplog
+):
+    """RecursionError and NotImplementedError are RuntimeErrors, and the page took them as an
+    expected failure: said as they are ("maximum recursion depth exceeded"), no trace in the
+    server's log. Both are bugs of ours: said as one ("internal ... (please report this)"),
+    their trace logged, from the worker thread (a computation) and from a handler's own
+    ``except RuntimeError`` (choosing a scene) alike."""
+    import stereovision.gui.app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-bug-runtime-error", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+
+    def deep(*args: Any, **kw: Any) -> Any:
+        raise RecursionError("maximum recursion depth exceeded")
+
+    monkeypatch.setattr(gui_app, "compute_view", deep)
+    app.state.method = "census"
+    _run(app, app.recompute)
+    assert app.state.error == (
+        "internal RecursionError: maximum recursion depth exceeded (please report this) (the "
+        "page still shows fast at full resolution)"
+    )
+    assert "gui: computing census failed" in caplog.text
+    assert "Traceback" in caplog.text and "RecursionError" in caplog.text
+    caplog.clear()
+
+    def unimplemented(*args: Any, **kw: Any) -> Any:
+        raise NotImplementedError("no such source")
+
+    monkeypatch.setattr(app, "_load_scene", unimplemented)
+    app._on_scene(str(bundled_data_dir() / "cones2"))
+    assert app.state.error == "internal NotImplementedError: no such source (please report this)"
+    assert "Traceback" in caplog.text and "NotImplementedError" in caplog.text
+
+
 def test_an_image_sequence_typed_as_a_camera_outside_the_data_folders_is_refused(tmp_path):
     """A pattern's folder is checked against --data like a file: one outside is refused."""
     from stereovision.gui import bundled_data_dir

@@ -1132,6 +1132,12 @@ def first_line(exc: BaseException) -> str:
     return text[0] if text else type(exc).__name__
 
 
+#: RuntimeError's subclasses that are a bug of ours, never a failure to say as it is: a
+#: recursion past Python's limit, a method no subclass implemented. The CLI and the GUI said
+#: them as an expected error (a RuntimeError), without "internal" or a trace in the log.
+BUG_ERRORS = (RecursionError, NotImplementedError)
+
+
 def internal_error(exc: BaseException) -> str:
     """The one line the CLI and ``python -m stereovision.gui`` print for an unexpected error (a
     bug of ours), instead of a traceback.

@@ -29,6 +29,7 @@ import numpy as np
 from stereovision._interrupt import Terminated, raise_terminated
 from stereovision._jsonout import json_line
 from stereovision._validate import (
+    BUG_ERRORS,
     advice_for,
     figure_shown,
     first_line,
@@ -2583,6 +2584,9 @@ def _run(args: argparse.Namespace) -> int:
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE
+    except BUG_ERRORS as exc:  # RuntimeErrors, but ours: said below as any bug of ours
+        print(internal_error(exc), file=sys.stderr)
+        return EXIT_ERROR
     # ImportError: an optional package missing (trame, rosbags, dask), said with its pip line
     except (CliError, ValueError, OSError, RuntimeError, MemoryError, ImportError) as exc:
         print(f"stereovision: error: {advice_for(first_line(exc), 'cli')}", file=sys.stderr)

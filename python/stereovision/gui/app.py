@@ -41,7 +41,13 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import release_memory
-from stereovision._validate import advice_for, first_line, internal_error, known_unit
+from stereovision._validate import (
+    BUG_ERRORS,
+    advice_for,
+    first_line,
+    internal_error,
+    known_unit,
+)
 from stereovision.calibration import fit_to_frames
 from stereovision.capture import DEFAULT_READ_TIMEOUT, _camera_device, mask_url_secrets
 from stereovision.gui.sources import (
@@ -1284,7 +1290,8 @@ def _for_the_loop(exc: BaseException, what: str) -> BaseException:
 
 
 #: What the page's worker thread raises for a failure the page says as it is (bad input, a
-#: file, a pair too large, OpenCV refusing a pair); anything else is a bug (:func:`_as_said`).
+#: file, a pair too large, OpenCV refusing a pair); anything else is a bug (:func:`_as_said`),
+#: :data:`~stereovision._validate.BUG_ERRORS` (RecursionError, NotImplementedError) too.
 _SAID = (ValueError, OSError, RuntimeError, MemoryError, cv2.error)
 
 
@@ -1297,7 +1304,7 @@ def _as_said(exc: Exception, what: str) -> Exception:
     Such an error went past the handler's ``except``: a computation's left the page
     "computing" under its progress bar for good, Save and Find floor then saying "the new pair
     is being computed"; a Save's, a floor's or a rows check's said nothing at all."""
-    if isinstance(exc, _SAID):
+    if isinstance(exc, _SAID) and not isinstance(exc, BUG_ERRORS):
         return exc
     log.error("gui: %s failed", what, exc_info=exc)
     return RuntimeError(internal_error(exc).removeprefix("stereovision: error: "))
@@ -1739,6 +1746,8 @@ class StereoApp:
         """Say ``exc`` on the page (its first line), ``path`` in it as the page shows paths
         (:func:`short_paths`) when given. With ``outlasts`` (a camera's read or open), an error
         said while a pair computes stays on the page after the computation's end."""
+        if isinstance(exc, BUG_ERRORS):  # caught as a RuntimeError by the handlers: a bug
+            exc = _as_said(exc, "an action")
         msg = first_line(exc)
         if path is not None:
             msg = short_paths(msg, path)
@@ -2068,6 +2077,8 @@ class StereoApp:
         still in use named (:meth:`_in_use_unchanged`), as a failed first read says it. An
         open that raised said only its error ("cannot open camera 5 (left)"): nothing told
         that the cameras on show kept running."""
+        if isinstance(exc, BUG_ERRORS):  # before its words are wrapped into an OSError
+            exc = _as_said(exc, "opening")
         if self.source is not None:
             exc = OSError(f"{first_line(exc)} ({self._in_use_unchanged()})")
         self._fail(exc, outlasts=outlasts)
@@ -2305,6 +2316,8 @@ class StereoApp:
                 return
             if not isinstance(exc, (ValueError, OSError, RuntimeError)):
                 log.exception("gui: reading %s failed", what)
+            if isinstance(exc, BUG_ERRORS):  # before its words are wrapped into an OSError
+                exc = _as_said(exc, f"reading {what}")
             if self.source is not None:
                 exc = OSError(f"{first_line(exc)} ({self._in_use_unchanged()})")
             self._fail(exc, outlasts=True)
