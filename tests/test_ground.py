@@ -1730,9 +1730,10 @@ def test_cli_depth_ground_says_why_no_floor_was_tried(
     calib = load_scene(kitti).calib
     disp = np.full((375, 1242), np.nan)
     disp.flat[: MIN_PIXELS - 1] = 40.0  # one short of a fit
-    disp.flat[MIN_PIXELS - 1] = -1.0  # behind the camera (doffs 0): no disparity
+    disp.flat[MIN_PIXELS - 1] = -1.0  # behind the camera (doffs 0): no depth
     assert _no_floor_line(disp, calib) == (
-        f"ground plane: none found ({MIN_PIXELS - 1} pixels have a disparity; a fit needs 500)"
+        f"ground plane: none found ({MIN_PIXELS - 1} pixels have a disparity giving a depth and "
+        "1 one of 0 px or less (no depth: at infinity or behind the camera); a fit needs 500)"
     )
     disp.flat[MIN_PIXELS - 1] = 40.0  # enough to try: then no plane held the floor's share
     assert _no_floor_line(disp, calib) == (
@@ -1785,7 +1786,9 @@ def test_mutation_audit_5_no_floor_line_counts_pixels_as_the_fit_does() -> None:
     disp = np.full((SIZE[1], SIZE[0]), np.nan)
     disp.flat[:MIN_PIXELS] = 0.0
     assert _no_floor_line(disp, rig(0.0)) == (
-        f"ground plane: none found (0 pixels have a disparity; a fit needs {MIN_PIXELS})"
+        f"ground plane: none found (0 pixels have a disparity giving a depth and {MIN_PIXELS} "
+        "one of 0 px or less (no depth: at infinity or behind the camera); a fit needs "
+        f"{MIN_PIXELS})"
     )
     assert fit_ground_plane(disp, rig(0.0)) is None
     disp.flat[:MIN_PIXELS] = -10.0
@@ -1793,6 +1796,30 @@ def test_mutation_audit_5_no_floor_line_counts_pixels_as_the_fit_does() -> None:
         "ground plane: none found (no near-level plane holds 3 % of the pixels)"
     )
     assert _no_floor_line(disp, rig(0.0)).startswith("ground plane: none found (0 pixels")
+
+
+def test_no_floor_line_of_opencv_sgbm_on_a_textureless_pair_counts_its_zeros() -> None:
+    """The GUI's Find floor after opencv-sgbm on a textureless pair said "0 pixels have a
+    disparity" of a map mostly at 0 px: OpenCV's SGBM gives such pixels its lowest level, 0
+    (a disparity, at infinity: no depth; its "none", -16 / 16 = -1, is NaN here), and the
+    left strip it cannot search none. The line now counts the zeros apart."""
+    from stereovision import baselines
+    from stereovision.ground import MIN_PIXELS, _no_floor_line
+
+    calib = Calibration(
+        K1=[[F, 0, 239.5], [0, F, 179.5], [0, 0, 1]], D1=RIG.D1,
+        K2=[[F, 0, 239.5], [0, F, 179.5], [0, 0, 1]], D2=RIG.D2,
+        R=RIG.R, T=RIG.T, image_size=SIZE, rectified=True,
+    )  # fmt: skip
+    flat = np.full((SIZE[1], SIZE[0]), 128, np.uint8)
+    disp = baselines.opencv_sgbm(flat, flat, 64)
+    zeros = int(np.count_nonzero(disp == 0))
+    # every pixel right of the 64 px strip is at 0 px, the strip has none (NaN)
+    assert zeros == (SIZE[0] - 64) * SIZE[1] and np.isnan(disp[:, :64]).all()
+    assert _no_floor_line(disp, calib) == (
+        f"ground plane: none found (0 pixels have a disparity giving a depth and {zeros} one of "
+        f"0 px or less (no depth: at infinity or behind the camera); a fit needs {MIN_PIXELS})"
+    )
 
 
 def test_mutation_audit_5_scan_dict_scalars_are_mapped_not_rounded() -> None:

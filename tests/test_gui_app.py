@@ -1596,7 +1596,8 @@ def test_find_floor_says_why_no_floor_was_found(data_dir):
     )
     disparity.flat[0] = -1e9  # behind the camera: not a disparity the fit counts
     assert floor_text(None, "ft", enough) == (
-        f"ground plane: none found ({MIN_PIXELS - 1} pixels have a disparity; a fit needs 500)"
+        f"ground plane: none found ({MIN_PIXELS - 1} pixels have a disparity giving a depth and "
+        "1 one of 0 px or less (no depth: at infinity or behind the camera); a fit needs 500)"
     )
 
 

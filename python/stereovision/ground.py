@@ -636,9 +636,19 @@ def _fit_ground(
     known = np.isfinite(disp) & (disp + rig[4] > 0)
     n_known = int(known.sum())
     if n_known < MIN_PIXELS:
+        # disparities with no depth (d + doffs <= 0) named apart: OpenCV's SGBM gives a
+        # textureless pair its lowest level, 0 px (its "none" is -1, NaN here), and the line
+        # said "0 pixels have a disparity" of a map 86 % at 0 px
+        n_far = int(np.isfinite(disp).sum()) - n_known
+        far = (
+            f" and {n_far} one of {-rig[4] + 0.0:g} px or less (no depth: at infinity or "
+            "behind the camera)"
+            if n_far
+            else ""
+        )
         return None, (
-            f"ground plane: none found ({n_known} pixels have a disparity; a fit needs "
-            f"{MIN_PIXELS})"
+            f"ground plane: none found ({n_known} pixels have a disparity"
+            f"{' giving a depth' if n_far else ''}{far}; a fit needs {MIN_PIXELS})"
         )
     vv, uu = np.nonzero(known)
     u, v, d = uu.astype(np.float64), vv.astype(np.float64), disp[known]
