@@ -2495,11 +2495,25 @@ fn half_mad_with_stored_differences_is_bit_identical_and_keeps_nothing_stale() {
 /// computed in both passes, the bits set one compare at a time.
 fn open_lanes_twice(
     b: &SidesBound,
-    (v_top, v_bot): (&[f32], &[f32]),
+    vs: (&[f32], &[f32]),
     j0: usize,
     mean_free: bool,
     open_below: f32,
 ) -> u32 {
+    let acc = bound_sums_twice(b, vs, j0, mean_free);
+    acc.iter().enumerate().fold(0u32, |bits, (t, &a)| {
+        bits | (u32::from(a / b.n < open_below) << t)
+    })
+}
+
+/// The bound's sums of the lanes `j0..j0 + 8` as [`open_lanes_twice`] adds them (columns in
+/// order, the mean pass first).
+fn bound_sums_twice(
+    b: &SidesBound,
+    (v_top, v_bot): (&[f32], &[f32]),
+    j0: usize,
+    mean_free: bool,
+) -> [f32; 8] {
     let interp = |v: &[f32], o: usize, f: f32| -> [f32; 8] {
         let v = &v[o + j0..o + j0 + 9];
         std::array::from_fn(|t| v[t] + f * (v[t + 1] - v[t]))
@@ -2525,9 +2539,7 @@ fn open_lanes_twice(
             acc[q] += (lt - t[q] - wt * m[q]).abs() + (lb - bt[q] - wb * m[q]).abs();
         }
     }
-    acc.iter().enumerate().fold(0u32, |bits, (t, &a)| {
-        bits | (u32::from(a / b.n < open_below) << t)
-    })
+    acc
 }
 
 #[test]
@@ -2575,6 +2587,20 @@ fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
                         bound.lane_sums(&mut scratch.rows, nk.div_ceil(8) * 8, mean_free);
                     }
                     for j0 in (0..nk).step_by(8) {
+                        if bound.shared_weight {
+                            // The sums themselves, bit for bit (the thresholds below see a
+                            // change of order or of a term only where it crosses one).
+                            let vs = (&scratch.rows.v_top[..], &scratch.rows.v_bot[..]);
+                            let want = bound_sums_twice(&bound, vs, j0, mean_free);
+                            for (t, a) in want.iter().enumerate().take(nk - j0) {
+                                assert_eq!(
+                                    scratch.rows.lane_acc[j0 + t].to_bits(),
+                                    a.to_bits(),
+                                    "{geom:?} {side} {ks:?} lane {} {mean_free}",
+                                    j0 + t
+                                );
+                            }
+                        }
                         for open_below in [0.0f32, 0.02, 0.05, 0.1, 0.2, f32::INFINITY] {
                             let vs = (&scratch.rows.v_top[..], &scratch.rows.v_bot[..]);
                             let want = open_lanes_twice(&bound, vs, j0, mean_free, open_below);
