@@ -1037,7 +1037,8 @@ pub(super) fn zero_crossings_reference(l: &[f32], w: usize, h: usize) -> ZeroCro
             xsub[i] = f32::NAN;
             continue;
         }
-        strength[i] = st;
+        // NaN as f32::NAN's bits, whatever the operations left (the channel's rule).
+        strength[i] = if st.is_nan() { f32::NAN } else { st };
         let t = gy.atan2(gx);
         theta[i] = if t < 0.0 { (t + TAU) % TAU } else { t };
         if mark[i] & ZC_H == 0 {

@@ -37,7 +37,8 @@ pub struct ZeroCrossings {
     pub mark: Vec<u8>,
     /// Sub-pixel x of the crossing (absolute column), NaN where unmarked.
     pub xsub: Vec<f32>,
-    /// `|grad L|` by central differences at marked pixels, 0 elsewhere.
+    /// `|grad L|` by central differences at marked pixels, 0 elsewhere; [`f32::NAN`] (those
+    /// bits) where it is NaN.
     pub strength: Vec<f32>,
     /// Normal direction `atan2(L_y, L_x)` in `[0, 2 pi)` at marked pixels (polarity kept), 0 else.
     pub theta: Vec<f32>,
@@ -199,7 +200,11 @@ fn crossings_row(
             xsub[x] = f32::NAN;
             continue;
         }
-        strength[x] = st;
+        // A NaN (an infinite LoG next to the pixel: inf - inf) stored as the one quiet NaN: an
+        // operation's NaN has no set sign or payload (x86's own is negative), and the AVX2 and
+        // baseline builds order `gx * gx + gy * gy`'s operands as they like; `strength` is
+        // returned (`mcgm_curves`), so both must give the same bits.
+        strength[x] = if st.is_nan() { f32::NAN } else { st };
         let t = gy.atan2(gx);
         // `(t + TAU) % TAU` without the fmod call: u = t + TAU lies in [pi, TAU], and
         // u - TAU is exact there (Sterbenz).
@@ -267,7 +272,7 @@ mod tests {
             f32::from_bits(1),
         ];
         let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        let mut n_marked = 0;
+        let (mut n_marked, mut n_nan) = (0, 0);
         for (k, &(w, h)) in [
             (3, 3),
             (1, 9),
@@ -303,10 +308,17 @@ mod tests {
                 assert_eq!(new.mark, old.mark, "{what}");
                 assert_eq!(bits(&new.xsub), bits(&old.xsub), "{what} xsub");
                 assert_eq!(bits(&new.strength), bits(&old.strength), "{what} strength");
+                for s in new.strength.iter().filter(|s| s.is_nan()) {
+                    assert_eq!(s.to_bits(), f32::NAN.to_bits(), "{what} NaN strength");
+                    n_nan += 1;
+                }
                 assert_eq!(bits(&new.theta), bits(&old.theta), "{what} theta");
                 n_marked += new.mark.iter().filter(|&&m| m != 0).count();
             }
         }
-        assert!(n_marked > 300, "{n_marked} marked");
+        assert!(
+            n_marked > 300 && n_nan > 10,
+            "{n_marked} marked, {n_nan} NaN strengths"
+        );
     }
 }
