@@ -1080,6 +1080,24 @@ def test_scan_scenes_names_half_scenes_and_skips_hidden_folders(tmp_path: Path) 
     assert scan_scenes(tmp_path / "e/.git") == ([tmp_path / "e/.git/x"], [])
 
 
+def test_scan_scenes_finds_a_scene_linked_by_a_hidden_and_a_visible_name(tmp_path: Path) -> None:
+    """434f57a's skip of hidden folders dropped a scene linked as ``.cache`` and as ``s``: the
+    walk took the hidden link (first in name order) as the folder's one entry, so the visible
+    one was an alias, and the hidden one was then skipped; eval found no scene at all."""
+    from stereovision.batch import find_pairs
+
+    ext, root = tmp_path / "ext", tmp_path / "root"
+    ext.mkdir()
+    root.mkdir()
+    for side in ("left.png", "right.png"):
+        (ext / side).write_bytes(b"")
+    for link in (".cache", "s"):
+        (root / link).symlink_to(ext, target_is_directory=True)
+    assert scan_scenes(root) == ([root / "s"], [])
+    # batch walks the same way (its pairs from the visible link)
+    assert [j.name for j in find_pairs(root)] == ["s"]
+
+
 def test_scene_max_disparity_ignores_a_gt_without_positive_disparity() -> None:
     # an all-zero (or negative) GT gives no range: the calibration's ndisp, else the width's
     zero = np.zeros((2, 2), np.float32)

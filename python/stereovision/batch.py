@@ -417,7 +417,9 @@ def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
     entered and their pairs left out without a word. A link to a folder inside ``top``, or to
     one holding it, or to one entered already, is an alias (or a loop): not entered (camera
     folders named by such links, ``seq/left -> ../raw/cam_l``, are still paired: their
-    search is their own)."""
+    search is their own). Hidden folders (``.git``, ``.Trash``) are not entered: a hidden
+    link sorted first claimed the folder a visible link also named, and the caller's skip of
+    hidden folders then dropped the folder's scenes (``.cache -> /d/s`` beside ``s -> /d/s``)."""
     top_real = os.path.realpath(top)
     seen = {top_real}
     for d, dirs, files in os.walk(top, followlinks=True):
@@ -426,6 +428,8 @@ def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
         # in name order, so that of two links to one folder the same one names its pairs on
         # every filesystem (the listing's order took the other one: ``in/b`` for ``in/a``)
         for x in sorted(dirs):
+            if x.startswith("."):
+                continue
             p = os.path.join(d, x)
             if os.path.islink(p):
                 real = os.path.realpath(p)
