@@ -1848,6 +1848,31 @@ def test_a_recursion_or_not_implemented_error_is_said_as_a_bug_of_ours(
     )
 
 
+@pytest.mark.parametrize("command", ["eval", "bench"])
+def test_a_recursion_error_in_one_scene_of_several_is_said_as_a_bug_of_ours(
+    command: str,
+    data_dir: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """181c822 left eval's and bench's per-scene catch of RuntimeError as it was: of several
+    scenes, a RecursionError was said as one damaged scene ("failed DIR: deep") and the run
+    went on, exit 1, not as the bug it is."""
+    import stereovision.bench as bench
+    import stereovision.cli as cli
+
+    def broken(*args: object, **kwargs: object) -> object:
+        raise RecursionError("deep")
+
+    monkeypatch.setattr(cli, "_eval_scene", broken)
+    monkeypatch.setattr(bench, "bench_scene", broken)
+    scenes = [str(data_dir / "middlebury2001" / s) for s in ("tsukuba", "venus")]
+    assert main([command, *scenes, "--json"]) == 2
+    cap = capsys.readouterr()
+    assert cap.err == "stereovision: error: internal RecursionError: deep (please report this)\n"
+    assert cap.out == ""
+
+
 def test_a_bug_of_ours_is_one_line_on_stderr_and_exit_2(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

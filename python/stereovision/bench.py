@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from stereovision._jsonout import json_line
-from stereovision._validate import NOT_NUMBERS
+from stereovision._validate import BUG_ERRORS, NOT_NUMBERS
 
 __all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table", "sparse_name"]
 
@@ -374,6 +374,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
                     # ...; give a max_disparity below 8" named a range and an option bench has not
                     raise ValueError(f"{d}: {narrow}")
                 cases = bench_scene(scene, runs=args.runs)
+            except BUG_ERRORS:  # RuntimeErrors, but a bug of ours: not one damaged scene of many
+                raise
             except (ValueError, OSError, RuntimeError) as e:
                 if len(dirs) == 1:
                     raise

@@ -1791,6 +1791,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 # smaller than the image width 8" named a range nobody gave
                 raise ValueError(f"{d}: {narrow}")
             row = _eval_scene(scene, args.method, not args.no_opencv, args.runs or 1)
+        except BUG_ERRORS:  # RuntimeErrors, but a bug of ours: not one damaged scene of many
+            raise
         except (ValueError, OSError, RuntimeError) as e:
             if len(dirs) == 1:
                 raise
