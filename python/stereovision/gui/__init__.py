@@ -299,11 +299,16 @@ def _main(argv: Sequence[str] | None) -> int:
     p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
     add_arguments(p)
     args = p.parse_args(argv)
+    from stereovision._validate import BUG_ERRORS, internal_error
+
     try:
         return cmd_gui(args)
     except KeyboardInterrupt:  # as the CLI: a word, where this said nothing
         print("stereovision: interrupted", file=sys.stderr)
         return 130
+    except BUG_ERRORS as exc:  # RuntimeErrors, but a bug of ours: said as the CLI says them
+        print(internal_error(exc), file=sys.stderr)
+        return 2
     # ImportError: an optional package missing (rosbags for --from-bag), said with its pip line;
     # MemoryError: as the CLI, one line for a frame size too large to allocate
     except (ValueError, OSError, RuntimeError, ImportError, MemoryError) as exc:
@@ -312,7 +317,5 @@ def _main(argv: Sequence[str] | None) -> int:
         print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
         return 2
     except Exception as exc:  # a bug of ours: one line, as the CLI, not a traceback
-        from stereovision._validate import internal_error
-
         print(internal_error(exc), file=sys.stderr)
         return 2
