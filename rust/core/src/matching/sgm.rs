@@ -2708,11 +2708,47 @@ mod tests {
         }
     }
 
+    /// Whole cost rows by the kernel a token picks against the compiler's loop, for each level
+    /// count: odd and even widths, ranges past either edge, on random 64-bit codes, census-like
+    /// 62-bit ones and equal codes (a flat patch: every inside level ties).
+    fn same_cost_rows_as_the_compilers(
+        seed: u64,
+        levels: impl IntoIterator<Item = usize>,
+        avx2: Option<Avx2>,
+        avx512: Option<Avx512>,
+    ) {
+        let mut s = seed;
+        let mut rand = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            s
+        };
+        for n in levels {
+            for w in [1usize, 2, 31, 64, 97, 230] {
+                for d_min in [-40i64, 0, 5] {
+                    let codes: [Vec<u64>; 3] = [
+                        (0..2 * w).map(|_| rand()).collect(),
+                        (0..2 * w).map(|_| rand() >> 2).collect(),
+                        vec![0x0123_4567_89ab_cdef; 2 * w],
+                    ];
+                    for c in &codes {
+                        let (cl, rev): (&[u64], Vec<u64>) =
+                            (&c[..w], c[w..].iter().rev().copied().collect());
+                        let mut want = vec![0u8; w * n];
+                        let mut got = vec![1u8; w * n];
+                        cost_row_as(cl, &rev, d_min, n, &mut want, None, None);
+                        cost_row_as(cl, &rev, d_min, n, &mut got, avx2, avx512);
+                        assert_eq!(got, want, "{n} levels, width {w}, d_min {d_min}");
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn the_avx2_hamming_costs_are_the_compilers() {
-        // Whole cost rows by the AVX2 kernel against the compiler's loop, odd and even widths,
-        // ranges past either edge, on random 64-bit codes, census-like 62-bit ones and equal
-        // codes (a flat patch: every inside level ties). A row's pixels hand the kernel every
+        // The AVX2 kernel's rows. A row's pixels hand the kernel every
         // length 1..=min(n, w) (their inside levels; d_min 0: pixel x has x + 1), so width 230
         // with n >= 230 already gives every length 32..=230 the kernel takes (every tail
         // 0..=31: below 16 one by one, above it a last vector overlapping the one before):
@@ -2722,40 +2758,17 @@ mod tests {
             eprintln!("no AVX2 on this CPU: nothing to compare");
             return;
         };
-        let mut s = 7u64;
-        let mut rand = move || {
-            s = s
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            s
-        };
-        for n in (1..=48usize).chain([63, 64, 65, 129, 200, 230, 300, 2047, 2048]) {
-            for w in [1usize, 2, 31, 64, 97, 230] {
-                for d_min in [-40i64, 0, 5] {
-                    let codes: [Vec<u64>; 3] = [
-                        (0..2 * w).map(|_| rand()).collect(),
-                        (0..2 * w).map(|_| rand() >> 2).collect(),
-                        vec![0x0123_4567_89ab_cdef; 2 * w],
-                    ];
-                    for c in &codes {
-                        let (cl, rev): (&[u64], Vec<u64>) =
-                            (&c[..w], c[w..].iter().rev().copied().collect());
-                        let mut want = vec![0u8; w * n];
-                        let mut got = vec![1u8; w * n];
-                        cost_row_as(cl, &rev, d_min, n, &mut want, None, None);
-                        cost_row_as(cl, &rev, d_min, n, &mut got, Some(avx2), None);
-                        assert_eq!(got, want, "{n} levels, width {w}, d_min {d_min}");
-                    }
-                }
-            }
-        }
+        same_cost_rows_as_the_compilers(
+            7,
+            (1..=48).chain([63, 64, 65, 129, 200, 230, 300, 2047, 2048]),
+            Some(avx2),
+            None,
+        );
     }
 
     #[test]
     fn the_avx512_hamming_costs_are_the_compilers() {
-        // Whole cost rows by the AVX-512 kernel against the compiler's loop, odd and even
-        // widths, ranges past either edge, on random 64-bit codes, census-like 62-bit ones and
-        // equal codes (a flat patch: every inside level ties). A row's pixels hand the kernel
+        // The AVX-512 kernel's rows. A row's pixels hand the kernel
         // every length 1..=min(n, w) (their inside levels; d_min 0: pixel x has x + 1), so
         // width 230 with n >= 230 already gives every tail 0..=15 of the masked last step
         // after 0..=13 whole steps: level counts 1..=48 and a few long ones (other cell
@@ -2765,33 +2778,12 @@ mod tests {
             eprintln!("no AVX-512 (F, BW, VL, VPOPCNTDQ) on this CPU: nothing to compare");
             return;
         };
-        let mut s = 11u64;
-        let mut rand = move || {
-            s = s
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            s
-        };
-        for n in (1..=48usize).chain([63, 64, 65, 129, 230, 300, 2047, 2048]) {
-            for w in [1usize, 2, 31, 64, 97, 230] {
-                for d_min in [-40i64, 0, 5] {
-                    let codes: [Vec<u64>; 3] = [
-                        (0..2 * w).map(|_| rand()).collect(),
-                        (0..2 * w).map(|_| rand() >> 2).collect(),
-                        vec![0x0123_4567_89ab_cdef; 2 * w],
-                    ];
-                    for c in &codes {
-                        let (cl, rev): (&[u64], Vec<u64>) =
-                            (&c[..w], c[w..].iter().rev().copied().collect());
-                        let mut want = vec![0u8; w * n];
-                        let mut got = vec![1u8; w * n];
-                        cost_row_as(cl, &rev, d_min, n, &mut want, None, None);
-                        cost_row_as(cl, &rev, d_min, n, &mut got, None, Some(avx512));
-                        assert_eq!(got, want, "{n} levels, width {w}, d_min {d_min}");
-                    }
-                }
-            }
-        }
+        same_cost_rows_as_the_compilers(
+            11,
+            (1..=48).chain([63, 64, 65, 129, 230, 300, 2047, 2048]),
+            None,
+            Some(avx512),
+        );
     }
 
     #[test]
