@@ -1408,6 +1408,48 @@ def test_match_names_the_method_that_takes_a_negative_min_disparity_as_depth_map
     assert len(got) > 100 and abs(float(np.nanmedian(got.dispx)) - 6.3) < 0.3
 
 
+def test_a_negative_min_disparity_with_fused_names_the_channels_that_run() -> None:
+    """match(method='fused', channels=('hopfield',), min_disparity=-2) said "its
+    graph-matching and Hopfield channels take no negative disparity" of a graph-matching
+    channel that does not run (depth_map too with ('gabor', 'hopfield')), and with
+    channels=('gabor',) that refusal came before the channels' own error."""
+    left = _texture(64, 96)
+    right = _shift(left, 6.3)
+    for channels, said in (
+        (("hopfield",), "its Hopfield channel takes"),
+        (("mcgm",), "its graph-matching channel takes"),
+        (("gabor", "hopfield"), "its Hopfield channel takes"),
+        (("mcgm", "hopfield"), "its graph-matching and Hopfield channels take"),
+    ):
+        for max_disparity in (None, 16):  # refused before the estimate, and after the checks
+            with pytest.raises(ValueError, match=rf"^min_disparity: .*\({said} no negative "):
+                sv.match(
+                    left,
+                    right,
+                    method="fused",
+                    channels=channels,
+                    max_disparity=max_disparity,
+                    min_disparity=-2,
+                )
+            if "gabor" in channels:
+                with pytest.raises(ValueError, match=rf"\({said} no negative .* 'fast' search"):
+                    sv.depth_map(
+                        left,
+                        right,
+                        channels=channels,
+                        max_disparity=max_disparity,
+                        min_disparity=-2,
+                    )
+    # a channels no fused match is made of is said first, as with min_disparity=0
+    for channels, said in ((("gabor",), "at least one sparse"), (("bogus",), "unknown channel")):
+        for lo in (0, -2):
+            with pytest.raises(ValueError, match=said):
+                sv.match(left, right, method="fused", channels=channels, min_disparity=lo)
+    # a one-pass iterator is read once: the refusal still names its channel
+    with pytest.raises(ValueError, match=r"\(its Hopfield channel takes"):
+        sv.match(left, right, method="fused", channels=iter(["hopfield"]), min_disparity=-2)
+
+
 def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
     from stereovision.depth import estimate_max_disparity
 

@@ -1311,24 +1311,42 @@ def _cloud(
 
 # Why each method searching from 0 px does: the words of :func:`_from_zero`.
 _FROM_ZERO = {
-    "fused": "its graph-matching and Hopfield channels take no negative disparity",
     "mcgm": "graph matching takes no negative disparity",
     "hopfield": "the Hopfield network takes no negative disparity",
     "best": "the best-match search takes no negative disparity",
 }
+# "fused"'s sparse channels, each by the name its refusal gives it
+_SPARSE_CHANNELS = {"mcgm": "graph-matching", "hopfield": "Hopfield"}
 
 
-def _from_zero(method: str, min_disparity: float, takers: tuple[str, ...]) -> ValueError:
+def _from_zero(
+    method: str,
+    min_disparity: float,
+    takers: tuple[str, ...],
+    channels: Iterable[str] | None = None,
+) -> ValueError:
     """The refusal of a negative ``min_disparity`` by a method searching from 0 px
     (:data:`_FROM_ZERO`), naming the methods that take one (``takers``: depth_map's and
     match()'s differ): the sparse matchers' own error ("must be a non-negative number of
-    pixels, got -2.0") named neither the method nor those."""
+    pixels, got -2.0") named neither the method nor those. ``"fused"``'s words name the
+    sparse ones of its ``channels`` (checked already): with ``("gabor", "hopfield")`` they
+    named a graph-matching channel that does not run. None: fuse_pair's default, all three."""
     names = ", ".join(repr(t) for t in takers[:-1])
     alternatives = (
         f"method={names} or {takers[-1]!r} search" if names else f"method={takers[-1]!r} searches"
     )
+    if method == "fused":
+        runs = set(_SPARSE_CHANNELS if channels is None else channels)
+        sparse = [said for name, said in _SPARSE_CHANNELS.items() if name in runs]
+        why = (
+            f"its {' and '.join(sparse)} channels take no negative disparity"
+            if len(sparse) > 1
+            else f"its {sparse[0]} channel takes no negative disparity"
+        )
+    else:
+        why = _FROM_ZERO[method]
     return ValueError(
-        f"min_disparity: method={method!r} searches from 0 px ({_FROM_ZERO[method]}), "
+        f"min_disparity: method={method!r} searches from 0 px ({why}), "
         f"got {_px(min_disparity)}; {alternatives} a negative range"
     )
 
@@ -1522,7 +1540,9 @@ def depth_map(
     if method == "fused" and min_disparity < 0 and max_disparity is None:
         # no range given to be refused first: up front, not after the rectification and the
         # automatic range's estimate (1.4 s of a 3600 x 3000 pair, for nothing)
-        raise _from_zero("fused", min_disparity, ("gabor", "census", "fast"))
+        raise _from_zero(
+            "fused", min_disparity, ("gabor", "census", "fast"), params.get("channels")
+        )
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
     # Each image is validated by as_bgr_uint8; the pair check without check_pair's grey
@@ -1590,7 +1610,9 @@ def depth_map(
     if max_disparity - min_disparity >= gl.shape[1]:
         raise _range_too_wide(max_disparity - min_disparity, gl.shape[1], min_disparity)
     if method == "fused" and min_disparity < 0:  # a range given: once it is known searchable
-        raise _from_zero("fused", min_disparity, ("gabor", "census", "fast"))
+        raise _from_zero(
+            "fused", min_disparity, ("gabor", "census", "fast"), params.get("channels")
+        )
     stage("prepare")
     channels: DepthChannels | None = {} if return_channels else None
     if refine is None:

@@ -26,6 +26,7 @@ from stereovision.depth import (
 from stereovision.matches import Matches
 from stereovision.matching import hopfield as _hopfield
 from stereovision.matching import mcgm as _mcgm
+from stereovision.matching.fusion import _checked_channels
 from stereovision.uncalibrated import UncalibratedRectification
 
 __all__ = ["METHODS", "match"]
@@ -114,8 +115,13 @@ def match(
     # anything not a finite number is left to the matchers' own words
     lo = params.get("min_disparity", 0)
     from_zero = method != "gabor" and real_number(lo) and -math.inf < lo < 0
+    if method == "fused" and "channels" in params:
+        # checked (and read once) first, so the refusal names the channels that run: it named
+        # a graph-matching channel with channels=("hopfield",), and came before the channels'
+        # own error with ("gabor",)
+        params["channels"] = _checked_channels(params["channels"])
     if from_zero and max_disparity is None:
-        raise _from_zero(method, lo, ("gabor",))
+        raise _from_zero(method, lo, ("gabor",), params.get("channels"))
     uint8 = np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8
     h, w = gl.shape
     # a calibrated rig not yet rectified, or an uncalibrated one: as depth_map does
@@ -131,7 +137,7 @@ def match(
         max_disparity = estimate_max_disparity(gl, gr)
     _refuse_unreachable(params.get("min_disparity", 0), max_disparity, gl.shape[1], automatic)
     if from_zero:  # a range given: once it is known searchable
-        raise _from_zero(method, lo, ("gabor",))
+        raise _from_zero(method, lo, ("gabor",), params.get("channels"))
     if method == "mcgm":
         m = _mcgm.mcgm_match(gl, gr, max_disparity=max_disparity, **params)
         keep = _in_range(m, params.get("min_disparity", 0), max_disparity)

@@ -484,6 +484,41 @@ def fuse(
     )
 
 
+def _checked_channels(channels: Iterable[Any]) -> tuple[str, ...]:
+    """``channels`` as :func:`fuse_pair` takes them, read once into a tuple, or the
+    ValueError naming what is wrong: a string, unknown names, no sparse channel.
+    :func:`stereovision.match` checks them with it before its own refusals, which name the
+    channels that run."""
+    if isinstance(channels, (str, bytes)):  # "gabor,mcgm" was read letter by letter
+        raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}")
+    # once: a generator was used up by the first check, then said to hold no sparse channel
+    try:
+        channels = tuple(channels)
+    except TypeError:
+        raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}") from None
+    # no set() or sorted() of the raw entries: a list among them was "unhashable type", a
+    # number beside a name "'<' not supported", naming nothing
+    # told apart by repr: ``c not in bad`` compared an array entry with == ("truth value of
+    # an array ... is ambiguous", naming nothing)
+    bad: list[Any] = []
+    seen: set[str] = set()
+    for c in channels:
+        if (not isinstance(c, str) or c not in CHANNEL_BITS) and repr(c) not in seen:
+            seen.add(repr(c))
+            bad.append(c)
+    if bad:
+        shown = sorted(bad, key=repr)
+        raise ValueError(f"unknown channel(s) {shown}: expected {sorted(CHANNEL_BITS)}")
+    if not set(channels) & {"mcgm", "hopfield"}:
+        # fuse refused it only after the channels had run (match(method="fused") on a whole
+        # pair), and () without the census map was ThreadPoolExecutor's "max_workers must be
+        # greater than 0"
+        raise ValueError(
+            f"channels: expected at least one sparse channel (mcgm or hopfield), got {channels!r}"
+        )
+    return channels
+
+
 def fuse_pair(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
@@ -583,33 +618,7 @@ def fuse_pair(
         # as depth_map's switches: "no" (true) ran the check, None (false) skipped it
         if not isinstance(flag, (bool, np.bool_)):
             raise TypeError(f"{name}: expected True or False, got {flag!r}")
-    if isinstance(channels, (str, bytes)):  # "gabor,mcgm" was read letter by letter
-        raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}")
-    # once: a generator was used up by the first check, then said to hold no sparse channel
-    try:
-        channels = tuple(channels)
-    except TypeError:
-        raise ValueError(f"channels: expected a tuple of channel names, got {channels!r}") from None
-    # no set() or sorted() of the raw entries: a list among them was "unhashable type", a
-    # number beside a name "'<' not supported", naming nothing
-    # told apart by repr: ``c not in bad`` compared an array entry with == ("truth value of
-    # an array ... is ambiguous", naming nothing)
-    bad: list[Any] = []
-    seen: set[str] = set()
-    for c in channels:
-        if (not isinstance(c, str) or c not in CHANNEL_BITS) and repr(c) not in seen:
-            seen.add(repr(c))
-            bad.append(c)
-    if bad:
-        shown = sorted(bad, key=repr)
-        raise ValueError(f"unknown channel(s) {shown}: expected {sorted(CHANNEL_BITS)}")
-    if not set(channels) & {"mcgm", "hopfield"}:
-        # fuse refused it only after the channels had run (match(method="fused") on a whole
-        # pair), and () without the census map was ThreadPoolExecutor's "max_workers must be
-        # greater than 0"
-        raise ValueError(
-            f"channels: expected at least one sparse channel (mcgm or hopfield), got {channels!r}"
-        )
+    channels = _checked_channels(channels)
     # before the channels run, not after
     mode, *_, min_agree = _fuse_options(**{**DEFAULTS, **params})
     _check_agree(mode, min_agree, channels)
