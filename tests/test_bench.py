@@ -101,6 +101,38 @@ def test_bench_cli_folder_without_scenes(
     assert "no scene" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("command", ["eval", "bench"])
+def test_no_scene_line_names_the_half_scenes_it_skipped(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    """'no scene (left.png + right.png) under ROOT' of a folder holding only half scenes
+    (left.png without right.png) did not say that they were skipped, though among scenes
+    each is named; bench did not say either that the folder given was itself half a scene."""
+    root = tmp_path / "root"
+    for name, image in (("a", "left.png"), ("b", "right.png")):
+        (root / name).mkdir(parents=True)
+        (root / name / image).write_bytes(b"")
+    assert main([command, str(root)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: no scene (left.png + right.png) under {root}; skipped 2 half "
+        f"scenes (a scene folder holds both images): {root / 'a'} has left.png but no "
+        f"right.png, {root / 'b'} has right.png but no left.png"
+    ]
+    for name in "cdef":  # a few named, the rest counted: still one line
+        (root / name).mkdir()
+        (root / name / "left.png").write_bytes(b"")
+    assert main([command, str(root)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "skipped 6 half scenes" in err
+    assert err.endswith(f"{root / 'c'} has left.png but no right.png, 3 more\n")
+    # the folder given is half a scene: said of it, as eval did
+    assert main([command, str(root / "a")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: {root / 'a'}: has left.png but no right.png (a scene folder "
+        "holds both)"
+    ]
+
+
 def _strict_json(line: str) -> dict[str, object]:
     def refuse(token: str) -> object:
         raise ValueError(f"not JSON: {token}")

@@ -291,7 +291,7 @@ def format_table(cases: Sequence[BenchCase]) -> str:
 
 
 def _scene_dirs(paths: Sequence[str]) -> list[Path]:
-    from stereovision.io import distinct_scenes, scan_scenes
+    from stereovision.io import _no_scene_under, distinct_scenes, scan_scenes
 
     if not paths:
         return [Path(str(resources.files("stereovision") / "data" / "cones"))]
@@ -301,7 +301,8 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
             raise ValueError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found, half = scan_scenes(d)  # FileNotFoundError for a missing folder
         if not found:
-            raise ValueError(f"no scene (left.png + right.png) under {d}")
+            # eval's line: a half scene skipped, or a JPEG pair, was not named
+            raise ValueError(_no_scene_under(Path(d), d, half))
         # as eval: half a scene among scenes was left out without a word
         for folder, reason in half:
             print(f"stereovision: skipped {folder}: {reason}", file=sys.stderr)

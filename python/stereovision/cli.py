@@ -1679,22 +1679,6 @@ def _fmt_dense(m: dict[str, Any]) -> str:
     return f"{m['bad_2.0']:6.1f} {m['bad_1.0']:6.1f} {m['density']:6.1f}"
 
 
-def _no_scene_under(folder: Path, given: str) -> str:
-    """The one line for a folder holding no scene, naming what is missing from it."""
-    pair = ("left.png", "right.png")
-    have = [n for n in pair if (folder / n).is_file()]
-    if len(have) == 1:
-        missing = pair[1 - pair.index(have[0])]
-        return f"{given}: has {have[0]} but no {missing} (a scene folder holds both)"
-    others = sorted(
-        q.name
-        for q in folder.iterdir()
-        if q.is_file() and q.stem.lower() in ("left", "right") and q.name not in pair
-    )
-    found = f" ({', '.join(others)} found: a scene's images are PNG)" if others else ""
-    return f"no scene (left.png + right.png) under {given}{found}"
-
-
 def _eval_time_line(row: dict[str, Any]) -> str:
     """An ``eval`` row's times in one line: ours, then OpenCV's and our ratio to SGBM-3WAY's.
 
@@ -1735,7 +1719,13 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from stereovision.baselines import bm_reference_refusal
-    from stereovision.io import distinct_scenes, load_scene, scan_scenes, scene_too_narrow
+    from stereovision.io import (
+        _no_scene_under,
+        distinct_scenes,
+        load_scene,
+        scan_scenes,
+        scene_too_narrow,
+    )
 
     dirs: list[Path] = []
     for d in args.scenes:
@@ -1746,7 +1736,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             raise CliError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found, half = scan_scenes(p)
         if not found:
-            raise CliError(_no_scene_under(p, d))
+            raise CliError(_no_scene_under(p, d, half))
         # half a scene among scenes was left out without a word (batch says it is unpaired)
         for folder, reason in half:
             print(f"stereovision: skipped {folder}: {reason}", file=sys.stderr)

@@ -1894,3 +1894,48 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
             )
             skipped.append((Path(folder), f"{why} (a scene folder holds both)"))
     return sorted(found), sorted(skipped)
+
+
+def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] = ()) -> str:
+    """The one line of ``eval`` and ``bench`` for a folder holding no scene, naming what is
+    missing from it.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The folder searched.
+    given : str
+        The folder as the user gave it.
+    half : sequence of (pathlib.Path, str)
+        :func:`scan_scenes`'s half scenes under it, with why.
+
+    Returns
+    -------
+    str
+        ``"FOLDER: has left.png but no right.png (a scene folder holds both)"`` when the folder
+        itself is half a scene; else ``"no scene (left.png + right.png) under FOLDER"``, with
+        the left/right images found that are not PNG, and the half scenes skipped under it
+        (they were not named: the line hid why a folder of them gave nothing).
+    """
+    pair = ("left.png", "right.png")
+    have = [n for n in pair if (folder / n).is_file()]
+    if len(have) == 1:
+        missing = pair[1 - pair.index(have[0])]
+        return f"{given}: has {have[0]} but no {missing} (a scene folder holds both)"
+    others = sorted(
+        q.name
+        for q in folder.iterdir()
+        if q.is_file() and q.stem.lower() in ("left", "right") and q.name not in pair
+    )
+    found = f" ({', '.join(others)} found: a scene's images are PNG)" if others else ""
+    # a few named, the rest counted: the line stays one line under a tree of them
+    named = [f"{f} {why.removesuffix(' (a scene folder holds both)')}" for f, why in half[:3]]
+    if len(half) > 3:
+        named.append(f"{len(half) - 3} more")
+    skipped = (
+        f"; skipped {len(half)} half scene{'s' if len(half) > 1 else ''} (a scene folder holds "
+        f"both images): {', '.join(named)}"
+        if half
+        else ""
+    )
+    return f"no scene (left.png + right.png) under {given}{found}{skipped}"
