@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import math
 import re
+import signal
 import socket
 import subprocess
 import sys
@@ -117,6 +118,47 @@ def test_gui_port_0_announces_the_port_it_got():
         watchdog.cancel()
         proc.terminate()
         proc.wait(timeout=30)
+
+
+@pytest.mark.parametrize(
+    ("entry", "signum", "status", "said"),
+    [
+        ("stereovision", signal.SIGINT, 130, "interrupted"),
+        ("stereovision", signal.SIGTERM, 143, "terminated (SIGTERM)"),
+        ("stereovision.gui", signal.SIGINT, 130, "interrupted"),
+        ("stereovision.gui", signal.SIGTERM, 143, "terminated (SIGTERM)"),
+    ],
+)
+def test_gui_stopped_by_ctrl_c_exits_130_as_the_cli(
+    entry: str, signum: int, status: int, said: str
+) -> None:
+    """Ctrl+C on a serving GUI exited 0 without a word (aiohttp's signal handlers stop the
+    server quietly and trame's start returns), SIGTERM too: the CLI's other commands exit 130
+    (143) and say so. Both entry points now do."""
+    import threading
+
+    pytest.importorskip("trame")
+    cmd = [sys.executable, "-m", entry, *(["gui"] if entry == "stereovision" else [])]
+    proc = subprocess.Popen(
+        [*cmd, "--no-browser", "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
+    watchdog.start()
+    try:
+        line = proc.stdout.readline()  # the server listens: its signal handlers are set
+        watchdog.cancel()
+        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
+        proc.send_signal(signum)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        watchdog.cancel()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=30)
+    assert (proc.returncode, out, err) == (status, "", f"stereovision: {said}\n")
 
 
 def test_gui_on_a_busy_port_says_so_in_one_line():

@@ -13,8 +13,11 @@ from the bundled demo data and the folders given with ``--data``.
 from __future__ import annotations
 
 import argparse
+import asyncio
+import contextlib
 import errno
 import logging
+import signal
 import sys
 from collections.abc import Sequence
 from importlib import resources
@@ -178,10 +181,16 @@ def cmd_gui(args: argparse.Namespace) -> int:
 
     Raises
     ------
+    KeyboardInterrupt
+        Ctrl+C (SIGINT) stopped the server (:class:`~stereovision._interrupt.Terminated` for
+        SIGTERM), once the page's work is stopped and the camera closed: the CLI's exit 130
+        (143), where trame's own stop returned and the command exited 0.
     OSError
         The server cannot listen there: ``"port 8080 on 127.0.0.1 is in use ..."`` when another
         program holds the port, the system's reason otherwise.
     """
+    from stereovision._interrupt import Terminated
+
     app = build_app(args)
     quiet_closed_pages()
     bound = []
@@ -197,6 +206,21 @@ def cmd_gui(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
 
+    stopped_by: list[int] = []
+
+    def stop_on(signum: int) -> None:
+        stopped_by.append(signum)
+        raise SystemExit  # how aiohttp's own handler stops the loop; trame's start returns
+
+    def hear_signals(**_: Any) -> None:
+        # aiohttp's handlers (set once the server is set up: on ready, ours replace them) stop
+        # the server as ours do but leave no trace of the signal: Ctrl+C exited 0, not 130
+        with contextlib.suppress(RuntimeError, ValueError, NotImplementedError):
+            loop = asyncio.get_running_loop()  # RuntimeError: none (not served by a loop)
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                loop.add_signal_handler(signum, stop_on, signum)
+
+    app.ctrl.on_server_ready.add(hear_signals)  # before the address is said: Ctrl+C heard
     app.ctrl.on_server_ready.add(announce)  # after the bind: the real port, and only if it bound
     argv, sys.argv = sys.argv, sys.argv[:1]  # trame parses sys.argv itself: give it nothing
     try:
@@ -207,6 +231,10 @@ def cmd_gui(args: argparse.Namespace) -> int:
             show_connection_info=False,
             timeout=0,
         )
+        if stopped_by[:1] == [signal.SIGTERM]:
+            raise Terminated(f"signal {signal.SIGTERM}")
+        if stopped_by:
+            raise KeyboardInterrupt
     except OSError as exc:
         if bound:  # a later failure: its own message
             raise
@@ -299,10 +327,14 @@ def _main(argv: Sequence[str] | None) -> int:
     p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
     add_arguments(p)
     args = p.parse_args(argv)
+    from stereovision._interrupt import Terminated
     from stereovision._validate import BUG_ERRORS, internal_error
 
     try:
         return cmd_gui(args)
+    except Terminated:  # as the CLI
+        print("stereovision: terminated (SIGTERM)", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:  # as the CLI: a word, where this said nothing
         print("stereovision: interrupted", file=sys.stderr)
         return 130
