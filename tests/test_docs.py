@@ -230,6 +230,38 @@ def test_help_texts_say_what_the_option_is_beside_its_default() -> None:
     assert not no_unit, f"--max-disparity without its unit: {no_unit}"
 
 
+def test_every_default_a_help_text_names_is_the_parsers() -> None:
+    """A second read of the help texts (f13e4d4, 89f2cb2) checked each by hand: every
+    default an option's help names as a value ("(default 0.5)", "m (default)", "auto, the
+    default") is the default argparse gives it. Held here, so that a default changed in
+    add_argument without its help (or the reverse) is caught."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    said = re.compile(r"\bdefault:? ([^;),]+)|([\w.]+) \(default\)|\(([\w.]+), the default\)")
+    checked, wrong = 0, []
+    for command, sub in commands.choices.items():
+        for action in sub._actions:
+            if action.default in (None, argparse.SUPPRESS) or isinstance(action.default, bool):
+                continue  # resolved later (the method's, found, estimated): said in words
+            for m in said.finditer(action.help or ""):
+                value = next(g for g in m.groups() if g)
+                if action.default == "auto" and value != "auto":
+                    continue  # a sentinel said by what it does ("found from the images")
+                if isinstance(action.default, (int, float)):
+                    same = float(value) == action.default
+                else:
+                    same = value == action.default
+                checked += 1
+                if not same:
+                    wrong.append(f"{command} {action.option_strings}: {value!r}")
+    assert not wrong, f"a help names another default than the parser's: {wrong}"
+    assert checked >= 20, checked  # the options above, not a pattern that matches nothing
+
+
 def test_board_side_options_say_their_unit() -> None:
     """`capture --square` said "--charuco: square side", no unit, where calibrate's and board's
     say "in --unit" (capture has none: any unit does, only the ratio to --marker is used)."""
