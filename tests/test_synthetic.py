@@ -92,3 +92,41 @@ def test_fisheye_and_pinhole_rays_of_one_camera_are_not_shared() -> None:
     u = np.arange(20)
     np.testing.assert_allclose(pin[0, :, 0], u + 4.5, atol=1e-3)
     np.testing.assert_allclose(fish[0, :, 0], np.tan((u + 5) / 100) * 100 - 0.5, atol=0.02)
+
+
+def test_a_fisheye_ray_past_90_degrees_sees_the_background_not_the_plane() -> None:
+    """With k1 = -0.1 the equidistant lens puts angle theta at r = f theta (1 - 0.1 theta^2):
+    90 degrees at r = 118.3 px for f = 100, so pixels 120 px off the centre look behind the
+    camera. OpenCV's inverse gave them a mirrored ray (tan theta < 0) that met the plane at
+    Z = 1, which was drawn there; the cut at theta_d = r / f >= 90 degrees missed them."""
+    k = np.array([[100.0, 0.0, 100.0], [0.0, 100.0, 100.0], [0.0, 0.0, 1.0]])
+    d = np.array([-0.1, 0.0, 0.0, 0.0])
+    tex = np.full((400, 400), 200.0, np.float32)  # 40 x 40 units, centred on the axis
+    out = render_plane(
+        tex,
+        0.1,
+        k,
+        d,
+        np.zeros(3),
+        [-20.0, -20.0, 1.0],
+        image_size=(240, 201),
+        model="fisheye",
+        supersample=1,
+        background=60.0,
+    )
+    r = np.arange(0, 140)
+
+    def angle(theta_d: float) -> float:
+        """The smallest theta >= 0 with theta - 0.1 theta^3 = theta_d (inf: none)."""
+        roots = np.roots([-0.1, 0.0, 1.0, -theta_d])
+        real = [t.real for t in roots if abs(t.imag) < 1e-9 and t.real >= 0]
+        return min(real, default=np.inf)
+
+    theta = np.array([angle(x / 100) for x in r])  # of each pixel right of the centre
+    front = theta < np.pi / 2
+    assert front[:118].all() and not front[119:].any()
+    # in front and within the plane's 20 units (tan theta <= 20): the plane, else background
+    seen = front & (np.tan(np.where(front, theta, 0)) < 19)
+    gone = ~front
+    np.testing.assert_array_equal(out[100, 100 + r[seen]], 200.0)
+    np.testing.assert_array_equal(out[100, 100 + r[gone]], 60.0)

@@ -49,9 +49,15 @@ def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pin
             und = cv2.undistortPoints(pts, K, D, R=None, P=None, criteria=crit)
         rays = np.asarray(und, np.float64).reshape(h * ss, w * ss, 2)
         if model == "fisheye":
-            # Past 90 degrees off axis there is no ray with z = 1: OpenCV returns garbage there.
-            theta_d = np.hypot((gx - K[0, 2]) / K[0, 0], (gy - K[1, 2]) / K[1, 1])
-            rays[theta_d >= np.pi / 2 * 0.999] = np.nan
+            # Past 90 degrees off axis there is no ray with z = 1: OpenCV returns a mirrored ray
+            # (tan < 0) or its -1e6 sentinel there. The limit is on the ray's angle theta, not
+            # on the distorted theta_d = r / f (the two differ by the k1..k4 polynomial: the
+            # old theta_d cut left out rays in front for k1 > 0 and kept mirrored ones behind
+            # for k1 < 0), so each ray is projected back and kept where it lands on its pixel.
+            theta = np.arctan(np.hypot(rays[..., 0], rays[..., 1]))
+            back = cv2.fisheye.distortPoints(und.reshape(-1, 1, 2), K, D)
+            off = np.hypot(*(np.asarray(back, np.float64).reshape(-1, 2) - pts[:, 0]).T)
+            rays[(theta >= np.pi / 2 * 0.999) | (off.reshape(theta.shape) > 0.01)] = np.nan
         if len(_RAYS) > 8:
             _RAYS.clear()
         _RAYS[key] = rays
