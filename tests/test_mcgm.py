@@ -702,6 +702,23 @@ def test_matches_rasters_are_left_minus_right_at_the_rounded_left_pixel() -> Non
     assert np.isnan(edge.dispx).all() and np.isnan(edge.dispy).all()
 
 
+def test_a_match_with_a_nan_score_does_not_hide_a_scored_one_at_its_pixel(
+    tmp_path: Path,
+) -> None:
+    """Two matches rounding to pixel (5, 10), scored 0.9 and NaN (a row another tool wrote as
+    "nan", read by from_csv), in either order: the rasters keep the scored one's disparity 3
+    and row offset 0.5. argsort put NaN last, so the unscored match was written over it."""
+    for order in ([0, 1], [1, 0]):
+        m = sv.Matches(
+            xl=np.array([10.2, 9.9])[order], yl=np.array([5.0, 5.1])[order],
+            xr=np.array([7.2, 1.9])[order], yr=np.array([4.5, 5.1])[order],
+            score=np.array([0.9, np.nan])[order], image_shape=(12, 40),
+        )  # fmt: skip
+        assert (m.dispx[5, 10], m.dispy[5, 10]) == pytest.approx((3.0, 0.5))
+        back = sv.Matches.from_csv(m.save_csv(tmp_path / "m.csv"), (12, 40))
+        assert back.dispx[5, 10] == pytest.approx(3.0)
+
+
 def test_matches_selection_keeps_trace_and_copies_stats() -> None:
     m = _three()
     sub = m[m.score > 0.6]

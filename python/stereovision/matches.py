@@ -272,8 +272,9 @@ class Matches:
         xi = np.where(ok, rx, 0).astype(np.int64)
         yi = np.where(ok, ry, 0).astype(np.int64)
         # Two matches can round to one pixel (MCGM: 15 of 5086 on tsukuba): the better-scored
-        # one is written last, so it is the one kept.
-        order = np.argsort(self.score, kind="stable")
+        # one is written last, so it is the one kept. A NaN score (a CSV row's "nan") ranks
+        # lowest: argsort puts NaN last, so such a match hid a scored one at its pixel.
+        order = np.argsort(np.where(np.isnan(self.score), -np.inf, self.score), kind="stable")
         order = order[ok[order]]
         out[yi[order], xi[order]] = values[order]
         return out
@@ -282,7 +283,7 @@ class Matches:
     def dispx(self) -> F32:
         """``(H, W)`` float32 ``x_left - x_right`` at the matched left pixels (rounded), NaN
         elsewhere; where two matches round to one pixel, the higher score's (the later one's on
-        a tie)."""
+        a tie; a NaN score is the lowest)."""
         return self._raster(self.xl - self.xr)
 
     @property
