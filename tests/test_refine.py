@@ -296,6 +296,25 @@ def test_a_right_image_outside_zero_one_is_named() -> None:
         refine_disparity(a * 255, a, a, max_disparity=8)
 
 
+def test_an_8_or_16_bit_pair_is_taken_at_full_scale() -> None:
+    """A uint8 pair was cast to floats 0-255 and refused, its message advising to "divide 8-bit
+    data by 255, or pass the uint8 array itself", which it was; uint16 alike. It is now refined
+    as the float pair divided by 255 (65535), bit for bit; the disparity is not scaled."""
+    rng = np.random.default_rng(3)
+    left8 = (rng.random((30, 48)) * 255).astype(np.uint8)
+    right8 = np.roll(left8, -2, axis=1)
+    disp = np.full(left8.shape, 2.0, np.float32)
+    left16, right16 = left8.astype(np.uint16) * 257, right8.astype(np.uint16) * 257
+    for lft, rgt, full in ((left8, right8, 255), (left16, right16, 65535)):
+        got = refine_disparity(lft, rgt.T.copy().T, disp, max_disparity=8)  # F-order too
+        want = refine_disparity(
+            lft.astype(np.float32) / full, rgt.astype(np.float32) / full, disp, max_disparity=8
+        )
+        np.testing.assert_array_equal(got.disparity, want.disparity)
+        assert got.n_filled == want.n_filled
+        assert np.nanmedian(got.disparity) == pytest.approx(2.0, abs=0.05)
+
+
 @pytest.mark.parametrize(
     "params",
     [

@@ -110,8 +110,13 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
         raise ValueError(f"{name} must be real numbers, got dtype {arr.dtype}")
     if arr.ndim != 2 or arr.size == 0:
         raise ValueError(f"{name} must be a non-empty 2-D (H, W) array, got shape {arr.shape}")
+    image = name in ("left", "right")
     # before the float32 copy: a broadcast image past the kernel's limit may not fit in memory
-    check_index_range(arr.shape, name, "image" if name in ("left", "right") else "map")
+    check_index_range(arr.shape, name, "image" if image else "map")
+    if image and arr.dtype in (np.uint8, np.uint16):
+        # 8- and 16-bit images at full scale, as every matcher takes them: the range check's
+        # advice ("pass the uint8 array itself") refused the uint8 array it had been given
+        return np.ascontiguousarray(arr, dtype=np.float32) / np.float32(np.iinfo(arr.dtype).max)
     return np.ascontiguousarray(arr, dtype=np.float32)
 
 
@@ -130,7 +135,8 @@ def refine_disparity(
     Parameters
     ----------
     left, right : array_like
-        Rectified grey images, ``(H, W)`` float in ``[0, 1]``.
+        Rectified grey images, ``(H, W)`` float in ``[0, 1]``, or ``uint8`` / ``uint16``
+        (divided by 255 / 65535).
     disparity : array_like
         ``(H, W)`` disparity of the left image (px), NaN = no estimate.
     confidence : array_like, optional
