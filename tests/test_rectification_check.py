@@ -694,6 +694,22 @@ def test_the_plot_colours_each_match_by_its_row_error() -> None:
     assert pair[52, 150, 2] > 200 and pair[52, 150, :2].max() == 0 and pair[28, 150].max() == 0
 
 
+@pytest.mark.parametrize(("right_shape", "said"), [((100, 150), "150x100"), ((80, 200), "200x80")])
+def test_the_plot_of_a_pair_of_two_sizes_names_both(right_shape: tuple, said: str) -> None:
+    """A narrower or shorter right image was NumPy's concatenation error, naming neither image
+    ("along dimension 1, the array at index 0 has size 400 and the array at index 1 has size
+    350"); it is said as check_rectification says it."""
+    from stereovision.rectification_check import RectificationCheck, draw_rectification_check
+
+    nan = float("nan")
+    check = RectificationCheck(0, nan, nan, nan, nan, nan, None, 0.5)
+    with pytest.raises(ValueError) as err:
+        draw_rectification_check(np.zeros((100, 200), np.uint8), np.zeros(right_shape), check)
+    assert str(err.value) == (
+        f"left is 200x100 px, right is {said} px: the two images of a pair have one size"
+    )
+
+
 def test_refine_fits_the_turn_to_the_matches_within_1_px() -> None:
     """Given the check: 40 matches 1 px above their rows in the right image (a pitch of
     atan(1 / 700) = 0.082 degrees) and 20 more 3 px off are corrected by the 40 alone; a

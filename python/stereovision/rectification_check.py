@@ -377,10 +377,22 @@ def draw_rectification_check(
     -------
     numpy.ndarray
         ``(H + band, 2 W, 3)`` BGR ``uint8`` image, the summary in a band above the pair.
+
+    Raises
+    ------
+    ValueError
+        Images that are not images, or of different sizes.
     """
     from stereovision._validate import as_bgr_uint8
 
     lb, rb = as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right")
+    if lb.shape != rb.shape:
+        # NumPy's concatenation error named neither image ("along dimension 1, the array at
+        # index 0 has size 120"), and a narrower right image was found only at the band
+        (hl, wl), (hr, wr) = lb.shape[:2], rb.shape[:2]
+        raise ValueError(
+            f"left is {wl}x{hl} px, right is {wr}x{hr} px: the two images of a pair have one size"
+        )
     h, w = lb.shape[:2]
     canvas = np.concatenate([lb, rb], axis=1)
     canvas = (canvas * 0.7).astype(np.uint8)
