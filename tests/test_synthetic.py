@@ -77,6 +77,36 @@ def test_bad_arguments_are_named(kw: dict, message: str) -> None:
         render_plane(TEX, 0.01, K, D, np.zeros(3), [0, 0, 1.0], **kw)
 
 
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"texture": np.zeros((0, 0))}, r"^texture: expected a non-empty .* got shape \(0, 0\)$"),
+        ({"texture": np.zeros(10)}, r"^texture: .* got shape \(10,\)$"),  # was one column
+        ({"texture": np.zeros((5, 5, 6))}, r"^texture: .*\(H, W, 1-4\) image, got shape"),
+        ({"K": np.eye(2)}, r"^K: expected a 3 x 3 camera matrix \(finite\), got shape \(2, 2\)$"),
+        ({"D": np.zeros(3)}, r"^D: expected 4, 5, 8, 12 or 14 coefficients \(or none\)"),
+        ({"D": np.zeros(5), "model": "fisheye"}, r"^D: expected 4 coefficients for model 'fish"),
+        ({"rvec": [0.0, 0.0]}, r"^rvec: expected 3 numbers \(finite\), got shape \(2,\)$"),
+        ({"tvec": [0.0, np.nan, 1.0]}, r"^tvec: expected 3 numbers \(finite\), got shape \(3,\)$"),
+        ({"tvec": [0.0, 0.0, 0.0]}, r"^tvec: the camera lies in the plane \(seen edge-on\)"),
+    ],
+)
+def test_a_bad_texture_or_camera_is_named(kw: dict, message: str) -> None:
+    """OpenCV's and NumPy's errors named no argument ("!_src.empty() in function 'remap'",
+    "Singular matrix", a cv2.error for K), and a 1-D texture was drawn as one column."""
+    args = {"texture": TEX, "K": K, "D": D, "rvec": np.zeros(3), "tvec": [0, 0, 1.0], **kw}
+    with pytest.raises(ValueError, match=message):
+        render_plane(units_per_pixel=0.01, image_size=(20, 12), **args)
+
+
+def test_no_distortion_coefficients_is_no_distortion() -> None:
+    kw = {"image_size": (20, 12)}
+    none = render_plane(TEX, 0.01, K, np.zeros(0), np.zeros(3), [0, 0, 1.0], **kw)
+    np.testing.assert_array_equal(
+        none, render_plane(TEX, 0.01, K, D, np.zeros(3), [0, 0, 1.0], **kw)
+    )
+
+
 @pytest.mark.parametrize("s", [0.0, -0.01, float("nan"), float("inf")])
 def test_units_per_pixel_must_be_positive(s: float) -> None:
     with pytest.raises(ValueError, match="units_per_pixel"):

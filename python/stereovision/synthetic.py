@@ -114,7 +114,9 @@ def render_plane(
     Raises
     ------
     ValueError
-        For a bad size, supersampling or model.
+        For a bad size, supersampling or model; a texture that is empty or not ``(H, W)`` or
+        ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3, ``D`` of a length the model does
+        not take, ``rvec`` or ``tvec`` not 3 numbers; a camera in the plane (seen edge-on).
     """
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
@@ -126,14 +128,40 @@ def render_plane(
         ) from None
     ss = int_in_range(supersample, "supersample", 1, 8)
     tex = np.asarray(texture)
+    # OpenCV's and NumPy's own errors named no argument ("!_src.empty() in function 'remap'",
+    # "Singular matrix"), and a 1-D texture was drawn as one column
+    if tex.size == 0 or not (tex.ndim == 2 or (tex.ndim == 3 and 1 <= tex.shape[2] <= 4)):
+        raise ValueError(
+            f"texture: expected a non-empty (H, W) or (H, W, 1-4) image, got shape {tex.shape}"
+        )
     s = float(units_per_pixel)
     if not (np.isfinite(s) and s > 0):
         raise ValueError(f"units_per_pixel: expected a positive number, got {units_per_pixel!r}")
     Kf = np.asarray(K, np.float64)
     Df = np.asarray(D, np.float64).ravel()
-    Rb, _ = cv2.Rodrigues(np.asarray(rvec, np.float64).reshape(3, 1))
+    rv = np.asarray(rvec, np.float64).ravel()
     t = np.asarray(tvec, np.float64).ravel()
-    Hi = np.linalg.inv(np.column_stack([Rb[:, 0], Rb[:, 1], t]))  # ray -> (u, v, 1) on the plane
+    # OpenCV's lengths; none at all is no distortion for the pinhole model
+    lengths = (4,) if model == "fisheye" else (0, 4, 5, 8, 12, 14)
+    for name, arr, ok in (
+        ("K", Kf, Kf.shape == (3, 3)),
+        ("D", Df, len(Df) in lengths),
+        ("rvec", rv, rv.shape == (3,)),
+        ("tvec", t, t.shape == (3,)),
+    ):
+        if not (ok and np.isfinite(arr).all()):
+            want = {"K": "a 3 x 3 camera matrix", "rvec": "3 numbers", "tvec": "3 numbers"}.get(
+                name,
+                "4 coefficients for model 'fisheye'"
+                if model == "fisheye"
+                else "4, 5, 8, 12 or 14 coefficients (or none) for model 'pinhole'",
+            )
+            raise ValueError(f"{name}: expected {want} (finite), got shape {arr.shape}")
+    Rb, _ = cv2.Rodrigues(rv.reshape(3, 1))
+    plane = np.column_stack([Rb[:, 0], Rb[:, 1], t])
+    if abs(np.linalg.det(plane)) <= 1e-12 * max(1.0, float(np.abs(t).max())):
+        raise ValueError("tvec: the camera lies in the plane (seen edge-on): nothing to render")
+    Hi = np.linalg.inv(plane)  # ray -> (u, v, 1) on the plane
     rays = pixel_rays(Kf, Df, (w, h), ss, model)
     x, y = rays[..., 0], rays[..., 1]
     u = Hi[0, 0] * x + Hi[0, 1] * y + Hi[0, 2]
