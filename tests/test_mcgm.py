@@ -748,8 +748,11 @@ def test_matches_csv_text_and_bad_files(tmp_path: Path) -> None:
     (tmp_path / "long.csv").write_text(f"{header}\n1,2,3,4,1,9\n")
     with pytest.raises(ValueError, match="line 2 has 6 values, expected 5"):
         sv.Matches.from_csv(tmp_path / "long.csv", (4, 4))
-    (tmp_path / "word.csv").write_text(f"{header}\n1,2,x,4,1\n")
-    with pytest.raises(ValueError, match=r"word\.csv: could not convert"):
+    # its line too, as a short row's ("could not convert ..." named no line of thousands)
+    (tmp_path / "word.csv").write_text(f"{header}\n1,2,3,4,1\n\n1,2,x,4,1\n")
+    with pytest.raises(
+        ValueError, match=r"word\.csv: line 4: could not convert string to float: 'x'$"
+    ):
         sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
 
 

@@ -351,7 +351,7 @@ class Matches:
         ValueError
             If ``path`` is a folder (or another file that is neither regular nor a pipe) or
             not UTF-8 text (an image given by mistake), another header, or a row without five
-            numbers, naming the file.
+            numbers, naming the file (and the row's line).
         """
         from stereovision.io import _existing_file
 
@@ -379,10 +379,15 @@ class Matches:
         if short is not None:
             line = lines[short][0]
             raise ValueError(f"{path}: line {line} has {len(rows[short])} values, expected 5")
-        try:
-            a = np.array([[float(v) for v in r] for r in rows], dtype=np.float64)
-        except ValueError as e:
-            raise ValueError(f"{path}: {e}") from None
+        values: list[list[float]] = []
+        for (line, _), r in zip(lines, rows, strict=True):
+            try:
+                values.append([float(v) for v in r])
+            except ValueError as e:
+                # the line too, as for a short row ("could not convert string to float: ''"
+                # named no line of a file of thousands)
+                raise ValueError(f"{path}: line {line}: {e}") from None
+        a = np.array(values, dtype=np.float64)
         a = a.reshape(len(lines), -1) if lines else np.zeros((0, 5))
         if a.ndim != 2 or a.shape[1] != 5:
             raise ValueError(f"{path}: expected 5 numbers per row")
