@@ -963,6 +963,25 @@ def test_align_rows_takes_the_roll_about_the_image_centre() -> None:
     np.testing.assert_allclose(out[rows, 60], ramp[rows, 60] - 4.0, atol=1e-3)
 
 
+def test_align_rows_gives_a_one_channel_image_back_in_its_shape() -> None:
+    """An (H, W, 1) right image came back (H, W) once aligned (cv2.remap drops the axis) but
+    (H, W, 1) when there was nothing to align: it is (H, W, 1) both ways, the same values as
+    the (H, W) image's."""
+    from stereovision.rectification_check import RectificationCheck, align_rows
+
+    h, w = 60, 81
+    ramp = np.repeat(np.arange(h, dtype=np.uint8)[:, None], w, axis=1)
+    check = RectificationCheck(60, 1.0, 2.0, 1.5, 200.0, 0.0, False, 0.5)
+    flat, _ = align_rows(ramp, ramp, check=check)
+    out, _ = align_rows(ramp, ramp[:, :, None], check=check)
+    assert out.shape == (h, w, 1) and out.dtype == np.uint8
+    np.testing.assert_array_equal(out[:, :, 0], flat)
+    assert not np.array_equal(flat, ramp)  # it was moved
+    nan = float("nan")
+    none = RectificationCheck(0, nan, nan, nan, nan, nan, None, 0.5)
+    assert align_rows(ramp, ramp[:, :, None], check=none)[0].shape == (h, w, 1)
+
+
 def test_refine_turns_the_right_camera_in_its_own_rectified_frame() -> None:
     """A toed-in rig (right camera turned 4 degrees about y): rows 1 px apart everywhere are a
     pitch about the rectified right camera's x axis (R2's frame), not about the left one's

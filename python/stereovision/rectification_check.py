@@ -589,4 +589,5 @@ def align_rows(
     out = remap_image(
         ra, xx, (yy - dy).astype(np.float32), cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
     )
-    return out, res
+    # cv2.remap drops the channel axis of an (H, W, 1) image: given back in the right's shape
+    return out.reshape(ra.shape), res
