@@ -673,3 +673,31 @@ def test_interest_thresholds_of_another_type_are_named(value: object) -> None:
     for name in ("rel_threshold", "floor_rel"):
         with pytest.raises(ValueError, match=rf"^{name} must lie in \[0, 1\], got "):
             hp.interest_points(img, **{name: value})
+
+
+@pytest.mark.parametrize(
+    ("name", "extra"),
+    [("nms_half", {}), ("edge_tol", {}), ("dy_window", {"candidates": "points"})],
+)
+def test_a_window_past_the_image_is_the_whole_image_up_to_2_64(
+    name: str, extra: dict[str, object]
+) -> None:
+    """The kernel added these sizes to a coordinate, which wrapped for 2**64 - 1 (accepted) to a
+    window ending before the point: on a cones crop nms_half kept 374 interest points (160
+    matches) where a window over the crop keeps one, edge_tol gave 0 matches instead of 372 and
+    dy_window (points mode) 0 instead of 134."""
+    left, right, sc = _grey("middlebury2003/cones")
+    lc, rc = (
+        np.ascontiguousarray(left[100:200, 100:300]),
+        np.ascontiguousarray(right[100:200, 100:300]),
+    )
+    want, got = (
+        hp.hopfield_match(lc, rc, max_disparity=sc.max_disparity, **{name: v}, **extra)
+        for v in (1000, 2**64 - 1)
+    )
+    np.testing.assert_array_equal(got.to_array(), want.to_array())
+    assert got.stats == want.stats
+    if name == "nms_half":
+        assert want.stats["n_points"] == 1
+    else:
+        assert len(want) > 20

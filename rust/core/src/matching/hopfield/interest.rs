@@ -279,9 +279,11 @@ pub fn select_points(
     let floor = max * p.floor_rel;
     let r = p.nms_half;
     // Is `v` (at x, y) above its later and strictly above its earlier neighbours?
+    // Saturating: `x + r` of a window wider than any image (nms_half up to usize::MAX) wrapped
+    // to a window ending before the point.
     let is_peak = |x: usize, y: usize, v: f32| -> bool {
-        let (x0, x1) = (x.saturating_sub(r), (x + r).min(w - 1));
-        for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+        let (x0, x1) = (x.saturating_sub(r), x.saturating_add(r).min(w - 1));
+        for yy in y.saturating_sub(r)..=y.saturating_add(r).min(h - 1) {
             let nrow = &m[yy * w..(yy + 1) * w];
             for (xx, &n) in nrow.iter().enumerate().take(x1 + 1).skip(x0) {
                 let earlier = yy < y || (yy == y && xx < x);

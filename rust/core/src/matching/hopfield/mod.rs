@@ -381,7 +381,9 @@ fn point_candidates(
         CandidateMode::Row => (y, y),
         CandidateMode::Points => (
             y.saturating_sub(p.dy_window).max(SIM_RADIUS),
-            (y + p.dy_window).min(h.saturating_sub(SIM_RADIUS + 1)),
+            // Saturating, as `hi` below: a band past the image (up to usize::MAX) wrapped.
+            y.saturating_add(p.dy_window)
+                .min(h.saturating_sub(SIM_RADIUS + 1)),
         ),
     };
     for yr in lo_row..=hi_row {
@@ -418,7 +420,8 @@ fn point_candidates(
             // surface prefers that surface's disparity by far more, while a periodic
             // texture's equal peaks (laundry's basket) stay acceptable.
             let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
-            let hi = (d + p.edge_tol).min(d_hi);
+            // Saturating: a tolerance past the range (up to usize::MAX) wrapped to d - 1.
+            let hi = d.saturating_add(p.edge_tol).min(d_hi);
             let halves_fail = halves.iter().enumerate().fold(0u8, |acc, (k, best)| {
                 let ok = best
                     .is_some_and(|best| max_of(&cv.curve[k + 1][lo..=hi]) >= best - p.edge_margin);
@@ -494,7 +497,11 @@ fn candidates(
             |(sc, stats), &(i0, i1)| {
                 let y_lo = pts[i0].y as usize;
                 let y_hi = pts[i1 - 1].y as usize + 1;
-                stats.fill_band(right, y_lo.saturating_sub(reach), y_hi + reach)?;
+                stats.fill_band(
+                    right,
+                    y_lo.saturating_sub(reach),
+                    y_hi.saturating_add(reach),
+                )?;
                 let mut out = Vec::new();
                 try_reserve_len(&mut out, 2 * (i1 - i0), CANDIDATES)?;
                 for (i, pt) in pts.iter().enumerate().take(i1).skip(i0) {

@@ -1310,3 +1310,64 @@ fn right_rows_too_large_to_allocate_are_an_error() {
                 32.00 MiB (33554432 bytes)";
     assert!(stdout.contains(want), "{want} not in {stdout}");
 }
+
+/// A window past every pixel is the whole image, up to `usize::MAX`: the NMS, the half-window
+/// tolerance and the points mode's band added their size to a coordinate (`x + nms_half`,
+/// `d + edge_tol`, `y + dy_window`), which wrapped (a panic in a debug build) to a window
+/// ending before the point itself: 412 interest points instead of 1 on a teddy crop, and no
+/// match at all for `edge_tol` or `dy_window` = 2^64 - 1, values the binding accepts.
+#[test]
+fn windows_wider_than_the_image_cover_it_up_to_usize_max() {
+    let (l, r) = shifted_pair(120, 90, 7);
+    let pts = |nms_half: usize| {
+        let p = InterestParams {
+            nms_half,
+            ..InterestParams::default()
+        };
+        interest_points(&l, &p).unwrap()
+    };
+    // One window over the image keeps its largest M only (earlier ties are suppressed).
+    let whole = pts(10_000);
+    assert_eq!(whole.len(), 1);
+    assert_eq!(pts(usize::MAX), whole);
+    assert_eq!(pts(usize::MAX / 2 + 1), whole);
+    for (mode, wide) in [
+        // Half-window tolerance past the disparity range: only the halves' textures decide.
+        (
+            CandidateMode::Row,
+            HopfieldParams {
+                edge_tol: 10_000,
+                ..params(16)
+            },
+        ),
+        // Points mode's band over every row.
+        (
+            CandidateMode::Points,
+            HopfieldParams {
+                candidates: CandidateMode::Points,
+                dy_window: 10_000,
+                ..params(16)
+            },
+        ),
+    ] {
+        let huge = HopfieldParams {
+            edge_tol: if wide.edge_tol > 1 { usize::MAX } else { 1 },
+            dy_window: if wide.dy_window > 2 { usize::MAX } else { 2 },
+            ..wide.clone()
+        };
+        let (_, want) = candidate_neurons(&l, &r, &wide).unwrap();
+        assert!(want.len() > 100, "{mode:?}: {} neurons", want.len());
+        let (_, got) = candidate_neurons(&l, &r, &huge).unwrap();
+        assert_eq!(got, want, "{mode:?}");
+        let (a, b) = (
+            hopfield_match(&l, &r, &wide).unwrap(),
+            hopfield_match(&l, &r, &huge).unwrap(),
+        );
+        assert!(
+            a.matches.len() > 100,
+            "{mode:?}: {} matches",
+            a.matches.len()
+        );
+        assert_eq!(a.matches, b.matches, "{mode:?}");
+    }
+}
