@@ -147,6 +147,34 @@ def test_lr_check_matches_reference() -> None:
     assert 0.2 < ours.mean() < 0.95
 
 
+def test_the_reference_rounds_half_pixel_shifts_as_the_kernel() -> None:
+    """On a map of half-integer disparities: the Newton step reads the right stability at
+    round(x - d) with ties to even and the left-right check rounds x - d half away from zero;
+    the reference rounded both half up (floor(s + 0.5)), so its confidence differed by up to
+    0.99 at 12 % of the pixels (the update by up to 4 px) and its mask passed pixels matched
+    half a pixel left of the row."""
+    left, right = _grey("middlebury2001/tsukuba", (slice(100, 160), slice(100, 220)))
+    chans = [ref.channel(0.25, t) for t in ref.ORIENTATIONS]
+    lv, rv = ref.level_data(left, chans), ref.level_data(right, chans)
+    thr2 = ref.thresholds2(lv, rv, 0.02)
+    for d in (-1.5, 0.5, 2.5, 3.5):
+        disp = np.full(left.shape, d, np.float32)
+        d_ours, c_ours = _core.gabor_newton_step(left, right, disp)
+        d_ref, c_ref = ref.newton_step(lv, rv, chans, thr2, disp.astype(np.float64))
+        assert c_ours.max() > 0.5, d
+        assert np.abs(c_ours - c_ref).max() <= STEP_ATOL_CONF, d
+        assert np.abs(d_ours - d_ref).max() <= STEP_ATOL_PX, d
+    # The mask with any tolerance is "x - d rounds into the row": x - d of 7.5 (the last
+    # pixel, 8), -0.5 (-1), 8.5 (9, past the row's end) and -0.4 (-0, the first pixel).
+    dl = np.array([[-7.5, 1.5, -6.5, -5.5, 4.5, -3.0, 6.0, 7.4, 8.5]], np.float32)
+    dr = np.zeros_like(dl)
+    want = [True, False, False, False, False, True, True, True, False]
+    np.testing.assert_array_equal(_core.gabor_lr_check(dl, dr, np.inf)[0], want)
+    np.testing.assert_array_equal(
+        ref.lr_check(dl.astype(np.float64), dr.astype(np.float64), np.inf)[0], want
+    )
+
+
 def test_one_level_pipeline_matches_reference() -> None:
     crop = (slice(60, 180), slice(40, 240))
     left, right = _grey("middlebury2001/tsukuba", crop)

@@ -195,7 +195,8 @@ def shifted(
     yy = np.arange(h)[:, None]
     carrier = np.exp(1j * (ch.kx * sc + ch.ky * yy))
     y = carrier * b - ch.dc * low
-    near = np.minimum(np.floor(sc + 0.5).astype(int), w - 1)
+    # The kernel's rounding: ties to even (fastmath round_fast), not half up.
+    near = np.minimum(np.rint(sc).astype(int), w - 1)
     return y, f, valid, near
 
 
@@ -232,7 +233,9 @@ def lr_check(dl: np.ndarray, dr: np.ndarray, tol: float = 1.0) -> np.ndarray:
     h, w = dl.shape
     x = np.arange(w)[None, :]
     with np.errstate(invalid="ignore"):
-        xr = np.floor(x - dl + 0.5)
+        # The kernel's rounding (f32::round): ties away from zero, so -0.5 is -1, outside.
+        s = x - dl
+        xr = np.sign(s) * np.floor(np.abs(s) + 0.5)
         inside = np.isfinite(dl) & (xr >= 0) & (xr <= w - 1)
     xi = np.where(inside, xr, 0).astype(int)
     other = dr[np.arange(h)[:, None], xi]
