@@ -701,3 +701,25 @@ def test_a_window_past_the_image_is_the_whole_image_up_to_2_64(
         assert want.stats["n_points"] == 1
     else:
         assert len(want) > 20
+
+
+@pytest.mark.parametrize("s_min", [0.0, -1.0])
+def test_textureless_right_windows_are_no_candidates_at_any_s_min(s_min: float) -> None:
+    """An undefined ZNCC (a textureless window) reads 0: with s_min <= 0 (accepted) a flat right
+    image gave every left point a candidate of score 0 and, with the edge test off, a match of
+    score 0. Defined similarities still pass, as in the reference."""
+    left = _texture(60, 120, 0.0, seed=4)
+    kw: dict[str, object] = {"s_min": s_min, "s_init": 0.0, "edge_test": False}
+    flat = np.full_like(left, 0.5)
+    assert len(hp.hopfield_candidates(left, flat, max_disparity=16, **kw)) == 0
+    assert len(hp.best_match(left, flat, max_disparity=16, **kw)) == 0
+    assert len(hp.hopfield_match(left, flat, max_disparity=16, **kw)) == 0
+    # Flat over columns 40..70: right windows centred in 43..66 lie inside it.
+    right = _texture(60, 120, 3.0, seed=4)
+    right[:, 40:70] = 0.5
+    cand = hp.hopfield_candidates(left, right, max_disparity=16, **kw)
+    want = ref.candidates(left, right, 0, 16, {**ref.DEFAULTS, **kw})
+    assert len(cand) > 100
+    assert not np.any((cand[:, 3] >= 43) & (cand[:, 3] <= 66))
+    ours = {(int(c[0]), int(c[3])) for c in cand}
+    assert ours == {(n["point"], n["xr"]) for n in want}

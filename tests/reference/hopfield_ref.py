@@ -165,6 +165,12 @@ def _parabola(a: float, b: float, c: float) -> float:
     return float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
 
 
+def _textured(img: np.ndarray, x: int, y: int) -> bool:
+    """The 7x7 window centred at ``(x, y)`` is textured: ZNCC with it is defined."""
+    win = img[y - 3 : y + 4, x - 3 : x + 4].astype(np.float64)
+    return float(((win - win.mean()) ** 2).sum()) >= win.size * MIN_WINDOW_STD**2
+
+
 def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: dict) -> list[dict]:
     """Row-mode candidate neurons, grouped by point, best ZNCC first."""
     xy, _ = interest_points(left, p["rel_threshold"], p["nms_half"], p["tile"], p["floor_rel"])
@@ -182,7 +188,9 @@ def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: d
             c = full[d]
             ok_lo = d == d_min or c >= full[d - 1]
             ok_hi = d == d_hi or c > full[d + 1]
-            if c >= p["s_min"] and ok_lo and ok_hi:
+            # an undefined ZNCC (a textureless window) reads 0 but is no candidate at any s_min
+            defined = _textured(left, x, y) and _textured(right, x - d, y)
+            if c >= p["s_min"] and ok_lo and ok_hi and defined:
                 lo, hi = max(d - p["edge_tol"], d_min), min(d + p["edge_tol"], d_hi)
                 halves_fail = sum(
                     (0 if b is not None and c[lo : hi + 1].max() >= c[b] - p["edge_margin"] else 1)

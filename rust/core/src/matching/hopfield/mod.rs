@@ -415,6 +415,11 @@ fn point_candidates(
         }
         for &d in &sc.ds {
             let xr = x - d;
+            // An undefined ZNCC reads 0: with s_min <= 0 it passed as a candidate (a flat right
+            // image gave every point a "match" of score 0). Never one at s_min > 0.
+            if !cv.left_defined || !stats.defined(xr, yr) {
+                continue;
+            }
             // Each half-window must find this disparity (within edge_tol px) as good as
             // its best anywhere in the range, up to edge_margin: a half lying on another
             // surface prefers that surface's disparity by far more, while a periodic

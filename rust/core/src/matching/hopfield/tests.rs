@@ -1371,3 +1371,41 @@ fn windows_wider_than_the_image_cover_it_up_to_usize_max() {
         assert_eq!(a.matches, b.matches, "{mode:?}");
     }
 }
+
+/// An undefined ZNCC (a textureless window, read as 0) is no candidate at any `s_min`: with
+/// `s_min <= 0` (accepted) a flat right image gave every left point a candidate of score 0,
+/// and `best_match` a "match" for each with the edge test off.
+#[test]
+fn textureless_right_windows_are_no_candidates_at_any_s_min() {
+    let (l, r) = shifted_pair(120, 60, 3);
+    let flat = Image::new(120, 60, vec![0.5; 120 * 60]).unwrap();
+    // The right image flat over columns 40..70: windows centred in 43..67 lie inside it.
+    let mut band = r.clone();
+    for row in band.data.chunks_mut(120) {
+        row[40..70].fill(0.5);
+    }
+    for s_min in [0.0, -1.0] {
+        let p = HopfieldParams {
+            s_min,
+            s_init: 0.0,
+            edge_test: false,
+            ..params(16)
+        };
+        let (pts, ns) = candidate_neurons(&l, &flat, &p).unwrap();
+        assert!(pts.len() > 50, "{} points", pts.len());
+        assert!(ns.is_empty(), "s_min {s_min}: {} candidates", ns.len());
+        assert!(best_match(&l, &flat, &p).unwrap().matches.is_empty());
+        assert!(hopfield_match(&l, &flat, &p).unwrap().matches.is_empty());
+        let (_, ns) = candidate_neurons(&l, &band, &p).unwrap();
+        assert!(ns.len() > 100, "s_min {s_min}: {} candidates", ns.len());
+        assert!(
+            ns.iter().all(|n| !(43..=66).contains(&n.xr)),
+            "s_min {s_min}"
+        );
+        // Defined negative similarities still pass a negative s_min.
+        assert!(
+            s_min >= 0.0 || ns.iter().any(|n| n.sim < 0.0),
+            "s_min {s_min}"
+        );
+    }
+}

@@ -340,6 +340,11 @@ impl RightStats {
         &self.buf[o..o + self.stride]
     }
 
+    /// The right 7x7 window centred at `(x, y)` is textured: ZNCC with it is defined.
+    pub fn defined(&self, x: usize, y: usize) -> bool {
+        self.inv_norms(FULL, y)[x] > 0.0
+    }
+
     /// Mean of the right 7x7 window centred at `(x, y)` (0 where it does not fit).
     pub fn mean(&self, x: usize, y: usize) -> f32 {
         self.sums(FULL, y)[x] / region_n(FULL) as f32
@@ -427,6 +432,8 @@ pub struct Curves {
     pub curve: [Vec<f32>; N_REGIONS],
     /// Mean of the left 7x7 window.
     pub left_mean: f32,
+    /// The left 7x7 window is textured (its full-window ZNCC is defined).
+    pub left_defined: bool,
 }
 
 /// ZNCC curves of the five regions around left `(x, y)` against right `(x - d, yr)`,
@@ -470,6 +477,7 @@ fn curves_with(
     });
     let (t, norm, mean) = template(&win);
     out.left_mean = mean;
+    out.left_defined = norm.inv_l[FULL] > 0.0;
     // Right rows yr-3..=yr+3 from column x0 = x - d_hi - 3: block b reads columns
     // x0 + 8 b ..= x0 + 8 b + 14 of each. Read in place (the lanes past `len` read the next
     // pixels of the row, or of the next one, and are never stored) unless the last block would
