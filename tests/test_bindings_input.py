@@ -379,6 +379,17 @@ try:
                 _core.gabor_remove_speckles(d, 10, 1.0)
         except ValueError as e:
             print("ValueError:", e)
+    elif case in ("segments_too_wide", "segments_too_large", "segments_too_deep"):
+        shape = {{
+            "segments_too_wide": (1, 2**40, 3),
+            "segments_too_large": (2**16, 2**16, 3),
+            "segments_too_deep": (1, 1, 2**40),
+        }}[case]
+        img = np.lib.stride_tricks.as_strided(np.zeros(1, np.float32), shape, (0, 0, 0))
+        try:
+            _core.graph_segments(img, 1.0, 5)
+        except ValueError as e:
+            print("ValueError:", e)
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -393,7 +404,9 @@ except MemoryError as e:
 """
 
 
-def _under_address_limit(case: str, limit: int) -> subprocess.CompletedProcess[str]:
+def _under_address_limit(
+    case: str, limit: int, timeout: float = 300
+) -> subprocess.CompletedProcess[str]:
     def limit_address_space() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
@@ -402,7 +415,7 @@ def _under_address_limit(case: str, limit: int) -> subprocess.CompletedProcess[s
         [sys.executable, "-c", _OOM_SCRIPT.format(case=case)],
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=timeout,
         env=env,
         preexec_fn=limit_address_space,
     )
@@ -458,6 +471,36 @@ def test_in_place_kernels_refuse_2_to_the_32_pixels_before_copying(case: str) ->
         "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
     assert want in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        (
+            "segments_too_wide",
+            "ValueError: image: image of 1099511627776x1 pixels is too large: the kernels index "
+            "pixels with 32-bit integers (at most 2147483648 pixels, 2147483647 per side)",
+        ),
+        (
+            "segments_too_large",
+            "ValueError: image: image of 65536x65536 pixels is too large: the kernels index "
+            "pixels with 32-bit integers (at most 2147483648 pixels, 2147483647 per side)",
+        ),
+        (
+            "segments_too_deep",
+            "MemoryError: out of memory: a copy of image needs 4096.00 GiB (4398046511104 bytes)",
+        ),
+    ],
+)
+def test_graph_segments_refuses_a_huge_image_before_reading_it(case: str, message: str) -> None:
+    """``graph_segments`` looked for NaN over the whole view, with the GIL held, before any
+    size check or copy: a broadcast (1, 2**40, 3) image kept the process reading 3.3e12 values,
+    deaf to Ctrl-C (this test's 60 s ran out), and (65536, 65536, 3) read 1.3e10 first. The
+    shape is refused now as the kernel would, and too many channels fail the copy at once."""
+    out = _under_address_limit(case, 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    assert message in out.stdout, out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

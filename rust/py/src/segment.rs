@@ -31,11 +31,20 @@ pub fn graph_segments<'py>(
             "image: expected (H, W, C) with no zero size, got ({h}, {w}, {c})"
         )));
     }
-    if a.iter().any(|v| !v.is_finite()) {
-        return Err(PyValueError::new_err("image: contains NaN or inf"));
-    }
+    // Refused from the shape, then copied (a MemoryError for a huge one), then scanned: the
+    // scan came first, over the view with the GIL held: a broadcast (1, 2**40, 3) image kept
+    // the process reading 3.3e12 values, deaf to Ctrl-C, before the kernel's size check.
+    stereovision_core::image::check_index_range_within(
+        w,
+        h,
+        stereovision_core::segment::GRAPH_MAX_PIXELS,
+    )
+    .map_err(|e| PyValueError::new_err(format!("image: {e}")))?;
     let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
+        if img.iter().any(|v| !v.is_finite()) {
+            return Err(PyValueError::new_err("image: contains NaN or inf"));
+        }
         guard("graph_segments", || {
             core_segments(&img, w, h, c, k, min_size)
         })
