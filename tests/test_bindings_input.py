@@ -390,6 +390,22 @@ try:
             _core.graph_segments(img, 1.0, 5)
         except ValueError as e:
             print("ValueError:", e)
+    elif case == "u8_too_deep":
+        deep = np.broadcast_to(np.uint8(5), (1, 1, 2**32))
+        mean = np.broadcast_to(np.float32(1.0), deep.shape)
+        # updated in place: writeable, one float32 seen 2**32 times
+        store = np.lib.stride_tricks.as_strided(np.zeros(1, np.float32), deep.shape, (0, 0, 0))
+        grid = (np.ones((1, 1), np.uint8), np.zeros((1, 1), np.float32))
+        for call in (
+            lambda: _core.gray_u8(deep, (0.1, 0.6, 0.3)),
+            lambda: _core.hopfield_match_u8(deep, deep, (0.1, 0.6, 0.3), {{}}),
+            lambda: _core.temporal_grey_difference(deep, mean),
+            lambda: _core.temporal_running_mean(deep, store, *grid, 2.0, 8),
+        ):
+            try:
+                call()
+            except (ValueError, MemoryError) as e:
+                print(f"{{type(e).__name__}}: {{e}}")
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -471,6 +487,37 @@ def test_in_place_kernels_refuse_2_to_the_32_pixels_before_copying(case: str) ->
         "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
     assert want in out.stdout, out.stdout
+
+
+@pytest.mark.parametrize("channels", [2, 5])
+def test_8_bit_images_of_other_channel_counts_name_the_image(channels: int) -> None:
+    """The 8-bit kernels read 1, 3 or 4 channels; another count was "invalid parameter
+    `channels`", a parameter none of them has: the error names the array now."""
+    img = np.zeros((6, 8, channels), np.uint8)
+    mean = img.astype(np.float32)
+    grid = (np.ones((6, 8), np.uint8), np.zeros((6, 8), np.float32))
+    says = f"expected 1, 3 or 4 channels, got {channels} (shape [6, 8, {channels}])"
+    for name, call in [
+        ("image", lambda: _core.gray_u8(img, LUMA_WEIGHTS_BGR)),
+        ("left", lambda: _core.hopfield_match_u8(img, img, LUMA_WEIGHTS_BGR, {})),
+        ("frame", lambda: _core.temporal_grey_difference(img, mean)),
+        ("frame", lambda: _core.temporal_running_mean(img, mean.copy(), *grid, 2.0, 8)),
+    ]:
+        with pytest.raises(ValueError, match=re.escape(f"{name}: {says}")):
+            call()
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_8_bit_images_of_too_many_channels_are_refused_before_copying() -> None:
+    """``gray_u8``, ``hopfield_match_u8`` and the temporal kernels copied a broadcast
+    (1, 1, 2**32) image (4 GiB: a MemoryError under ``ulimit -v``, the memory taken without
+    one) before the kernel refused its channel count."""
+    out = _under_address_limit("u8_too_deep", 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    says = "expected 1, 3 or 4 channels, got 4294967296 (shape [1, 1, 4294967296])"
+    assert out.stdout.splitlines() == [
+        f"ValueError: {name}: {says}" for name in ("image", "left", "frame", "frame")
+    ], out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

@@ -245,10 +245,10 @@ pub fn map_and_confidence<'a>(
     Ok((values(disp, "disparity")?, values(conf, "confidence")?))
 }
 
-/// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)`, its values in
-/// row-major order: its own buffer when C-contiguous, else a copy (a strided, reversed or
-/// Fortran-ordered view, e.g. one channel of a colour image, was refused with "must be
-/// C-contiguous").
+/// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)` (C 1, 3 or 4),
+/// its values in row-major order: its own buffer when C-contiguous, else a copy (a strided,
+/// reversed or Fortran-ordered view, e.g. one channel of a colour image, was refused with
+/// "must be C-contiguous").
 pub fn u8_layout<'a>(
     a: &'a numpy::PyReadonlyArrayDyn<'_, u8>,
     what: &str,
@@ -263,6 +263,14 @@ pub fn u8_layout<'a>(
             )))
         }
     };
+    // Every kernel taking 8-bit images reads 1, 3 or 4 channels: said before the copy, which
+    // came first (4 GiB for a broadcast (1, 1, 2**32) image, a MemoryError under a memory
+    // limit), and naming the array ("invalid parameter `channels`" named no argument).
+    if !matches!(c, 1 | 3 | 4) {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected 1, 3 or 4 channels, got {c} (shape {shape:?})"
+        )));
+    }
     Ok((h, w, c, row_major(a, what)?))
 }
 
