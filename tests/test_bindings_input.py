@@ -359,11 +359,15 @@ try:
     elif case in ("mcgm_filter_nan", "mcgm_filter_outside"):
         a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
         row = [np.nan, 20, 26, 20] if case.endswith("nan") else [100, 20, 96, 20]
-        m = np.broadcast_to(np.array(row, np.float32), (2**29, 4))
+        m = np.broadcast_to(np.array(row, np.float32), (2**25, 4))
         try:
             _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
         except ValueError as e:
             print("ValueError:", e)
+    elif case == "mcgm_filter_huge":
+        a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
+        m = np.broadcast_to(np.array([30, 20, 26, 20], np.float32), (2**40, 4))
+        _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
     elif case == "interest_too_wide":
         try:
             _core.hopfield_interest(np.broadcast_to(np.float32(0.5), (1, 2**31 + 1)))
@@ -582,11 +586,25 @@ def test_mcgm_log_refuses_before_copying_the_image(case: str, message: str) -> N
 def test_mcgm_filter_counts_bad_rows_without_listing_them(case: str, message: str) -> None:
     """``mcgm_filter``'s row check collected the indices of every bad row (8 bytes a row) with
     an unchecked ``collect``: 2**29 broadcast bad rows aborted the process (SIGABRT) under
-    ``ulimit -v`` instead of refusing them with the count."""
+    ``ulimit -v`` instead of refusing them with the count. The matches' copy (24 bytes a row)
+    is reserved before the check now, so 2**29 rows are its MemoryError there; 2**25 fit and
+    are refused with the count."""
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
-    n = 2**29
+    n = 2**25
     assert f"ValueError: matches: {n} of {n} {message}" in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_mcgm_filter_refuses_huge_matches_before_reading_them() -> None:
+    """``mcgm_filter`` checked every row of ``matches`` (finite, inside the images) with the
+    GIL held before reserving their copy: (2**40, 4) broadcast rows kept the process reading
+    4.4e12 values, deaf to Ctrl-C (this test's 60 s ran out). The copy that cannot be made is
+    said at once now."""
+    out = _under_address_limit("mcgm_filter_huge", 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    want = "MemoryError: out of memory: a copy of matches needs 24576.00 GiB (26388279066624 bytes)"
+    assert want in out.stdout, out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

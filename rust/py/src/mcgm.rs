@@ -396,11 +396,13 @@ pub fn mcgm_filter<'py>(
             view.shape()
         )));
     }
-    check_match_rows(&view, l.width, l.height)?;
-    // Reserved first: an unchecked collect of a huge (broadcast) `matches` aborted the process.
+    // Reserved first: an unchecked collect of a huge (broadcast) `matches` aborted the process,
+    // and the row check before it read every row with the GIL held: (2**40, 4) broadcast rows
+    // kept the process reading 4.4e12 values, deaf to Ctrl-C, before the copy's MemoryError.
     let mut ms: Vec<Match> = Vec::new();
     ms.try_reserve_exact(view.nrows())
         .map_err(|_| crate::errors::copy_oom::<Match>(view.nrows(), "matches"))?;
+    check_match_rows(&view, l.width, l.height)?;
     ms.extend(view.rows().into_iter().map(|row| Match {
         xl: row[0],
         yl: row[1],
