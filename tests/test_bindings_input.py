@@ -868,6 +868,30 @@ def test_graph_segments_refuses_an_image_with_a_zero_size(shape: tuple[int, int,
         _core.graph_segments(np.zeros(shape, np.float32), 1.0, 2)
 
 
+def test_a_map_or_confidence_of_another_shape_names_the_argument() -> None:
+    """``depth_rectified`` and ``refine_disparity`` said "confidence shape (1, 8) differs from
+    the expected shape (6, 8)" of their argument ``conf`` (and "disparity" of ``disp``), the
+    expected shape from an argument they did not name, and copied a strided ``disp`` before
+    checking ``conf``."""
+    g = np.random.default_rng(0).random((6, 8), dtype=np.float32)
+    d, c = np.full_like(g, 2.0), np.full_like(g, 0.5)
+    sigma = (50.0, 2.0, 0.74, -0.52, 0.2, 0.9)
+    with pytest.raises(
+        ValueError, match=re.escape("conf: expected shape (6, 8) like disp, got (1, 8)")
+    ):
+        _core.depth_rectified(d, c[:1], *sigma)
+    with pytest.raises(
+        ValueError, match=re.escape("disp: expected shape (6, 8) like left, got (6, 7)")
+    ):
+        _core.refine_disparity(g, g, d[:, :7], c, *REFINE_ARGS)
+    with pytest.raises(
+        ValueError, match=re.escape("conf: expected shape (6, 8) like left, got (8, 6)")
+    ):
+        _core.refine_disparity(g, g, d, c.T.copy(), *REFINE_ARGS)
+    z, _ = _core.depth_rectified(d, c, *sigma)
+    np.testing.assert_array_equal(z, np.full_like(g, 12.5))  # 50 / (2 + 2)
+
+
 @pytest.mark.parametrize("right_shape", [(6, 8), (6, 10), (5, 9)])
 def test_lr_check_maps_must_have_one_shape(right_shape: tuple[int, int]) -> None:
     """A right map of another width was unasserted: a mutation audit comparing the heights

@@ -223,26 +223,28 @@ pub fn vec_to_numpy<'py, T: numpy::Element>(
 /// Row-major values: an array's own buffer, or a copy.
 pub type RowMajor<'a, T> = Cow<'a, [T]>;
 
-/// The values of a disparity map and its confidence in row-major order, both checked to be
-/// `(h, w)`: their own buffers when C-contiguous (the Python wrappers make them so), else
-/// copies (a strided, reversed or Fortran-ordered view was refused with "must be
-/// C-contiguous"); the error names the array.
+/// The values of the arguments `disp` and `conf` in row-major order, both checked to be
+/// `(h, w)`, the shape of the argument `like`, before either is copied: their own buffers when
+/// C-contiguous (the Python wrappers make them so), else copies (a strided, reversed or
+/// Fortran-ordered view was refused with "must be C-contiguous"). The error names the
+/// argument: it said "confidence shape ... differs from the expected shape", of an argument
+/// called `conf`, and the shape expected came from nowhere it named.
 pub fn map_and_confidence<'a>(
     disp: &'a PyReadonlyArray2<'_, f32>,
     conf: &'a PyReadonlyArray2<'_, f32>,
     (h, w): (usize, usize),
+    like: &str,
 ) -> PyResult<(RowMajor<'a, f32>, RowMajor<'a, f32>)> {
-    let values = |a: &'a PyReadonlyArray2<'_, f32>, name: &str| -> PyResult<Cow<'a, [f32]>> {
+    for (a, name) in [(disp, "disp"), (conf, "conf")] {
         if a.as_array().dim() != (h, w) {
             return Err(PyValueError::new_err(format!(
-                "{name} shape {:?} differs from the expected shape {:?}",
-                a.as_array().dim(),
-                (h, w)
+                "{name}: expected shape {:?} like {like}, got {:?}",
+                (h, w),
+                a.as_array().dim()
             )));
         }
-        row_major(a, name)
-    };
-    Ok((values(disp, "disparity")?, values(conf, "confidence")?))
+    }
+    Ok((row_major(disp, "disp")?, row_major(conf, "conf")?))
 }
 
 /// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)` (C 1, 3 or 4),

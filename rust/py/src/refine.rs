@@ -43,7 +43,7 @@ pub fn refine_disparity<'py>(
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
     let (w, h) = (l.view().width, l.view().height);
-    let (d, c) = map_and_confidence(&disp, &conf, (h, w))?;
+    let (d, c) = map_and_confidence(&disp, &conf, (h, w), "left")?;
     let p = RefineParams {
         base_sigma,
         win_sigma,

@@ -32,7 +32,7 @@ pub fn depth_rectified<'py>(
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let conf: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(conf, "conf")?;
     let (h, w) = disp.as_array().dim();
-    let (d, c) = map_and_confidence(&disp, &conf, (h, w))?;
+    let (d, c) = map_and_confidence(&disp, &conf, (h, w), "disp")?;
     let m = SigmaModel {
         s0,
         slope,
