@@ -161,6 +161,57 @@ def test_gui_stopped_by_ctrl_c_exits_130_as_the_cli(
     assert (proc.returncode, out, err) == (status, "", f"stereovision: {said}\n")
 
 
+_CALLER_OF_THE_GUI = """
+import os, signal, sys
+import stereovision.gui as gui
+
+heard = []
+def mine(signum, _frame):
+    heard.append(signum)
+signal.signal(signal.SIGINT, mine)
+signal.signal(signal.SIGTERM, mine)
+status = gui.main(["--no-browser", "--port", "0"])
+back = [signal.getsignal(s) is mine for s in (signal.SIGINT, signal.SIGTERM)]
+fd = signal.set_wakeup_fd(-1)
+os.kill(os.getpid(), signal.SIGINT)
+os.kill(os.getpid(), signal.SIGTERM)
+print(status, back, fd, heard, flush=True)
+"""
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_program_calling_the_gui_gets_its_signal_handlers_back(signum: int) -> None:
+    """The server's loop took SIGINT and SIGTERM (a no-op handler and a wakeup fd into its
+    pipe) and kept them once it had stopped: a program that ran ``gui.main`` and went on had
+    its own handlers replaced, every later Ctrl+C ignored. They are put back, the wakeup fd
+    too."""
+    import threading
+
+    pytest.importorskip("trame")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _CALLER_OF_THE_GUI],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
+    watchdog.start()
+    try:
+        line = proc.stdout.readline()  # the server listens: its signal handlers are set
+        watchdog.cancel()
+        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
+        proc.send_signal(signum)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        watchdog.cancel()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=30)
+    status = 130 if signum == signal.SIGINT else 143
+    # the signal stopped the GUI; the caller's handlers then heard the two sent after it
+    assert (proc.returncode, out) == (0, f"{status} [True, True] -1 [2, 15]\n"), err
+
+
 def test_gui_on_a_busy_port_says_so_in_one_line():
     """A busy port: the address was announced first, then
     ``[Errno 98] error while attempting to bind on address ...``. Now nothing is announced and

@@ -19,6 +19,7 @@ import errno
 import logging
 import signal
 import sys
+import threading
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
@@ -207,6 +208,10 @@ def cmd_gui(args: argparse.Namespace) -> int:
             )
 
     stopped_by: list[int] = []
+    loops: list[asyncio.AbstractEventLoop] = []
+    # the caller's handlers: the loop's (aiohttp's, then ours) were left in place once the
+    # server stopped, so a program calling this had its Ctrl+C ignored from then on
+    kept = _signal_state()
 
     def stop_on(signum: int) -> None:
         stopped_by.append(signum)
@@ -219,6 +224,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
             loop = asyncio.get_running_loop()  # RuntimeError: none (not served by a loop)
             for signum in (signal.SIGINT, signal.SIGTERM):
                 loop.add_signal_handler(signum, stop_on, signum)
+            loops.append(loop)
 
     app.ctrl.on_server_ready.add(hear_signals)  # before the address is said: Ctrl+C heard
     app.ctrl.on_server_ready.add(announce)  # after the bind: the real port, and only if it bound
@@ -253,7 +259,39 @@ def cmd_gui(args: argparse.Namespace) -> int:
         app.stop_work()  # the computation under way is not waited for (a Save is)
         if app.source is not None:
             app.source.close()
+        # last: until the Save is whole and the camera closed, a second signal stays the loop's
+        _restore_signals(kept, loops)
     return 0
+
+
+def _signal_state() -> tuple[dict[int, Any], int] | None:
+    """The SIGINT and SIGTERM handlers and the wakeup fd as they are, to be put back by
+    :func:`_restore_signals`; None outside the main thread (signals cannot be set there)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    fd = signal.set_wakeup_fd(-1)  # read by setting: there is no getter
+    signal.set_wakeup_fd(fd)
+    return {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}, fd
+
+
+def _restore_signals(
+    kept: tuple[dict[int, Any], int] | None, loops: Sequence[asyncio.AbstractEventLoop]
+) -> None:
+    """Put back the handlers :func:`_signal_state` kept: the server's loop took SIGINT and
+    SIGTERM (its no-op handler, a wakeup fd into its pipe) and kept them after it stopped."""
+    if kept is None:
+        return
+    for loop in loops:
+        # taken from the loop too: closing it later (its collection) set Python's defaults
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            with contextlib.suppress(RuntimeError, ValueError, NotImplementedError):
+                loop.remove_signal_handler(sig)
+    handlers, fd = kept
+    for signum, handler in handlers.items():
+        if handler is not None:  # None: set outside Python, cannot be put back
+            signal.signal(signum, handler)
+    with contextlib.suppress(ValueError):  # a closed or blocking fd: left unset
+        signal.set_wakeup_fd(fd)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
