@@ -131,6 +131,19 @@ def test_no_scene_line_names_the_half_scenes_it_skipped(
         f"stereovision: error: {root / 'a'}: has left.png but no right.png (a scene folder "
         "holds both)"
     ]
+    # its right.png a folder, or a broken link: said as scan_scenes says them, not as "no
+    # right.png" and as a half scene skipped under the folder given
+    (root / "a" / "right.png").mkdir()
+    (root / "b" / "right.png").unlink()
+    (root / "b" / "right.png").symlink_to(tmp_path / "nowhere.png")
+    for name, said in (
+        ("a", "has left.png but right.png is a folder"),
+        ("b", "has right.png but no left.png"),
+    ):
+        assert main([command, str(root / name)]) == 2
+        assert capsys.readouterr().err.splitlines() == [
+            f"stereovision: error: {root / name}: {said} (a scene folder holds both)"
+        ]
 
 
 def _strict_json(line: str) -> dict[str, object]:

@@ -1913,11 +1913,18 @@ def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] =
     -------
     str
         ``"FOLDER: has left.png but no right.png (a scene folder holds both)"`` when the folder
-        itself is half a scene; else ``"no scene (left.png + right.png) under FOLDER"``, with
-        the left/right images found that are not PNG, and the half scenes skipped under it
-        (they were not named: the line hid why a folder of them gave nothing).
+        itself is half a scene (in its entry of ``half``'s words when it has one: a right.png
+        that is a folder); else ``"no scene (left.png + right.png) under FOLDER"``, with the
+        left/right images found that are not PNG, and the half scenes skipped under it (they
+        were not named: the line hid why a folder of them gave nothing).
     """
     pair = ("left.png", "right.png")
+    # the folder itself half a scene: in scan_scenes' words, which tell a right.png that is a
+    # folder ("has left.png but no right.png" here) or a broken link (said as a half scene
+    # skipped under the folder) from a missing one
+    own = [why for f, why in half if f == folder]
+    if own:
+        return f"{given}: {own[0]}"
     have = [n for n in pair if (folder / n).is_file()]
     if len(have) == 1:
         missing = pair[1 - pair.index(have[0])]
