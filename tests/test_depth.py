@@ -1448,6 +1448,13 @@ def test_a_negative_min_disparity_with_fused_names_the_channels_that_run() -> No
     # a one-pass iterator is read once: the refusal still names its channel
     with pytest.raises(ValueError, match=r"\(its Hopfield channel takes"):
         sv.match(left, right, method="fused", channels=iter(["hopfield"]), min_disparity=-2)
+    # with no negative min_disparity to refuse, channels are checked where fuse_pair checks
+    # them, after its options and switches, as before: checked first, a bad switch beside
+    # them was said as the channels' ValueError, a misspelt option as an unknown channel
+    with pytest.raises(TypeError, match=r"^check_members: expected True or False, got .no.$"):
+        sv.match(left, right, method="fused", channels="gabor", check_members="no")
+    with pytest.raises(ValueError, match=r"^unknown fusion option\(s\) \['chanels'\]"):
+        sv.match(left, right, method="fused", channels=("bogus",), chanels=1)
 
 
 def test_the_automatic_range_is_clamped_to_half_the_width() -> None:

@@ -115,10 +115,12 @@ def match(
     # anything not a finite number is left to the matchers' own words
     lo = params.get("min_disparity", 0)
     from_zero = method != "gabor" and real_number(lo) and -math.inf < lo < 0
-    if method == "fused" and "channels" in params:
+    if from_zero and method == "fused" and "channels" in params:
         # checked (and read once) first, so the refusal names the channels that run: it named
         # a graph-matching channel with channels=("hopfield",), and came before the channels'
-        # own error with ("gabor",)
+        # own error with ("gabor",). Only then: otherwise fuse_pair checks them after its
+        # options and switches, as before (a bad channels beside check_members="no" turned
+        # the switch's TypeError into the channels' ValueError)
         params["channels"] = _checked_channels(params["channels"])
     if from_zero and max_disparity is None:
         raise _from_zero(method, lo, ("gabor",), params.get("channels"))
