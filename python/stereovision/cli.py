@@ -1019,6 +1019,9 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     if not (math.isfinite(args.tolerance) and args.tolerance > 0):  # before reading the pair
         raise CliError(f"--tolerance: expected a positive number of pixels, got {args.tolerance:g}")
+    if args.plot and Path(args.plot).suffix.lower() not in ("", ".png"):
+        # the plot is PNG bytes: p.jpg (or .gif, .pdf) held a PNG its viewers misread
+        raise CliError(f"--plot {args.plot}: the plot is written as PNG; give a .png file name")
     left = imread(args.left)
     right = imread(args.right)
     same = (
