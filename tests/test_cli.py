@@ -3225,6 +3225,7 @@ def _number_options() -> list[tuple[str, str]]:
     """Every (command, option) of the CLI whose value is converted to a number."""
     import argparse
 
+    from stereovision.capture import fourcc_code
     from stereovision.cli import build_parser
 
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
@@ -3232,7 +3233,10 @@ def _number_options() -> list[tuple[str, str]]:
         (name, action.option_strings[-1])
         for name, parser in sub.choices.items()
         for action in parser._actions
-        if action.option_strings and action.type not in (None, str) and action.nargs != 0
+        # --fourcc's type checks four characters, not a number ('25mm' is a fourcc)
+        if action.option_strings
+        and action.type not in (None, str, fourcc_code)
+        and action.nargs != 0
     ]
 
 
@@ -3356,4 +3360,48 @@ def test_mutation_audit_5_the_unit_hint_names_each_options_unit_and_none_for_a_c
     )
     assert _with_unit_hint("argument --count: expected an integer, got '10x'") == (
         "argument --count: expected an integer without a unit, got '10x'"
+    )
+
+
+@pytest.mark.parametrize("name", ["plot.jpg", "plot.GIF", "plot.pdf"])
+def test_check_plot_refuses_a_name_of_another_format(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str
+) -> None:
+    """``check L R --plot plot.jpg`` wrote PNG bytes under a .jpg name (exit 0): now refused
+    before the pair is read, one line, exit 2, nothing written. A .png name (any case) or one
+    without a suffix still gets its PNG."""
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    plot = tmp_path / name
+    assert main(["check", *pair, "--plot", str(plot)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        f"stereovision: error: --plot {plot}: the plot is written as PNG; give a .png file name\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+    for ok in ("plot.PNG", "plot"):
+        assert main(["check", *pair, "--plot", str(tmp_path / ok)]) == 0
+        assert (tmp_path / ok).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("command", ["capture", "stream", "gui"])
+@pytest.mark.parametrize("code", ["MJPEG", "", "é123"])
+def test_a_bad_fourcc_is_refused_in_the_options_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, code: str
+) -> None:
+    """``--fourcc MJPEG`` was said as the library's parameter (``fourcc: expected four
+    characters ...``), after the parsing; argparse now refuses it as ``--fps`` and ``--size``
+    are refused: ``argument --fourcc: ...``, one line, exit 2, nothing written."""
+    argv = [command, "--left", "0", "--right", "1", "--fourcc", code]
+    if command == "capture":
+        argv += ["-o", str(tmp_path / "out")]
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    assert exit_.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == "" and list(tmp_path.iterdir()) == []
+    assert err == (
+        f"stereovision {command}: error: argument --fourcc: expected four characters such as "
+        f"'MJPG' or 'YUYV', got {code!r} (see stereovision {command} --help)\n"
     )

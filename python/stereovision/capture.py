@@ -369,6 +369,17 @@ def parse_fourcc(text: str | None) -> str | None:
     return text
 
 
+def fourcc_code(text: str) -> str:
+    """argparse type of ``--fourcc``: four printable ASCII characters, refused in the option's
+    name (the library's parameter, ``fourcc: expected ...``, was what the CLI said)."""
+    try:
+        return str(parse_fourcc(text))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected four characters such as 'MJPG' or 'YUYV', got {text!r}"
+        ) from None
+
+
 def fourcc_text(code: float) -> str:
     """``CAP_PROP_FOURCC``'s number as its four characters.
 
@@ -2201,6 +2212,7 @@ def add_source_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--right", help="device index, video file or pattern")
     p.add_argument(
         "--fourcc",
+        type=fourcc_code,
         help="pixel format asked of the cameras: YUYV (raw) or MJPG (compressed, more size/fps "
         "over USB; costs some accuracy)",
     )

@@ -298,13 +298,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``gui`` options."""
     p.add_argument("--left", help="left camera: device index, video file or image pattern")
     p.add_argument("--right", help="right camera: device index, video file or image pattern")
+    from stereovision.capture import add_bag_args, fourcc_code
+
     p.add_argument(
         "--fourcc",
+        type=fourcc_code,
         help="pixel format asked of the cameras: YUYV (raw) or MJPG (compressed; two webcams on "
         "one USB 2 bus often need it)",
     )
-    from stereovision.capture import add_bag_args
-
     add_bag_args(
         p,
         "play a rig recorded in a ROS 1 / ROS 2 bag instead (its camera_info as calibration)",
