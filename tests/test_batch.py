@@ -2756,3 +2756,22 @@ def test_a_float_tiff_pair_says_why_it_is_no_image(tmp_path: Path) -> None:
     )
     with pytest.raises(ValueError, match=says):
         process_pair(_task(job, {"method": "gabor", "max_disparity": 16, "fill": None}))
+
+
+def test_workers_with_a_scheduler_is_refused_before_any_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``batch IN -o OUT --workers 8 --scheduler tcp://...`` ran on the cluster's own workers,
+    --workers ignored without a word (run_batch ignores it with a scheduler); refused now in
+    one line, exit 2, before the scheduler is asked or OUT made."""
+    _noise_pair(tmp_path / "in" / "scene")
+    out = tmp_path / "out"
+    argv = ["batch", str(tmp_path / "in"), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"]
+    assert main([*argv, "--workers", "8"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        "stereovision: error: --workers sizes the local cluster; --scheduler's workers are the "
+        "cluster's own: give one of them\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]

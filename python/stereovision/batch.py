@@ -1992,6 +1992,13 @@ def cmd_batch(args: argparse.Namespace) -> int:
     # in the option's name, as --count and --max-pairs are (run_batch names its parameter)
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers: expected a whole number above 0, got {args.workers}")
+    if args.workers is not None and args.scheduler is not None:
+        # run_batch ignores workers with a scheduler: --workers 8 ran on the cluster's own
+        # workers without a word
+        raise ValueError(
+            "--workers sizes the local cluster; --scheduler's workers are the cluster's own: "
+            "give one of them"
+        )
     # as depth says them: run_batch's words were its parameters' ("it needs ground=True")
     if args.grid is not None and not args.ground:
         raise ValueError("--grid needs --ground (the grid lies on the floor)")
