@@ -3102,3 +3102,29 @@ def test_mutation_audit_the_view_rounds_16_bits_as_the_pipeline_does() -> None:
     shown = _view_bgr(grey)
     np.testing.assert_array_equal(shown, as_bgr_uint8(grey))
     assert shown[0, 129, 0] == 1 and tuple(shown.reshape(-1, 3)[65406:65408, 0]) == (254, 255)
+
+
+@pytest.mark.parametrize(
+    ("extra", "said"),
+    [
+        (["--serve", "9000"], "--serve: it places"),
+        (["--host", "0.0.0.0"], "--host: it places"),
+        (["--host", "::1", "--serve", "0"], "--serve and --host: they place"),
+    ],
+)
+def test_serve_or_host_with_no_display_is_refused_before_any_open(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], extra: list[str], said: str
+) -> None:
+    """``stream --no-display --serve 9000`` (or ``--host 0.0.0.0``) streamed headless, the view
+    asked for at that address never served and nothing said; refused now in one line, exit 2,
+    before the cameras are opened (these do not exist)."""
+    from stereovision.cli import main
+
+    argv = ["stream", "--left", str(tmp_path / "l.avi"), "--right", str(tmp_path / "r.avi")]
+    assert main([*argv, "--no-display", *extra]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        f"stereovision: error: {said} the live view, which --no-display turns off; give one or "
+        "the other\n"
+    )

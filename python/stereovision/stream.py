@@ -1347,6 +1347,13 @@ def cmd_stream(args: argparse.Namespace) -> int:
     from stereovision.calibration import _sizeless
     from stereovision.cli import load_calibration
 
+    given = [o for o, v in (("--serve", args.serve), ("--host", args.host)) if v is not None]
+    if args.no_display and given:
+        # refused before any open, not ignored: the view the user asked an address for
+        raise ValueError(
+            f"{' and '.join(given)}: {'they place' if len(given) > 1 else 'it places'} the live "
+            "view, which --no-display turns off; give one or the other"
+        )
     if args.no_tf and not args.bag:  # refused before any open, not ignored
         raise ValueError("--no-tf leaves /tf out of a --bag: give --bag DIR")
     if args.no_tf and args.ground_every is None:
@@ -1433,7 +1440,10 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 raise said from None
         sinks: list[Callable[[np.ndarray, Any], None]] = []
         if not args.no_display and not stopped:
-            server = FrameServer(args.host, args.serve)
+            server = FrameServer(
+                "127.0.0.1" if args.host is None else args.host,
+                DEFAULT_PORT if args.serve is None else args.serve,
+            )
             print(f"serving the live view on {server.url}", file=log, flush=True)
             srv = server
             sinks.append(
@@ -1684,14 +1694,14 @@ def add_cli(subparsers: Any) -> None:
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
     )
     p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
+    # no argparse defaults: given with --no-display, which serves no view, they are refused
     p.add_argument(
         "--serve",
         type=port_number,
-        default=DEFAULT_PORT,
         metavar="PORT",
         help=f"view port (default {DEFAULT_PORT})",
     )
-    p.add_argument("--host", default="127.0.0.1", help="view address (default 127.0.0.1)")
+    p.add_argument("--host", help="view address (default 127.0.0.1)")
     p.add_argument("--json", action="store_true", help="one JSON object per second on stdout")
     p.add_argument(
         "--no-check",
