@@ -3405,3 +3405,30 @@ def test_a_bad_fourcc_is_refused_in_the_options_name(
         f"stereovision {command}: error: argument --fourcc: expected four characters such as "
         f"'MJPG' or 'YUYV', got {code!r} (see stereovision {command} --help)\n"
     )
+
+
+@pytest.mark.parametrize("command", ["depth", "batch", "stream"])
+def test_fill_and_no_fill_together_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    """``depth L R -o OUT --fill --no-fill`` ran with the last one, the other ignored without
+    a word (the README's usage has them as one or the other, ``[--fill|--no-fill]``); refused
+    now by argparse in one line naming both, exit 2, nothing written. Either alone is taken."""
+    argv = {
+        "depth": ["depth", "l.png", "r.png", "-o", str(tmp_path / "out")],
+        "batch": ["batch", str(tmp_path), "-o", str(tmp_path / "out")],
+        "stream": ["stream", "--left", "0", "--right", "1"],
+    }[command]
+    with pytest.raises(SystemExit) as exit_:
+        main([*argv, "--fill", "--no-fill"])
+    assert exit_.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == "" and list(tmp_path.iterdir()) == []
+    assert err == (
+        f"stereovision {command}: error: argument --no-fill: not allowed with argument --fill "
+        f"(see stereovision {command} --help)\n"
+    )
+    from stereovision.cli import build_parser
+
+    for flag, fill in (("--fill", True), ("--no-fill", False)):
+        assert build_parser().parse_args([*argv, flag]).fill is fill

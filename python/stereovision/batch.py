@@ -2142,10 +2142,12 @@ def add_cli(subparsers: Any) -> None:
         "or Q.dat)",
     )
     add_calib_unit(p)
-    p.add_argument(
+    # one or the other: both given, the last silently won
+    fill = p.add_mutually_exclusive_group()
+    fill.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )
-    p.add_argument(
+    fill.add_argument(
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
     )
     p.add_argument(

@@ -2287,10 +2287,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="disparity range to search, in pixels (default: estimated from the images)",
     )
     d.add_argument("--method", default=METHODS[0], choices=METHODS, help=_METHOD_HELP)
-    d.add_argument(
+    # one or the other: both given, the last silently won
+    fill = d.add_mutually_exclusive_group()
+    fill.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )
-    d.add_argument(
+    fill.add_argument(
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
     )
     d.add_argument(

@@ -1687,10 +1687,12 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--refine", action="store_true", help="sub-pixel refinement per frame (2-3x the time)"
     )
-    p.add_argument(
+    # one or the other: both given, the last silently won
+    fill = p.add_mutually_exclusive_group()
+    fill.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )
-    p.add_argument(
+    fill.add_argument(
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
     )
     p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
