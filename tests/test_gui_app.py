@@ -3408,8 +3408,8 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
     add_arguments(parser)
     built = build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPG"]))
     assert asked[-1] == "MJPG" and built.state.live
-    with pytest.raises(ValueError, match="four characters"):
-        build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPEG"]))
+    with pytest.raises(SystemExit):  # refused by argparse, in the option's name
+        parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPEG"])
     with pytest.raises(ValueError, match="--fourcc asks the cameras for a format"):
         build_app(parser.parse_args(["--fourcc", "MJPG"]))
 
