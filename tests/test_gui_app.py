@@ -6399,3 +6399,26 @@ def test_gui_main_refuses_a_value_in_one_line_with_the_unit_hint(capsys):
         "stereovision gui: error: argument --read-timeout: expected seconds above 0 or 'none' "
         "(no limit) without a unit (5 for 5 s), got '10s' (see stereovision gui --help)\n",
     )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--left-topic", "/cam/left"],
+        ["--right-topic", "/r"],
+        ["--left", "0", "--right", "1", "--left-topic", "/l"],
+    ],
+)
+def test_a_topic_without_a_bag_is_refused_before_the_server_starts(
+    capsys: pytest.CaptureFixture[str], argv: list[str]
+) -> None:
+    """``gui --left-topic /cam/left`` without --from-bag served the page, the topic ignored
+    without a word (capture and calibrate refuse it): refused now before any camera is opened
+    or the server started, one line, exit 2."""
+    import stereovision.gui as gui
+
+    said = "--left-topic and --right-topic are for --from-bag"
+    with pytest.raises(ValueError, match=f"^{said}$"):
+        gui.build_app(_gui_args(*argv))
+    assert gui.main([*argv, "--no-browser"]) == 2
+    assert capsys.readouterr() == ("", f"stereovision: error: {said}\n")

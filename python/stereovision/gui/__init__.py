@@ -60,6 +60,10 @@ def build_app(args: argparse.Namespace) -> Any:
     from_bag = getattr(args, "from_bag", None)
     if from_bag is not None and args.left is not None:
         raise ValueError("--from-bag replaces --left and --right: give one source")
+    topics = (getattr(args, "left_topic", None), getattr(args, "right_topic", None))
+    if from_bag is None and topics != (None, None):
+        # as capture and calibrate refuse them: the page was served with the topic ignored
+        raise ValueError("--left-topic and --right-topic are for --from-bag")
     if not 0 <= args.port <= 65535:
         raise ValueError(f"--port must be in 0..65535, got {args.port}")
     folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
