@@ -1678,3 +1678,53 @@ def test_a_tolerance_past_float32_is_its_infinity_without_numpy_warnings(
             got = sv_depth_map(left, right, max_disparity=32, **{key: huge})
             np.testing.assert_array_equal(got.disparity, want.disparity)
             np.testing.assert_array_equal(got.confidence, want.confidence)
+
+
+def test_radius_offsets_are_nearest_first_in_a_fixed_order() -> None:
+    """D.2's "nearest": equal distances are visited up before down, left before right
+    (``(dy, dx)`` ascending), so a candidate between two sparse values takes the one above."""
+    assert _radius_offsets(1.5) == [
+        (0, 0),
+        (-1, 0),
+        (0, -1),
+        (0, 1),
+        (1, 0),
+        (-1, -1),
+        (-1, 1),
+        (1, -1),
+        (1, 1),
+    ]
+    # MCGM measured above and below the Hopfield point, at the same distance: the one above
+    # (7.5) is MCGM's value there, and the member the mean with Hopfield's 7.0.
+    mcgm = _m([(10, 9, 7.5), (10, 11, 6.5)])
+    hop = _m([(10, 10, 7.0)])
+    res = fuse(None, {"mcgm": mcgm, "hopfield": hop}, tau_dx=0.6)
+    assert res.dispx[10, 10] == pytest.approx(7.25)
+
+
+def test_a_map_that_is_not_two_dimensional_is_named() -> None:
+    """A Gabor map of shape (H, W, 1) (a colour axis left on) is refused by name, not read."""
+    d, c = _dense(10.0)
+    with pytest.raises(ValueError, match=r"^gabor dispx: expected an \(H, W\) map, got shape"):
+        fuse((d[..., None], c), {"hopfield": _m([(5, 5, 10.0)])})
+    with pytest.raises(ValueError, match=r"^members: expected an \(H, W\) map, got shape"):
+        fused_dense(d, c, d[None])
+
+
+def test_equal_spreads_keep_the_first_pair_in_bit_order() -> None:
+    """Two agreeing pairs with the same x spread (Gabor 10 with MCGM 10.75 or Hopfield 9.25;
+    MCGM and Hopfield 1.5 apart): the first in bit order (Gabor + MCGM) is the member."""
+    res = fuse(_dense(10.0), {"mcgm": _m([(4, 4, 10.75)]), "hopfield": _m([(4, 4, 9.25)])})
+    assert list(res.sources) == [1 | 2] and list(res.count) == [2]
+    assert res.dispx[4, 4] == pytest.approx(10.375)
+
+
+def test_count_map_holds_the_count_and_sources_map_the_bits() -> None:
+    """The rasters carry each member's own values: 3 agreeing channels (bits 7) at (3, 3), 2
+    (Gabor + MCGM, bits 3) at (9, 3), 0 off the members."""
+    mcgm = _m([(3, 3, 10.0), (9, 3, 10.0)])
+    hop = _m([(3, 3, 10.4), (9, 3, 14.0)])
+    res = fuse(_dense(10.2), {"mcgm": mcgm, "hopfield": hop})
+    assert res.count_map[3, 3] == 3 and res.count_map[3, 9] == 2
+    assert res.sources_map[3, 3] == 7 and res.sources_map[3, 9] == 3
+    assert np.count_nonzero(res.count_map) == np.count_nonzero(res.sources_map) == 2
