@@ -1728,3 +1728,61 @@ def test_count_map_holds_the_count_and_sources_map_the_bits() -> None:
     assert res.count_map[3, 3] == 3 and res.count_map[3, 9] == 2
     assert res.sources_map[3, 3] == 7 and res.sources_map[3, 9] == 3
     assert np.count_nonzero(res.count_map) == np.count_nonzero(res.sources_map) == 2
+
+
+def test_fuse_pair_times_each_channel_and_the_fusion() -> None:
+    """``stats["seconds"]`` names every matcher that ran (the census one for the census check)
+    and the fusion itself, each a positive time; the census map is kept only with
+    ``dense_sgm``."""
+    rng = np.random.default_rng(5)
+    right = rng.random((48, 80)).astype(np.float32)
+    left = np.roll(right, 4, axis=1)  # disparity 4
+    res = fuse_pair(left, right, max_disparity=8)
+    seconds = res.matches.stats["seconds"]
+    assert set(seconds) == {"gabor", "mcgm", "hopfield", "sgm", "fuse"}
+    assert all(isinstance(s, float) and s > 0 for s in seconds.values())
+    assert "sgm" not in res.channel_outputs
+    res = fuse_pair(left, right, max_disparity=8, channels=("gabor", "mcgm"), dense_sgm=True)
+    assert set(res.matches.stats["seconds"]) == {"gabor", "mcgm", "sgm", "fuse"}
+    assert res.channel_outputs["sgm"].shape == (48, 80)
+    res = fuse_pair(left, right, max_disparity=8, census_members=False)
+    assert set(res.matches.stats["seconds"]) == {"gabor", "mcgm", "hopfield", "fuse"}
+
+
+def test_fuse_pair_runs_mcgm_and_the_member_check_with_member_mcgm(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """MCGM votes with MEMBER_MCGM's stricter settings (GHT score 0.5, 4 px half-windows, MAD
+    0.04), not its own defaults, and the members' both-sides check uses the same sides."""
+    import stereovision.matching.mcgm as mcgm
+
+    seen: dict[str, dict[str, Any]] = {}
+
+    def spy(name: str, fn: Any) -> Any:
+        def call(*args: Any, **kw: Any) -> Any:
+            seen[name] = kw
+            return fn(*args, **kw)
+
+        return call
+
+    monkeypatch.setattr(mcgm, "mcgm_match", spy("mcgm", mcgm.mcgm_match))
+    monkeypatch.setattr(mcgm, "edge_filters", spy("sides", mcgm.edge_filters))
+    rng = np.random.default_rng(5)
+    right = rng.random((48, 80)).astype(np.float32)
+    fuse_pair(np.roll(right, 4, axis=1), right, max_disparity=8, census_members=False)
+    assert {k: seen["mcgm"][k] for k in ("ght_min_score", "sides_mad", "sides_width")} == {
+        "ght_min_score": 0.5,
+        "sides_mad": 0.04,
+        "sides_width": 4,
+    }
+    assert (seen["sides"]["sides_mad"], seen["sides"]["sides_width"]) == (0.04, 4)
+
+
+@pytest.mark.parametrize("jump", [-0.5, -1e-3])
+def test_census_clear_refuses_a_negative_jump(jump: float) -> None:
+    """``jump`` is a distance below the member's disparity: a negative one is refused by name
+    (it would drop members the census map agrees with)."""
+    res = fuse(_dense(10.0), {"hopfield": _m([(5, 5, 10.0)])})
+    with pytest.raises(ValueError, match=r"^jump must be >= 0, got -"):
+        census_clear(res, np.full((H, W), 10.0, np.float32), jump=jump)
+    assert len(census_clear(res, np.full((H, W), 10.0, np.float32), jump=0.0)) == 1
