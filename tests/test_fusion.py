@@ -1786,3 +1786,95 @@ def test_census_clear_refuses_a_negative_jump(jump: float) -> None:
     with pytest.raises(ValueError, match=r"^jump must be >= 0, got -"):
         census_clear(res, np.full((H, W), 10.0, np.float32), jump=jump)
     assert len(census_clear(res, np.full((H, W), 10.0, np.float32), jump=0.0)) == 1
+
+
+def test_fused_dense_edge_step_runs_from_a_one_pixel_radius() -> None:
+    """Step 7 runs from ``edge_radius`` 1 (only 0 turns it off): a square drawn 1 px too wide
+    on every side loses that 1 px ring, which a 1 px look reaches."""
+    h, w = 60, 80
+    guide = np.full((h, w), 0.2, np.float32)
+    guide[20:40, 30:50] = 0.8
+    guide += np.random.default_rng(1).normal(0, 0.01, (h, w)).astype(np.float32)
+    d = np.full((h, w), 10.0, np.float32)
+    d[20:40, 29:51] = 20.0
+    d[19:41, 30:50] = 20.0
+    conf = np.full(d.shape, 0.8, np.float32)
+    none = np.full(d.shape, np.nan, np.float32)
+    out, c = fused_dense(d, conf, none, guide=guide, speckle_area=0.0, edge_radius=1)
+    truth = np.full((h, w), 10.0, np.float32)
+    truth[20:40, 30:50] = 20.0
+    fat = d != truth
+    assert np.count_nonzero(fat) == 80
+    assert np.isnan(out[fat]).all() and (c[fat] == 0).all()
+    np.testing.assert_array_equal(out[~fat], d[~fat])
+
+
+@pytest.mark.parametrize("name", ["edge_ratio", "edge_jump"])
+def test_an_edge_option_just_past_float32_is_named(name: str) -> None:
+    """The bound is float32's largest value, not a larger one: 1e39 (finite in float64,
+    infinite in float32) is refused by name as 1e308 is."""
+    d, c = _dense(5.0, 0.5)
+    members = np.full((H, W), np.nan, np.float32)
+    guide = np.random.default_rng(0).random((H, W)).astype(np.float32)
+    with pytest.raises(ValueError, match=f"^{name}: expected at most 3.40282e\\+38 \\(float32\\)"):
+        fused_dense(d, c, members, guide=guide, **{name: 1e39})
+
+
+def test_the_default_tables_are_the_functions_defaults() -> None:
+    """DEFAULTS and DENSE_DEFAULTS (what depth_map checks and documents) are exactly the
+    defaults fuse and fused_dense run with."""
+    import inspect
+
+    from stereovision.matching.fusion import DEFAULTS, DENSE_DEFAULTS
+
+    for fn, table in ((fuse, DEFAULTS), (fused_dense, DENSE_DEFAULTS)):
+        params = inspect.signature(fn).parameters
+        assert {k: params[k].default for k in table} == table
+    assert (DENSE_DEFAULTS["tau"], DENSE_DEFAULTS["fill_radius"]) == (2.0, 3.0)
+
+
+@pytest.mark.parametrize("side", ["top", "bottom", "left", "right"])
+def test_enclosed_far_leaves_a_region_open_to_each_border(side: str) -> None:
+    """A dark floor region touching any one of the four borders is open (kept as it is); the
+    same region moved 5 px inward is enclosed (filled with the surround's 6)."""
+    h, w = 40, 50
+    rows, cols = {
+        "top": (slice(0, 10), slice(20, 30)),
+        "bottom": (slice(30, 40), slice(20, 30)),
+        "left": (slice(15, 25), slice(0, 10)),
+        "right": (slice(15, 25), slice(40, 50)),
+    }[side]
+    d = np.full((h, w), 6.0, np.float32)
+    g = np.full((h, w), 0.6, np.float32)
+    d[rows, cols], g[rows, cols] = 0.0, 0.1
+    out, filled = fill_enclosed_far(d, g)
+    assert not filled.any() and np.array_equal(out, d)
+    shift = {"top": (5, 0), "bottom": (-5, 0), "left": (0, 5), "right": (0, -5)}[side]
+    d2 = np.roll(d, shift, axis=(0, 1))
+    g2 = np.roll(g, shift, axis=(0, 1))
+    out, filled = fill_enclosed_far(d2, g2)
+    assert filled.sum() == 100 and np.all(out == 6.0)
+
+
+def test_enclosed_far_joins_regions_touching_at_a_corner() -> None:
+    """Regions are 8-connected: a dark floor block that meets a border-touching one only at a
+    corner is part of it, so open to the border too (neither is filled)."""
+    d = np.full((40, 50), 6.0, np.float32)
+    g = np.full((40, 50), 0.6, np.float32)
+    d[0:10, 10:20], g[0:10, 10:20] = 0.0, 0.1  # open to the top
+    d[10:20, 20:30], g[10:20, 20:30] = 0.0, 0.1  # meets it at (9, 19) / (10, 20) only
+    out, filled = fill_enclosed_far(d, g)
+    assert not filled.any() and np.array_equal(out, d)
+
+
+def test_enclosed_far_default_far_is_half_a_pixel() -> None:
+    """By default a region is locked to the floor below 0.5 px: a dark pane at 0.45 is filled,
+    one at 0.55 is not."""
+    d = np.full((60, 80), 6.0, np.float32)
+    g = np.full((60, 80), 0.6, np.float32)
+    g[20:30, 10:25] = 0.1
+    for value, fills in ((0.45, True), (0.55, False)):
+        d[20:30, 10:25] = value
+        out, filled = fill_enclosed_far(d, g)
+        assert filled.any() == fills
+        assert np.all(out[20:30, 10:25] == (6.0 if fills else np.float32(value)))
