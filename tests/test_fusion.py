@@ -1878,3 +1878,22 @@ def test_enclosed_far_default_far_is_half_a_pixel() -> None:
         out, filled = fill_enclosed_far(d, g)
         assert filled.any() == fills
         assert np.all(out[20:30, 10:25] == (6.0 if fills else np.float32(value)))
+
+
+def test_census_clear_window_past_the_shorter_side_reaches_as_far_as_asked() -> None:
+    """On a 20 x 30 map a 25 px window is wider than the map is tall but still ends 25 px
+    along the row: a census value 23 px to the right, 10 below the member, drops it at radius
+    25 and not at 22."""
+    res = fuse(_dense(20.0), {"hopfield": _m([(2, 10, 20.0)])})
+    census = np.full((H, W), 20.0, np.float32)
+    census[10, 25] = 10.0
+    assert len(census_clear(res, census, radius=25)) == 0
+    assert len(census_clear(res, census, radius=22)) == 1
+
+
+def test_fuse_pair_refuses_channels_given_as_bytes() -> None:
+    """``b"gabor,mcgm"`` is one string of bytes, not channel names: refused as such before
+    the channels run, not read byte by byte as the unknown channels 103, 97, ..."""
+    img = np.zeros((20, 30), np.float32)
+    with pytest.raises(ValueError, match=r"^channels: expected a tuple of channel names, got b"):
+        fuse_pair(img, img, max_disparity=8, channels=b"gabor,mcgm")  # type: ignore[arg-type]
