@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stereovision.synthetic import render_plane
+from stereovision.synthetic import pixel_rays, render_plane
 
 # f = 100 px, plane at Z = 1, 0.01 units per texture pixel: one texture pixel per image pixel.
 # The principal point (-5, -3) puts image pixel (u, v) on texture pixel (u + 4.5, v + 2.5)
@@ -160,3 +160,24 @@ def test_a_fisheye_ray_past_90_degrees_sees_the_background_not_the_plane() -> No
     gone = ~front
     np.testing.assert_array_equal(out[100, 100 + r[seen]], 200.0)
     np.testing.assert_array_equal(out[100, 100 + r[gone]], 60.0)
+
+
+def test_a_fisheye_ray_whose_distorted_angle_passes_90_degrees_still_sees_the_plane() -> None:
+    """With k1 = 0.3, k2 = 0.1 the lens puts angle theta at r = f theta (1 + 0.3 theta^2 +
+    0.1 theta^4): 90 degrees lies at r = 368 px for f = 100, 64 degrees already at r = 170 px.
+    cv2.fisheye.undistortPoints clamps theta_d = r / f at 90 degrees, so every pixel past
+    157 px (the image's corners) got a wrong ray, which the round trip cut: background where
+    the plane is (484 of these 48240 pixels). They are solved by render_plane now."""
+    k = np.array([[100.0, 0.0, 100.0], [0.0, 100.0, 100.0], [0.0, 0.0, 1.0]])
+    d = np.array([0.3, 0.1, 0.0, 0.0])
+    tex = np.full((400, 400), 200.0, np.float32)  # 40 x 40 units: tan theta <= 20 in view
+    kw = {"image_size": (240, 201), "model": "fisheye", "supersample": 1, "background": 60.0}
+    out = render_plane(tex, 0.1, k, d, np.zeros(3), [-20.0, -20.0, 1.0], **kw)
+    np.testing.assert_array_equal(out, 200.0)  # corner: r = 172 px, theta 65 degrees
+    rays = pixel_rays(k, d, (240, 201), 1, "fisheye")
+    for dx, dy in ((139, 0), (120, 100), (139, 100)):  # r = 139, 156 (OpenCV's), 171 px
+        r = np.hypot(dx, dy)
+        roots = np.roots([0.1, 0.0, 0.3, 0.0, 1.0, -r / 100])
+        theta = min(t.real for t in roots if abs(t.imag) < 1e-9 and t.real >= 0)
+        want = np.array([dx, dy]) / r * np.tan(theta)
+        np.testing.assert_allclose(rays[100 + dy, 100 + dx], want, rtol=1e-9)

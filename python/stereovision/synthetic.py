@@ -57,11 +57,59 @@ def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pin
             theta = np.arctan(np.hypot(rays[..., 0], rays[..., 1]))
             back = cv2.fisheye.distortPoints(und.reshape(-1, 1, 2), K, D)
             off = np.hypot(*(np.asarray(back, np.float64).reshape(-1, 2) - pts[:, 0]).T)
-            rays[(theta >= np.pi / 2 * 0.999) | (off.reshape(theta.shape) > 0.01)] = np.nan
+            bad = (theta >= np.pi / 2 * 0.999) | (off.reshape(theta.shape) > 0.01)
+            if bad.any():
+                # OpenCV clamps theta_d at 90 degrees: for k1 > 0 the rays in front beyond
+                # r = f pi / 2 came back wrong and were cut (f 300 px, k 0.1, -0.02, 0.005,
+                # -0.001: 243808 pixels of a 2000 x 1500 image seeing the background)
+                rays[bad] = _fisheye_rays(pts[bad.ravel(), 0], K, D)
         if len(_RAYS) > 8:
             _RAYS.clear()
         _RAYS[key] = rays
     return _RAYS[key]
+
+
+def _fisheye_rays(px: F64, K: F64, D: F64) -> F64:
+    """Rays ``(x, y)`` (``z = 1``) of fisheye pixels ``px`` ``(N, 2)``, solved here; NaN where
+    no ray within 89.91 degrees of the axis projects back within 0.01 px of its pixel.
+
+    ``theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8)`` is solved for the smallest
+    ``theta`` in ``[0, 0.999 pi / 2]`` (cv2.fisheye.undistortPoints clamps
+    ``theta_d`` to 90 degrees, which a lens with k1 > 0 exceeds in front of the camera).
+    """
+    lim = np.pi / 2 * 0.999
+    yd = (px[:, 1] - K[1, 2]) / K[1, 1]
+    xd = (px[:, 0] - K[0, 2] - K[0, 1] * yd) / K[0, 0]
+    theta_d = np.hypot(xd, yd)
+
+    def poly(t: F64) -> F64:
+        t2 = t * t
+        return t * (1 + t2 * (D[0] + t2 * (D[1] + t2 * (D[2] + t2 * D[3]))))
+
+    # the first crossing (the smallest theta) lies below the first grid angle past theta_d
+    grid = np.linspace(0.0, lim, 2049)
+    vals = poly(grid)
+    # the first grid value >= theta_d is the first of their running maximum (sorted)
+    first = np.minimum(np.searchsorted(np.maximum.accumulate(vals), theta_d), len(grid) - 1)
+    has = vals[first] >= theta_d
+    i0 = np.maximum(first - 1, 0)
+    lo, hi = grid[i0], grid[first]
+    # the chord's angle, then Newton within the bracket (the bracket is 0.0008 rad wide:
+    # quadratic convergence to float64 in two or three steps)
+    span = np.where(vals[first] > vals[i0], vals[first] - vals[i0], 1.0)
+    theta = np.clip(lo + (hi - lo) * (theta_d - vals[i0]) / span, lo, hi)
+    for _ in range(4):
+        t2 = theta * theta
+        slope = 1 + t2 * (3 * D[0] + t2 * (5 * D[1] + t2 * (7 * D[2] + t2 * 9 * D[3])))
+        step = (poly(theta) - theta_d) / np.where(slope > 0, slope, np.inf)
+        theta = np.clip(theta - step, lo, hi)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.where(theta_d > 0, np.tan(theta) / theta_d, 1.0)
+    rays = np.stack([xd * scale, yd * scale], axis=1)
+    back = cv2.fisheye.distortPoints(rays.reshape(-1, 1, 2), K, D).reshape(-1, 2)
+    ok = has & (np.hypot(*(np.asarray(back, np.float64) - px).T) <= 0.01)
+    rays[~ok] = np.nan
+    return rays
 
 
 def render_plane(
