@@ -181,3 +181,19 @@ def test_a_fisheye_ray_whose_distorted_angle_passes_90_degrees_still_sees_the_pl
         theta = min(t.real for t in roots if abs(t.imag) < 1e-9 and t.real >= 0)
         want = np.array([dx, dy]) / r * np.tan(theta)
         np.testing.assert_allclose(rays[100 + dy, 100 + dx], want, rtol=1e-9)
+
+
+def test_a_one_channel_texture_gives_a_one_channel_image() -> None:
+    """88b0743 takes an (H, W, 1) texture, but cv2.remap drops its channel axis: the render
+    came back (height, width), where 2 to 4 channels keep theirs. It is (height, width, 1) now,
+    the values those of the (H, W) texture's render."""
+    rng = np.random.default_rng(5)
+    tex = (rng.random((60, 80)) * 255).astype(np.uint8)
+    k = np.array([[120.0, 0.0, 40.0], [0.0, 120.0, 30.0], [0.0, 0.0, 1.0]])
+    args = (0.01, k, np.zeros(5), np.zeros(3), [-0.4, -0.3, 1.0])
+    kw = {"image_size": (80, 60), "supersample": 2}
+    grey = render_plane(tex, *args, **kw)
+    one = render_plane(tex[:, :, None], *args, **kw)
+    assert one.shape == (60, 80, 1) and one.dtype == np.uint8
+    np.testing.assert_array_equal(one[:, :, 0], grey)
+    assert render_plane(np.dstack([tex] * 4), *args, **kw).shape == (60, 80, 4)

@@ -136,7 +136,8 @@ def render_plane(
     Parameters
     ----------
     texture : array_like
-        Grey ``(H, W)`` or colour ``(H, W, 3)`` image, any dtype ``cv2.remap`` takes.
+        Grey ``(H, W)`` or ``(H, W, C)`` image of 1 to 4 channels (colour ``(H, W, 3)``), any
+        dtype ``cv2.remap`` takes.
     units_per_pixel : float
         Size of one texture pixel on the plane (in the unit of ``tvec``).
     K, D : array_like
@@ -157,7 +158,8 @@ def render_plane(
     Returns
     -------
     numpy.ndarray
-        ``(height, width[, 3])`` of the texture's dtype (float textures stay float).
+        ``(height, width[, C])``, the texture's ``C`` channels (one included), of the
+        texture's dtype (float textures stay float).
 
     Raises
     ------
@@ -225,7 +227,8 @@ def render_plane(
     canvas = cv2.remap(
         work, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=fill
     )
-    out = cv2.resize(canvas, (w, h), interpolation=cv2.INTER_AREA)
+    # cv2.remap and resize drop the channel axis of an (H, W, 1) texture, which is taken
+    out = cv2.resize(canvas, (w, h), interpolation=cv2.INTER_AREA).reshape((h, w, *tex.shape[2:]))
     if np.issubdtype(tex.dtype, np.integer):
         info = np.iinfo(tex.dtype)
         return np.clip(np.round(out), info.min, info.max).astype(tex.dtype)
