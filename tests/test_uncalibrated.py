@@ -572,6 +572,32 @@ def test_a_saved_rectification_reads_back_field_by_field(tmp_path: Path) -> None
     np.testing.assert_allclose(back.rectify_points([[10.0, 20.0]], "right"), moved)
 
 
+def test_a_rectification_with_a_nan_figure_is_saved_as_strict_json(tmp_path: Path) -> None:
+    """save wrote json.dumps' bare NaN / Infinity for a figure that is not finite (an aspect
+    of a middle line squeezed to a point, a rectification built by hand): no JSON for jq or
+    JavaScript. Such a figure is null now, as the package's other JSON, and read back as NaN;
+    the homographies and the finite figures are kept exactly."""
+    nan, inf = float("nan"), float("inf")
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (100, 80), (100, 80), np.zeros((3, 3)), 40, nan, 0.2, (1.0, inf),
+        16, (0.0, nan), (-inf, 1.0),
+    )  # fmt: skip
+
+    def refuse(word: str) -> float:
+        raise AssertionError(f"{word} in the file: not JSON")
+
+    path = rect.save(tmp_path / "r.json")
+    raw = json.loads(path.read_text(), parse_constant=refuse)
+    assert raw["median_dy"] is None and raw["disparity_range"] == [1.0, None]
+    assert raw["skew_deg"] == [0.0, None] and raw["aspect"] == [None, 1.0]
+    back = UncalibratedRectification.load(path)
+    assert math.isnan(back.median_dy) and back.p95_dy == 0.2
+    assert back.disparity_range[0] == 1.0 and math.isnan(back.disparity_range[1])
+    assert back.skew_deg[0] == 0.0 and math.isnan(back.skew_deg[1])
+    assert math.isnan(back.aspect[0]) and back.aspect[1] == 1.0
+    np.testing.assert_array_equal(back.H1, np.eye(3))
+
+
 def test_check_with_identity_homographies_is_the_plain_check(data_dir: Path) -> None:
     """Homographies that move nothing, on a pair already rectified: :meth:`check` keeps every
     match (all lie in the image) and gives :func:`check_rectification`'s verdict and counts on

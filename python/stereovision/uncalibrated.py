@@ -525,7 +525,7 @@ class UncalibratedRectification:
         }
 
     def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write :meth:`as_dict` as JSON (atomically).
+        """Write :meth:`as_dict` as JSON (atomically; a NaN or infinite value as null).
 
         Parameters
         ----------
@@ -537,11 +537,15 @@ class UncalibratedRectification:
         Path
             ``path``.
         """
+        from stereovision._jsonout import json_ready
         from stereovision.io import atomic_write
 
         p = Path(path)
+        # strict JSON, as the package's other JSON: a NaN or infinite figure was written as
+        # the bare NaN / Infinity that jq and JavaScript refuse; it is null, read back as NaN
+        text = json.dumps(json_ready(self.as_dict()), indent=2, allow_nan=False)
         with atomic_write(p, "w") as fh:
-            fh.write(json.dumps(self.as_dict(), indent=2))
+            fh.write(text)
         return p
 
     @classmethod
@@ -602,12 +606,12 @@ class UncalibratedRectification:
                 (int(d["input_size"][0]), int(d["input_size"][1])),
                 mats["F"],
                 int(d["matches"]),
-                float(d["median_dy"]),
-                float(d["p95_dy"]),
-                (float(d["disparity_range"][0]), float(d["disparity_range"][1])),
+                _figure(d["median_dy"]),
+                _figure(d["p95_dy"]),
+                (_figure(d["disparity_range"][0]), _figure(d["disparity_range"][1])),
                 int(d["max_disparity"]),
-                (float(d["skew_deg"][0]), float(d["skew_deg"][1])),
-                (float(d["aspect"][0]), float(d["aspect"][1])),
+                (_figure(d["skew_deg"][0]), _figure(d["skew_deg"][1])),
+                (_figure(d["aspect"][0]), _figure(d["aspect"][1])),
                 str(d.get("model", "projective")),
             )
         except (ValueError, KeyError, TypeError, IndexError) as exc:
@@ -634,6 +638,12 @@ class UncalibratedRectification:
             f"{self.max_disparity}); {self.size[0]}x{self.size[1]} px, skew "
             f"{max(self.skew_deg):.2f} deg, aspect {self.aspect[0]:.3f} / {self.aspect[1]:.3f}"
         )
+
+
+def _figure(value: Any) -> float:
+    """A figure of a rectification file: :meth:`UncalibratedRectification.save` writes a NaN
+    or infinite one as null (strict JSON), read back as NaN."""
+    return math.nan if value is None else float(value)
 
 
 def _damaged(rect: UncalibratedRectification) -> str | None:
