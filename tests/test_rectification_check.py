@@ -358,6 +358,27 @@ def test_align_rows_undoes_a_row_offset(data_dir: Path) -> None:
     assert res.ok is None and same is not None and np.array_equal(same, flat)
 
 
+def test_align_rows_keeps_a_float_pair_in_its_range(data_dir: Path) -> None:
+    """A float [0, 1] pair with saturated parts (cones, contrast doubled, the right image
+    1.5 px lower): bicubic overshot the edges to -0.063 .. 1.120, and depth_map refused the
+    aligned image it had been handed ("float image values must lie in [0, 1]"). It is clipped
+    to the right image's own range; the rows are aligned as before."""
+    from stereovision.rectification_check import align_rows
+
+    left, right = _pair(data_dir, "middlebury2003/cones")
+    m = np.float64([[1, 0, 0], [0, 1, 1.5]])
+    grey = [cv2.cvtColor(im, cv2.COLOR_BGR2GRAY) if im.ndim == 3 else im for im in (left, right)]
+    lf, rf = (np.clip(g.astype(np.float32) / 255 * 2 - 0.3, 0, 1) for g in grey)
+    rf = _warp(rf, m)
+    aligned, before = align_rows(lf, rf)
+    assert before.ok is False and aligned.dtype == np.float32
+    assert aligned.min() == 0.0 and aligned.max() == 1.0
+    after = check_rectification(lf, aligned)
+    assert after.ok is True and abs(after.offset) < 0.15
+    res = sv.depth_map(lf, aligned, max_disparity=64)
+    assert np.isfinite(res.disparity).mean() > 0.5
+
+
 def test_align_rows_on_kitti(data_dir: Path) -> None:
     """KITTI's rectified pair has its rows 0.24 px apart (offset -0.24 px, slopes -0.34 and
     -0.51 px per 1000 px): aligned, the default depth map's bad-2.0 falls 13.18 -> 10.81 %."""

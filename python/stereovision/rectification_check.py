@@ -563,9 +563,10 @@ def align_rows(
     Returns
     -------
     tuple
-        ``(right_aligned, check)``: the right image (same shape and dtype) and the check it
-        was aligned by. The right image is returned unchanged when the check found no common
-        row model (too little texture, or far from rectified).
+        ``(right_aligned, check)``: the right image (same shape and dtype; a float image
+        within its own range, bicubic's overshoot clipped) and the check it was aligned by.
+        The right image is returned unchanged when the check found no common row model (too
+        little texture, or far from rectified).
     """
     ra = as_image_array(right, "right")
     res = check if check is not None else check_rectification(left, right)
@@ -589,5 +590,9 @@ def align_rows(
     out = remap_image(
         ra, xx, (yy - dy).astype(np.float32), cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
     )
+    if ra.dtype.kind == "f" and np.isfinite(ra).any():
+        # bicubic overshoots an edge (a float [0, 1] pair: -0.06 .. 1.12), which the matchers
+        # then refused as out of range: kept within the right image's own range
+        out = np.clip(out, np.nanmin(ra), np.nanmax(ra))
     # cv2.remap drops the channel axis of an (H, W, 1) image: given back in the right's shape
     return out.reshape(ra.shape), res
