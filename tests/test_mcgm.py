@@ -719,6 +719,26 @@ def test_a_match_with_a_nan_score_does_not_hide_a_scored_one_at_its_pixel(
         assert back.dispx[5, 10] == pytest.approx(3.0)
 
 
+def test_a_nan_score_ranks_below_a_minus_inf_one_and_ties_keep_the_later() -> None:
+    """b689787 ranked a NaN score as -inf, tied with a -inf score: a NaN-scored match written
+    after a -inf-scored one at its pixel hid it (dispx 8 for the -inf match's 3), though the
+    docstring says a NaN score is the lowest. NaN ranks below -inf now, in either order; of
+    two equal scores the later is kept, as before."""
+    for order in ([0, 1], [1, 0]):
+        m = sv.Matches(
+            xl=np.array([10.0, 10.0])[order], yl=np.array([5.0, 5.0])[order],
+            xr=np.array([7.0, 2.0])[order], yr=np.array([5.0, 5.0])[order],
+            score=np.array([-np.inf, np.nan])[order], image_shape=(12, 40),
+        )  # fmt: skip
+        assert m.dispx[5, 10] == 3.0
+    tie = sv.Matches(
+        xl=np.array([10.0, 10.0, 10.0]), yl=np.array([5.0, 5.0, 5.0]),
+        xr=np.array([7.0, 2.0, 4.0]), yr=np.array([5.0, 5.0, 5.0]),
+        score=np.array([0.5, 0.5, 0.2]), image_shape=(12, 40),
+    )  # fmt: skip
+    assert tie.dispx[5, 10] == 8.0  # the later of the two 0.5 scores
+
+
 def test_matches_selection_keeps_trace_and_copies_stats() -> None:
     m = _three()
     sub = m[m.score > 0.6]

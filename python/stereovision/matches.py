@@ -273,8 +273,11 @@ class Matches:
         yi = np.where(ok, ry, 0).astype(np.int64)
         # Two matches can round to one pixel (MCGM: 15 of 5086 on tsukuba): the better-scored
         # one is written last, so it is the one kept. A NaN score (a CSV row's "nan") ranks
-        # lowest: argsort puts NaN last, so such a match hid a scored one at its pixel.
-        order = np.argsort(np.where(np.isnan(self.score), -np.inf, self.score), kind="stable")
+        # lowest: argsort puts NaN last, so such a match hid a scored one at its pixel, and
+        # NaN read as -inf tied with a -inf score, which a later NaN hid. NaN first, then the
+        # score (a stable sort: the later one wins a tie, as before).
+        nan = np.isnan(self.score)
+        order = np.lexsort((np.where(nan, 0, self.score), ~nan))
         order = order[ok[order]]
         out[yi[order], xi[order]] = values[order]
         return out
