@@ -774,6 +774,14 @@ def test_matches_csv_text_and_bad_files(tmp_path: Path) -> None:
         ValueError, match=r"word\.csv: line 4: could not convert string to float: 'x'$"
     ):
         sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
+    # a form feed or U+2028 ending a row (read as whitespace) is no new line of the file: the
+    # bad row is still line 4 (splitlines counted 5 and 6); CRLF and CR files alike
+    for end in ("\x0c", "\u2028", "\x0c\u2028"):
+        for nl in ("\n", "\r\n", "\r"):
+            text = nl.join([header, f"1,2,3,4,1{end}", "", "1,2,x,4,1", ""])
+            (tmp_path / "word.csv").write_bytes(text.encode())
+            with pytest.raises(ValueError, match=r"word\.csv: line 4: could not convert"):
+                sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
 
 
 def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_path: Path) -> None:

@@ -370,8 +370,10 @@ class Matches:
                 head = fh.readline().strip()
                 if head != _CSV_HEADER:
                     raise ValueError(f"{path}: expected the header {_CSV_HEADER!r}, got {head!r}")
-                # (line number, text) of the non-blank rows, for the messages
-                lines = [(k, ln) for k, ln in enumerate(fh.read().splitlines(), 2) if ln.strip()]
+                # (line number, text) of the non-blank rows, for the messages; split at "\n"
+                # only (text mode has made "\r\n" and "\r" one): splitlines also split at a
+                # form feed or U+2028 within a row, and every line after it was named one on
+                lines = [(k, ln) for k, ln in enumerate(fh.read().split("\n"), 2) if ln.strip()]
         except UnicodeDecodeError as exc:
             raise ValueError(
                 f"{path}: not a CSV text file (a byte 0x{exc.object[exc.start]:02x} is not "
