@@ -410,6 +410,23 @@ try:
                 call()
             except (ValueError, MemoryError) as e:
                 print(f"{{type(e).__name__}}: {{e}}")
+    elif case == "shapes_before_copies":
+        # 12 GiB uint8 and 16 GiB float32 views of one value: a copy is a MemoryError here.
+        big = np.broadcast_to(np.uint8(5), (2**16, 2**16, 3))
+        grey = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
+        small = np.zeros((6, 8, 3), np.uint8)
+        mean, one = np.zeros((6, 8, 3), np.float32), np.zeros((6, 8), np.uint8)
+        d = np.ones((6, 8), np.float32)
+        for call in (
+            lambda: _core.temporal_grey_difference(big, mean),
+            lambda: _core.temporal_running_mean(big, mean, one, d, 2.0, 8),
+            lambda: _core.hopfield_match_u8(big, small, (0.1, 0.6, 0.3), {{}}),
+            lambda: _core.refine_disparity(grey, grey, d, d, *{refine_args}),
+        ):
+            try:
+                call()
+            except (ValueError, MemoryError) as e:
+                print(f"{{type(e).__name__}}: {{e}}")
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -432,7 +449,7 @@ def _under_address_limit(
 
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     return subprocess.run(
-        [sys.executable, "-c", _OOM_SCRIPT.format(case=case)],
+        [sys.executable, "-c", _OOM_SCRIPT.format(case=case, refine_args=REFINE_ARGS)],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -593,6 +610,23 @@ def test_mcgm_filter_counts_bad_rows_without_listing_them(case: str, message: st
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     n = 2**25
     assert f"ValueError: matches: {n} of {n} {message}" in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_the_other_arguments_shapes_are_checked_before_an_image_is_copied() -> None:
+    """``temporal_grey_difference``, ``temporal_running_mean`` and ``hopfield_match_u8`` copied
+    the frame or left image, and ``refine_disparity`` both images, before the shapes of the
+    other arguments were compared: a broadcast (65536, 65536, 3) frame with a mean of another
+    shape was the frame's 12 GiB copy (its MemoryError under ``ulimit -v``), not the mismatch."""
+    out = _under_address_limit("shapes_before_copies", 3_000_000 * 1024, timeout=120)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    assert out.stdout.splitlines() == [
+        "ValueError: mean shape [6, 8, 3] differs from the frame's [65536, 65536, 3]",
+        "ValueError: mean shape [6, 8, 3] differs from the frame's [65536, 65536, 3]",
+        "ValueError: left and right images must have the same shape, got left "
+        "[65536, 65536, 3] and right [6, 8, 3]",
+        "ValueError: disp: expected shape (65536, 65536) like left, got (6, 8)",
+    ], out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

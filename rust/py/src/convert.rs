@@ -235,6 +235,18 @@ pub fn map_and_confidence<'a>(
     (h, w): (usize, usize),
     like: &str,
 ) -> PyResult<(RowMajor<'a, f32>, RowMajor<'a, f32>)> {
+    check_map_shapes(disp, conf, (h, w), like)?;
+    Ok((row_major(disp, "disp")?, row_major(conf, "conf")?))
+}
+
+/// The shape check of [`map_and_confidence`] alone, for a caller that copies other arrays
+/// first (`refine_disparity` copied `left` and `right` before `disp`'s shape was checked).
+pub fn check_map_shapes(
+    disp: &PyReadonlyArray2<'_, f32>,
+    conf: &PyReadonlyArray2<'_, f32>,
+    (h, w): (usize, usize),
+    like: &str,
+) -> PyResult<()> {
     for (a, name) in [(disp, "disp"), (conf, "conf")] {
         if a.as_array().dim() != (h, w) {
             return Err(PyValueError::new_err(format!(
@@ -244,19 +256,19 @@ pub fn map_and_confidence<'a>(
             )));
         }
     }
-    Ok((row_major(disp, "disp")?, row_major(conf, "conf")?))
+    Ok(())
 }
 
-/// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)` (C 1, 3 or 4),
-/// its values in row-major order: its own buffer when C-contiguous, else a copy (a strided,
-/// reversed or Fortran-ordered view, e.g. one channel of a colour image, was refused with
-/// "must be C-contiguous").
-pub fn u8_layout<'a>(
-    a: &'a numpy::PyReadonlyArrayDyn<'_, u8>,
+/// `(H, W, C)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)` (C 1, 3 or 4), read
+/// from its shape alone: the callers check the other arguments' shapes against it before
+/// [`u8_layout`] copies anything (a frame or left image was copied, 4 GiB for a broadcast
+/// one, before a mean or right image of another shape was refused).
+pub fn u8_shape(
+    a: &numpy::PyReadonlyArrayDyn<'_, u8>,
     what: &str,
-) -> PyResult<(usize, usize, usize, Cow<'a, [u8]>)> {
-    let shape = a.shape().to_vec();
-    let (h, w, c) = match shape.as_slice() {
+) -> PyResult<(usize, usize, usize)> {
+    let shape = a.shape();
+    let (h, w, c) = match shape {
         [h, w] => (*h, *w, 1),
         [h, w, c] => (*h, *w, *c),
         _ => {
@@ -273,6 +285,17 @@ pub fn u8_layout<'a>(
             "{what}: expected 1, 3 or 4 channels, got {c} (shape {shape:?})"
         )));
     }
+    Ok((h, w, c))
+}
+
+/// `(H, W, C, data)` of an 8-bit image array ([`u8_shape`]), its values in row-major order:
+/// its own buffer when C-contiguous, else a copy (a strided, reversed or Fortran-ordered
+/// view, e.g. one channel of a colour image, was refused with "must be C-contiguous").
+pub fn u8_layout<'a>(
+    a: &'a numpy::PyReadonlyArrayDyn<'_, u8>,
+    what: &str,
+) -> PyResult<(usize, usize, usize, Cow<'a, [u8]>)> {
+    let (h, w, c) = u8_shape(a, what)?;
     Ok((h, w, c, row_major(a, what)?))
 }
 

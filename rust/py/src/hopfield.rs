@@ -15,7 +15,7 @@ use stereovision_core::matching::hopfield::{
 };
 use stereovision_core::parallel::run_hot;
 
-use crate::convert::{grey_from_numpy, image_to_numpy, u8_layout};
+use crate::convert::{grey_from_numpy, image_to_numpy, u8_layout, u8_shape};
 use crate::errors::{flat_rows, guard};
 use crate::params::{check_keys, get};
 
@@ -247,9 +247,10 @@ pub fn hopfield_match_u8<'py>(
 ) -> PyResult<MatchOut<'py>> {
     let left: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(left, "left")?;
     let right: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(right, "right")?;
-    let (h, w, c, ld) = u8_layout(&left, "left")?;
-    let (hr, wr, cr, rd) = u8_layout(&right, "right")?;
-    if (hr, wr, cr) != (h, w, c) {
+    // Both shapes before either copy: `left` was copied (4 GiB for a broadcast one) before a
+    // `right` of another shape was refused.
+    let (h, w, c) = u8_shape(&left, "left")?;
+    if u8_shape(&right, "right")? != (h, w, c) {
         return Err(PyValueError::new_err(format!(
             "left and right images must have the same shape, got left {:?} and right {:?}",
             left.shape(),
@@ -258,6 +259,8 @@ pub fn hopfield_match_u8<'py>(
     }
     let wts = crate::convert::luma_weights(weights)?;
     let (p, best) = parse_match(params)?;
+    let (_, _, _, ld) = u8_layout(&left, "left")?;
+    let (_, _, _, rd) = u8_layout(&right, "right")?;
     // Grey conversion and matcher in one hot region of the pool (`run_hot`): one wake-up of
     // the workers per call instead of one per parallel region.
     let out = crate::workers::detach(py, || {

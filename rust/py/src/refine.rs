@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use stereovision_core::refine::{refine_disparity as core_refine, FillPass, RefineParams};
 use stereovision_core::Image;
 
-use crate::convert::{grey_from_numpy, image_to_numpy, map_and_confidence};
+use crate::convert::{check_map_shapes, grey_from_numpy, image_to_numpy, map_and_confidence};
 use crate::errors::guard;
 
 type Refined<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>, usize);
@@ -40,9 +40,13 @@ pub fn refine_disparity<'py>(
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let conf: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(conf, "conf")?;
+    // The maps' shapes are checked before `left` and `right` are copied (a broadcast or
+    // strided `left` was copied, or its copy's MemoryError said, before a `disp` of another
+    // shape was refused).
+    let (h, w) = left.as_array().dim();
+    check_map_shapes(&disp, &conf, (h, w), "left")?;
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
-    let (w, h) = (l.view().width, l.view().height);
     let (d, c) = map_and_confidence(&disp, &conf, (h, w), "left")?;
     let p = RefineParams {
         base_sigma,

@@ -11,7 +11,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::temporal::{grey_difference, running_mean};
 
-use crate::convert::{row_major, u8_layout, vec_to_numpy};
+use crate::convert::{row_major, u8_layout, u8_shape, vec_to_numpy};
 use crate::errors::guard;
 
 /// The mean's values in row-major order, checked to have the frame's shape: its own buffer
@@ -39,8 +39,11 @@ pub fn temporal_grey_difference<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let frame: PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(frame, "frame")?;
     let mean: PyReadonlyArrayDyn<'py, f32> = crate::convert::array_arg(mean, "mean")?;
-    let (h, w, c, f) = u8_layout(&frame, "frame")?;
+    // The mean's shape before the frame's copy: the frame was copied (4 GiB for a broadcast
+    // one) before a mean of another shape was refused.
+    u8_shape(&frame, "frame")?;
     let m = mean_values(&mean, frame.shape())?;
+    let (h, w, c, f) = u8_layout(&frame, "frame")?;
     let d = crate::workers::detach(py, || {
         guard("temporal_grey_difference", || {
             grey_difference(&f, &m, h * w, c)
@@ -66,7 +69,7 @@ pub fn temporal_running_mean<'py>(
     let mut count: PyReadwriteArray2<'py, u8> = crate::convert::array_arg_rw(count, "count")?;
     let frame: PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(frame, "frame")?;
     let diff: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(diff, "diff")?;
-    let (h, w, c, f) = u8_layout(&frame, "frame")?;
+    let (h, w, _) = u8_shape(&frame, "frame")?;
     let shape = frame.shape().to_vec();
     if mean.shape() != shape.as_slice() {
         return Err(PyValueError::new_err(format!(
@@ -83,7 +86,6 @@ pub fn temporal_running_mean<'py>(
             )));
         }
     }
-    let d = row_major(&diff, "diff")?;
     // `mean` and `count` are written in place: no copy can stand for them. The error names
     // the one that is not C-contiguous (it named both).
     for (name, ok) in [
@@ -96,6 +98,10 @@ pub fn temporal_running_mean<'py>(
             )));
         }
     }
+    // Copied once every shape and layout is checked: the frame was copied (4 GiB for a
+    // broadcast one) before a mean, count or diff of another shape was refused.
+    let (_, _, c, f) = u8_layout(&frame, "frame")?;
+    let d = row_major(&diff, "diff")?;
     let (Ok(m), Ok(n)) = (mean.as_slice_mut(), count.as_slice_mut()) else {
         return Err(PyValueError::new_err("mean and count must be C-contiguous"));
     };
