@@ -360,10 +360,14 @@ try:
         a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
         row = [np.nan, 20, 26, 20] if case.endswith("nan") else [100, 20, 96, 20]
         m = np.broadcast_to(np.array(row, np.float32), (2**25, 4))
+        import resource
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         try:
             _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
         except ValueError as e:
             print("ValueError:", e)
+        # KiB on Linux: the matches' copy is reserved, not written, before the check
+        print("peak RSS grew by", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak)
     elif case == "mcgm_filter_huge":
         a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
         m = np.broadcast_to(np.array([30, 20, 26, 20], np.float32), (2**40, 4))
@@ -605,11 +609,14 @@ def test_mcgm_filter_counts_bad_rows_without_listing_them(case: str, message: st
     an unchecked ``collect``: 2**29 broadcast bad rows aborted the process (SIGABRT) under
     ``ulimit -v`` instead of refusing them with the count. The matches' copy (24 bytes a row)
     is reserved before the check now, so 2**29 rows are its MemoryError there; 2**25 fit and
-    are refused with the count."""
+    are refused with the count. At 2**25 a list of them (256 MiB) fits under the limit too:
+    the peak resident size says whether one was made (the copy is reserved, never written)."""
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     n = 2**25
     assert f"ValueError: matches: {n} of {n} {message}" in out.stdout, out.stdout
+    grew = int(out.stdout.split("peak RSS grew by")[1])
+    assert grew < 64 * 1024, f"{grew} KiB: the check holds something N-sized ({n} rows)"
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
