@@ -933,6 +933,28 @@ def test_a_map_or_confidence_of_another_shape_names_the_argument() -> None:
     np.testing.assert_array_equal(z, np.full_like(g, 12.5))  # 50 / (2 + 2)
 
 
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda a: _core.hopfield_interest(a),
+        lambda a: _core.mcgm_log(a, 2.0),
+        lambda a: _core.mcgm_curves(a, {}),
+    ],
+    ids=["hopfield_interest", "mcgm_log", "mcgm_curves"],
+)
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_kernels_taking_img_name_it_img(call: Callable[[np.ndarray], object], order: str) -> None:
+    """``hopfield_interest``, ``mcgm_log`` and ``mcgm_curves`` take ``img``: a float64 one was
+    "img: expected a float32 array", a NaN in it "image: image contains non-finite values",
+    an argument none of them has."""
+    a = np.zeros((20, 30), np.float32, order=order)
+    a[3, 4] = np.nan
+    with pytest.raises(ValueError, match=r"^img: image contains non-finite values .* at 1 pix"):
+        call(a)
+    with pytest.raises(TypeError, match=r"^img: expected a float32 array, got float64$"):
+        call(a.astype(np.float64))
+
+
 @pytest.mark.parametrize("right_shape", [(6, 8), (6, 10), (5, 9)])
 def test_lr_check_maps_must_have_one_shape(right_shape: tuple[int, int]) -> None:
     """A right map of another width was unasserted: a mutation audit comparing the heights

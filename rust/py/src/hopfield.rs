@@ -140,7 +140,7 @@ pub fn hopfield_interest<'py>(
     // the image is copied.
     let (h, w) = img.as_array().dim();
     stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
-    let im = grey_from_numpy(&img, "image")?;
+    let im = grey_from_numpy(&img, "img")?;
     let im = im.view();
     let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
     if !unit(rel_threshold) || !unit(floor_rel) || nms_half == 0 {

@@ -148,7 +148,7 @@ pub fn mcgm_log<'py>(
     }
     let (rows, cols) = img.as_array().dim();
     stereovision_core::image::check_index_range(cols, rows).map_err(crate::errors::to_pyerr)?;
-    let im = image_from_numpy(&img, "image")?;
+    let im = image_from_numpy(&img, "img")?;
     let (w, h) = im.size();
     let data = crate::workers::detach(py, || guard("mcgm_log", || log_filter(&im, sigma)))?;
     image_to_numpy(
@@ -262,7 +262,7 @@ pub fn mcgm_curves<'py>(
     params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyList>> {
     let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
-    let im = image_from_numpy(&img, "image")?;
+    let im = image_from_numpy(&img, "img")?;
     let p = self::params(params)?;
     let chans = crate::workers::detach(py, || guard("mcgm_curves", || image_curves(&im, &p)))?;
     let out = PyList::empty(py);
