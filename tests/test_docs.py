@@ -259,7 +259,9 @@ def test_every_default_a_help_text_names_is_the_parsers() -> None:
                 if not same:
                     wrong.append(f"{command} {action.option_strings}: {value!r}")
     assert not wrong, f"a help names another default than the parser's: {wrong}"
-    assert checked >= 20, checked  # the options above, not a pattern that matches nothing
+    # The options above, not a pattern that matches nothing (18 since 70673a2 and 9681991
+    # made --serve, --host and --fill/--no-fill default to None, applied where used).
+    assert checked >= 15, checked
 
 
 def test_board_side_options_say_their_unit() -> None:
