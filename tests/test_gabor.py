@@ -175,6 +175,57 @@ def test_the_reference_rounds_half_pixel_shifts_as_the_kernel() -> None:
     )
 
 
+def test_the_reference_computes_x_minus_d_in_float32_as_the_kernel() -> None:
+    """One float32 ulp from a half pixel, ``x - d`` rounds onto the tie in the kernel's float32
+    (``100 - 0.50000006`` is ``99.5``) but not in float64: the reference's Newton step read the
+    right stability one pixel off at every other pixel (confidence off by up to 0.83 at 12 % of
+    them, the update by 4 px), its search one pixel off, and its left-right check kept a pixel
+    matched past the row's end and dropped a difference the kernel's float32 makes exactly
+    ``tol``."""
+    left, right = _grey("middlebury2001/tsukuba", (slice(100, 160), slice(100, 220)))
+    chans = [ref.channel(0.25, t) for t in ref.ORIENTATIONS]
+    lv, rv = ref.level_data(left, chans), ref.level_data(right, chans)
+    thr2 = ref.thresholds2(lv, rv, 0.02)
+    up = np.float32(np.inf)
+    for d in (np.nextafter(np.float32(0.5), up), np.nextafter(np.float32(-1.5), up)):
+        disp = np.full(left.shape, d, np.float32)
+        d_ours, c_ours = _core.gabor_newton_step(left, right, disp)
+        d_ref, c_ref = ref.newton_step(lv, rv, chans, thr2, disp.astype(np.float64))
+        assert c_ours.max() > 0.5, d
+        assert np.abs(c_ours - c_ref).max() <= STEP_ATOL_CONF, d
+        assert np.abs(d_ours - d_ref).max() <= STEP_ATOL_PX, d
+    # x 119 (the last pixel) - (-0.49999997) is 119.5 in float32: 120, past the row; at x 10,
+    # 1.7 - 0.7 (dr at round(8.3)) is exactly 1 in float32 (1 + 6e-8 in float64): within tol 1.
+    dl = np.zeros((1, 120), np.float32)
+    dr = np.zeros_like(dl)
+    dl[0, 119] = np.nextafter(np.float32(-0.5), up)
+    dl[0, 10], dr[0, 8] = 1.7, 0.7
+    for mask in (
+        _core.gabor_lr_check(dl, dr, 1.0)[0],
+        ref.lr_check(dl.astype(np.float64), dr.astype(np.float64), 1.0)[0],
+    ):
+        assert not mask[119]
+        assert mask[10]
+    # The search's integer shift floor(x - d + 0.5) too: from min_disparity 0.50000006 the
+    # reference's one-level pipeline searched one pixel off (masks agreed at 95 %, 49 % of
+    # the pixels off by > 0.05).
+    d0 = float(np.nextafter(np.float32(0.5), up))
+    ours = gabor_disparity(
+        left,
+        right,
+        min_disparity=d0,
+        max_disparity=d0 + 12,
+        n_levels=1,
+        lr_check=False,
+        speckle_size=0,
+    ).disparity
+    want, _ = ref.disparity_one_level(left, right, d0, d0 + 12)
+    vo, vr = np.isfinite(ours), np.isfinite(want)
+    assert np.mean(vo == vr) >= PIPE_MASK_AGREE
+    assert vo.mean() > 0.5
+    assert np.mean(np.abs(ours - want)[vo & vr] <= PIPE_ATOL_PX) >= PIPE_SHARE
+
+
 def test_one_level_pipeline_matches_reference() -> None:
     crop = (slice(60, 180), slice(40, 240))
     left, right = _grey("middlebury2001/tsukuba", crop)

@@ -166,6 +166,21 @@ def thresholds2(lv: Level, rv: Level, amp_rel: float) -> list[float]:
     return out
 
 
+def _shift32(disp: np.ndarray) -> np.ndarray:
+    """``x - d`` as the kernel computes it: in float32 (one rounding), as float64.
+
+    Near a half pixel the float32 difference can round onto the tie (``100 - 0.50000006`` is
+    ``99.5``), which the rounding sites then send to the other pixel than float64 does.
+    """
+    x = np.arange(disp.shape[1], dtype=np.float32)[None, :]
+    return (x - disp.astype(np.float32)).astype(np.float64)
+
+
+def _round_away(s: np.ndarray) -> np.ndarray:
+    """``f32::round``: half away from zero (exact on float32 values held in float64)."""
+    return np.sign(s) * np.floor(np.abs(s) + 0.5)
+
+
 def _interp_row(v: np.ndarray, i0: np.ndarray, i1: np.ndarray, t: np.ndarray) -> np.ndarray:
     rows = np.arange(v.shape[0])[:, None]
     return v[rows, i0] + t * (v[rows, i1] - v[rows, i0])
@@ -180,8 +195,7 @@ def shifted(
     exactly. Returns ``(y_r(x - d), f_r(x - d), valid, nearest index)``.
     """
     h, w = disp.shape
-    x = np.arange(w)[None, :].astype(np.float64)
-    s = x - disp
+    s = _shift32(disp)
     valid = (s >= 0) & (s <= w - 1)
     sc = np.clip(s, 0, w - 1)
     i0 = np.minimum(np.floor(sc).astype(int), max(w - 2, 0))
@@ -231,23 +245,23 @@ def newton_step(
 def lr_check(dl: np.ndarray, dr: np.ndarray, tol: float = 1.0) -> np.ndarray:
     """``True`` where ``|dl(x) - dr(round(x - dl(x)))| <= tol`` (``dr`` on the right grid)."""
     h, w = dl.shape
-    x = np.arange(w)[None, :]
     with np.errstate(invalid="ignore"):
         # The kernel's rounding (f32::round): ties away from zero, so -0.5 is -1, outside.
-        s = x - dl
-        xr = np.sign(s) * np.floor(np.abs(s) + 0.5)
+        xr = _round_away(_shift32(dl))
         inside = np.isfinite(dl) & (xr >= 0) & (xr <= w - 1)
     xi = np.where(inside, xr, 0).astype(int)
     other = dr[np.arange(h)[:, None], xi]
     with np.errstate(invalid="ignore"):
-        return inside & (np.abs(dl - other) <= tol)
+        # the difference in float32 as in the kernel: 1.7 - 0.7 is 1 there, 1 + 6e-8 in float64
+        diff = np.abs(dl.astype(np.float32) - other.astype(np.float32))
+        return inside & (diff <= np.float32(tol))
 
 
 def energy_terms(lv: Level, rv: Level, disp: np.ndarray, off: float) -> tuple[np.ndarray, ...]:
     """Binocular energy terms at the integer shift ``round(d + off)`` (zero outside)."""
     h, w = disp.shape
-    x = np.arange(w)[None, :]
-    s = np.floor(x - (disp + off) + 0.5)
+    # The kernel: floor(x - d + 0.5) in float32, then the (integer) offset subtracted.
+    s = np.floor(_shift32(disp).astype(np.float32) + np.float32(0.5)).astype(np.float64) - off
     valid = (s >= 0) & (s <= w - 1)
     si = np.where(valid, s, 0).astype(int)
     rows = np.arange(h)[:, None]
@@ -315,6 +329,7 @@ def disparity_one_level(
         disp = np.where(cbar >= conf_min, np.clip(disp + dbar, d_min - 1.0, d_max + 1.0), disp)
         disp = median5(disp)
         conf = np.maximum(conf, cbar)
-    s = np.arange(w)[None, :] - disp
+    # The kernel's validity (post::validity_row): x - d itself (float32, not rounded) in the row.
+    s = _shift32(disp)
     valid = (conf >= conf_min) & (s >= 0) & (s <= w - 1)
     return np.where(valid, disp, np.nan), np.where(valid, np.clip(conf, 0, 1), 0.0)
