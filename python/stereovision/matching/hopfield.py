@@ -56,7 +56,7 @@ DEFAULTS: dict[str, Any] = {
     "floor_rel": 1e-4,  # ... but never below 0.01 % of the image's max (flat areas stay empty)
     "candidates": "row",  # "row": ZNCC peaks along the row (C.10); "points": right interest points
     "dy_window": 2,  # epipolar band for "points" (px, C.3)
-    "s_min": 0.8,  # minimum candidate ZNCC (the real gate, C.10)
+    "s_min": 0.8,  # minimum candidate ZNCC (the real gate, C.10); a flat window never passes
     "k_cand": 8,  # candidates per left point (C.3)
     "A": 3.0,  # compatibility weight (C.10)
     "B": 1.5,  # uniqueness inhibition (C.3)

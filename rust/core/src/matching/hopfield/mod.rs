@@ -64,6 +64,8 @@ pub struct HopfieldParams {
     /// Epipolar band `|y_l - y_r|` for [`CandidateMode::Points`] (px, C.3).
     pub dy_window: usize,
     /// Minimum ZNCC of a candidate (the real gate of the network, C.10).
+    /// A textureless left or right 7x7 window (undefined ZNCC, stored as 0) is never a
+    /// candidate, whatever `s_min` (even <= 0).
     pub s_min: f32,
     /// Candidates kept per left point (C.3; C.10: never binds).
     pub k_cand: usize,
