@@ -1296,3 +1296,21 @@ def test_debug_is_a_switch(value: object) -> None:
         mcgm.mcgm_match(img, right, max_disparity=8, debug=value)
     assert "channels" in mcgm.mcgm_match(img, right, max_disparity=8, debug=np.True_).stats
     assert "channels" not in mcgm.mcgm_match(img, right, max_disparity=8, debug=False).stats
+
+
+def test_filter_windows_past_the_image_are_the_whole_image_up_to_2_31() -> None:
+    """disc_dx, disc_dy and sides_gap are bounded below only: x + 2**31 - 1 wrapped in i32 to a
+    window ending before the match, so the discontinuity filter checked no neighbour (920
+    matches on a tsukuba crop where an image-wide window keeps 33 in x, 2 in y) and the
+    both-sides check indexed out of the image (an internal error)."""
+    left, right, _ = _crop("middlebury2001/tsukuba", (slice(100, 220), slice(100, 300)))
+
+    def run(**kw: int) -> np.ndarray:
+        m = mcgm.mcgm_match(left, right, max_disparity=16, **kw)
+        return np.stack([m.xl, m.yl, m.xr, m.yr])
+
+    default = run()
+    for key in ("disc_dx", "disc_dy", "sides_gap"):
+        wide = run(**{key: 10**6})
+        assert wide.shape[1] < default.shape[1] / 4, key
+        np.testing.assert_array_equal(run(**{key: 2**31 - 1}), wide, err_msg=key)

@@ -1337,8 +1337,10 @@ fn sides_ok(
     if yl - hh < 0 || yr - hh < 0 || yl + hh >= h || yr + hh >= h {
         return false;
     }
-    let inner = f.sides_gap + 1;
-    let outer = f.sides_gap + f.sides_width;
+    // Saturating: validate bounds sides_gap below only (>= 0): at i32::MAX the sums wrapped
+    // negative, passed the fit test and indexed out of the image (a panic).
+    let inner = f.sides_gap.saturating_add(1);
+    let outer = f.sides_gap.saturating_add(f.sides_width);
     if xi - outer < 0 || xi + outer >= w {
         return false;
     }
@@ -1652,8 +1654,11 @@ pub fn edge_filters(
                 return true;
             };
             let d = m.xl - m.xr;
-            let (x0, x1) = (x - f.disc_dx, x + f.disc_dx);
-            for yy in (y - f.disc_dy).max(0)..=(y + f.disc_dy).min(h as i32 - 1) {
+            // Saturating: a window past the image is the whole image (x + i32::MAX wrapped to a
+            // window ending before the match, which then checked no neighbour).
+            let (x0, x1) = (x.saturating_sub(f.disc_dx), x.saturating_add(f.disc_dx));
+            let (y0, y1) = (y.saturating_sub(f.disc_dy), y.saturating_add(f.disc_dy));
+            for yy in y0.max(0)..=y1.min(h as i32 - 1) {
                 let row = &items[start[yy as usize] as usize..start[yy as usize + 1] as usize];
                 let from = row.partition_point(|&(c, _)| c < x0);
                 for &(c, j) in &row[from..] {
