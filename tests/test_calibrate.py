@@ -1997,6 +1997,10 @@ def test_a_vertical_rigs_epipolar_error_is_taken_across_its_baseline(
     assert "rectified epipolar error |dx|: mean " in rep.summary()
     html = calmod._render_html(rep)
     assert "rectified |dx| mean" in html and "rectified |dy|" not in html
+    # its rectified pair is shown as OpenCV aligns it, by columns: one image above the other
+    # (rectify() refuses the rig; the report drew it side by side, lines along the rows)
+    picture = calmod._rectified_picture(rep)
+    assert picture is not None and picture.shape[0] > picture.shape[1]
     side_by_side = chessboard[1]
     assert side_by_side.epipolar_mean_dy < 0.3
     assert "rectified epipolar error |dy|: mean " in side_by_side.summary()

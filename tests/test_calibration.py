@@ -2038,3 +2038,57 @@ def test_from_file_takes_a_numpy_image_size_for_a_q_dat(data_dir: Path) -> None:
         as_array = Calibration.from_file(where, image_size=np.array([320, 240]))
         assert as_array == as_tuple
         assert as_array.image_size == (320, 240)
+
+
+def test_a_vertical_rig_is_refused_by_rectify_as_by_rectified_calibration(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A vertical rig (a ROS or Kalibr file, or calibrate's own result in Python) was rectified
+    by rectify() to columns without a word, though it says rows, and everything after it
+    (rectified_calibration, describe, depth) refuses the rig: `stereovision check --calib`
+    then said "pair NOT rectified ... the calibration no longer rectifies this rig:
+    recalibrate". rectify() and rectify_points() now refuse it as rectified_calibration()
+    does, for the pinhole and the fisheye model; a side-by-side rig is rectified as before."""
+    from stereovision.cli import main
+    from stereovision.rectification_check import check_rectification
+
+    rng = np.random.default_rng(3)
+    img = rng.integers(0, 255, (SIZE[1], SIZE[0]), dtype=np.uint8)
+    vertical = r"^R, T: the rig is vertical \((fisheye )?stereoRectify"
+    d = np.array([0.01, -0.002, 0.0003, 0.0])
+    for cal in (
+        raw_calib(T=np.array([0.002, -0.12, 0.003])),
+        raw_calib(T=np.array([0.002, -0.12, 0.003]), D1=d, D2=d, model="fisheye"),
+    ):
+        with pytest.raises(ValueError, match=vertical):
+            cal.rectified_calibration()
+        with pytest.raises(ValueError, match=vertical):
+            cal.rectify(img, img)
+        with pytest.raises(ValueError, match=vertical):
+            cal.rectify(img, img, alpha=1.0)
+        for side in ("left", "right"):
+            with pytest.raises(ValueError, match=vertical):
+                cal.rectify_points([[10.0, 20.0]], side)
+            with pytest.raises(ValueError, match=vertical):
+                cal.rectify_points(np.zeros((0, 2)), side)
+        with pytest.raises(ValueError, match=vertical):
+            check_rectification(img, img, calib=cal)
+    cal = raw_calib(T=np.array([0.002, -0.12, 0.003]))
+    cal.save(tmp_path / "vertical.yaml")
+    cv2.imwrite(str(tmp_path / "left.png"), img)
+    cv2.imwrite(str(tmp_path / "right.png"), np.roll(img, 5, axis=0))
+    pair = [str(tmp_path / "left.png"), str(tmp_path / "right.png")]
+    capsys.readouterr()
+    assert main(["check", *pair, "--calib", str(tmp_path / "vertical.yaml")]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.startswith("stereovision: error: R, T: the rig is vertical")
+    assert err.count("\n") == 1
+    # a side-by-side rig: unchanged
+    side_by_side = raw_calib()
+    rl, rr = side_by_side.rectify(img, img)
+    assert rl.shape == img.shape and rl.dtype == np.uint8 and rl.any()
+    m = side_by_side._maps(0.0)
+    assert np.array_equal(rl, cv2.remap(img, m[0], m[1], cv2.INTER_LINEAR))
+    assert np.array_equal(rr, cv2.remap(img, m[2], m[3], cv2.INTER_LINEAR))
+    p = side_by_side.rectify_points([[10.0, 20.0]], "right")
+    assert p.shape == (1, 2) and np.all(np.isfinite(p))

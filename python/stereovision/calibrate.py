@@ -1177,8 +1177,8 @@ def _rectified_checks(
     sides: list[F64] = []
     cols, rows = pattern
     for cl, cr, idx in zip(left, right, ids, strict=True):
-        ul = cal.rectify_points(cl, "left")
-        ur = cal.rectify_points(cr, "right")
+        ul = cal._moved_points(cl, "left", 0.0)  # a vertical rig's too, to columns
+        ur = cal._moved_points(cr, "right", 0.0)
         dys.append(np.abs(ul[:, across] - ur[:, across]))
         Xh = cv2.triangulatePoints(P1, P2, ul.T, ur.T)
         flat = np.full((rows * cols, 3), np.nan)
@@ -2315,17 +2315,24 @@ def _fit_width(img: np.ndarray) -> np.ndarray:
 
 
 def _rectified_picture(rep: CalibrationReport) -> np.ndarray | None:
-    """The sample pair rectified side by side, with horizontal epipolar lines."""
+    """The sample pair rectified side by side, with horizontal epipolar lines (a vertical rig's,
+    which OpenCV aligns by columns, one above the other with vertical lines)."""
     if rep._sample is None or rep._calibration is None:
         return None
     cal = rep._calibration
-    rl, rr = cal.rectify(rep._sample[1], rep._sample[2])
-    pair = np.hstack([cv2.cvtColor(im, cv2.COLOR_GRAY2BGR) for im in (rl, rr)])
-    h = pair.shape[0]
-    step = max(8, h // 16)
+    # not cal.rectify, which refuses a vertical rig: its report shows it as OpenCV rectifies it
+    rl, rr = cal._remap_pair(rep._sample[1], rep._sample[2], 0.0)
+    across = _across_baseline(cal._stereo_rectify(0.0)[3])
+    pair = (np.hstack if across else np.vstack)(
+        [cv2.cvtColor(im, cv2.COLOR_GRAY2BGR) for im in (rl, rr)]
+    )
+    h, w = pair.shape[:2]
+    along = h if across else w
+    step = max(8, along // 16)
     colors = [(0, 0, 255), (0, 200, 0), (255, 0, 0), (0, 200, 255)]
-    for k, y in enumerate(range(step // 2, h, step)):
-        cv2.line(pair, (0, y), (pair.shape[1] - 1, y), colors[k % len(colors)], 1, cv2.LINE_AA)
+    for k, v in enumerate(range(step // 2, along, step)):
+        a, b = ((0, v), (w - 1, v)) if across else ((v, 0), (v, h - 1))
+        cv2.line(pair, a, b, colors[k % len(colors)], 1, cv2.LINE_AA)
     _label(pair, f"rectified pair {rep._sample[0]}", (8, 22), 0.6, (0, 0, 255))
     return _fit_width(pair)
 

@@ -721,6 +721,24 @@ class Calibration:
         out: tuple[F64, F64, F64, F64, F64] = self._cache[key]
         return out
 
+    def _check_horizontal(self, alpha: float) -> None:
+        """Refuse a vertical rig, which nothing here matches: ``cv2.stereoRectify`` aligns its
+        columns, not its rows, and ``cv2.fisheye.stereoRectify`` turns its views instead."""
+        r1, _, _, p2, _ = self._stereo_rectify(alpha)
+        if abs(p2[1, 3]) > abs(p2[0, 3]):
+            raise ValueError(
+                "R, T: the rig is vertical (stereoRectify produced a vertical baseline); "
+                "only horizontal rigs are supported"
+            )
+        if abs(r1[0, 1]) > abs(r1[0, 0]):
+            # cv2.fisheye.stereoRectify always puts the baseline along x: for a vertical
+            # rig it turns both views by about 90 degrees instead (width and height swap)
+            raise ValueError(
+                "R, T: the rig is vertical (fisheye stereoRectify turned the views "
+                f"{abs(math.degrees(math.atan2(r1[0, 1], r1[0, 0]))):.0f} degrees to lay its "
+                "baseline along the rows); only horizontal rigs are supported"
+            )
+
     def valid_roi(
         self, alpha: float = 0.0
     ) -> tuple[tuple[int, int, int, int], tuple[int, int, int, int]]:
@@ -797,8 +815,9 @@ class Calibration:
         Raises
         ------
         ValueError
-            If an image is not an image array or its size differs from ``image_size``, or
-            ``alpha`` is outside ``[0, 1]``.
+            If an image is not an image array or its size differs from ``image_size``,
+            ``alpha`` is outside ``[0, 1]``, or the rig is vertical (as
+            :meth:`rectified_calibration`).
         """
         la = as_image_array(left, "left")
         ra = as_image_array(right, "right")
@@ -811,6 +830,15 @@ class Calibration:
         _check_alpha(alpha)  # also of a rectified calibration: alpha=5 passed there unsaid
         if self.rectified:
             return la, ra
+        # a vertical rig came out aligned by columns without a word, and `stereovision check`
+        # then said "the calibration no longer rectifies this rig: recalibrate"
+        self._check_horizontal(alpha)
+        return self._remap_pair(la, ra, alpha)
+
+    def _remap_pair(
+        self, la: np.ndarray, ra: np.ndarray, alpha: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`rectify`'s warp, of a vertical rig too (to columns: calibrate's report)."""
         m1x, m1y, m2x, m2y = self._maps(alpha)
         from stereovision._validate import remap_image
 
@@ -844,14 +872,21 @@ class Calibration:
         Raises
         ------
         ValueError
-            For points not of shape ``(N, 2)``, an unknown ``side`` or ``alpha`` outside
-            ``[0, 1]``.
+            For points not of shape ``(N, 2)``, an unknown ``side``, ``alpha`` outside
+            ``[0, 1]``, or a vertical rig (as :meth:`rectify`).
         """
         pts = xy_points(points)
         if side not in ("left", "right"):
             raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
         _check_alpha(alpha)  # also of a rectified calibration or no points
-        if self.rectified or len(pts) == 0:
+        if self.rectified:
+            return pts.copy()
+        self._check_horizontal(alpha)
+        return self._moved_points(pts, side, alpha)
+
+    def _moved_points(self, pts: F64, side: str, alpha: float) -> F64:
+        """:meth:`rectify_points`' mapping, of a vertical rig too (calibrate's checks)."""
+        if len(pts) == 0:
             return pts.copy()
         r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
         K, D, r, p = (self.K1, self.D1, r1, p1) if side == "left" else (self.K2, self.D2, r2, p2)
@@ -895,20 +930,8 @@ class Calibration:
             return self
         key = ("rectified_calibration", float(alpha))
         if key not in self._cache:
-            r1, _, p1, p2, _ = self._stereo_rectify(alpha)
-            if abs(p2[1, 3]) > abs(p2[0, 3]):
-                raise ValueError(
-                    "R, T: the rig is vertical (stereoRectify produced a vertical baseline); "
-                    "only horizontal rigs are supported"
-                )
-            if abs(r1[0, 1]) > abs(r1[0, 0]):
-                # cv2.fisheye.stereoRectify always puts the baseline along x: for a vertical
-                # rig it turns both views by about 90 degrees instead (width and height swap)
-                raise ValueError(
-                    "R, T: the rig is vertical (fisheye stereoRectify turned the views "
-                    f"{abs(math.degrees(math.atan2(r1[0, 1], r1[0, 0]))):.0f} degrees to lay its "
-                    "baseline along the rows); only horizontal rigs are supported"
-                )
+            self._check_horizontal(alpha)
+            _, _, p1, p2, _ = self._stereo_rectify(alpha)
             token = _DERIVING.set(True)
             try:
                 self._cache[key] = Calibration(
