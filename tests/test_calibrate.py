@@ -1400,6 +1400,45 @@ def test_names_numbered_by_capture_second_keep_their_pairs() -> None:
         calmod._pair_by_number(lefts, rights)
 
 
+def test_a_number_all_of_a_cameras_names_share_is_not_the_pairs(
+    cached_corners: None, tmp_path: Path
+) -> None:
+    """Names carrying the camera's index last (pair01_cam0.jpg, pair01_cam1.jpg) were read by
+    that last number, 0 for every left image and 1 for every right one: calibrate warned that
+    "the left and right file numbers differ in" every pair and that "a missing or extra file
+    shifts the pairing", though none does, and the CLI did not pair them on the pair's number
+    (one left and one other right file deleted went mis-paired unsaid). The number taken is
+    now the last one that differs between a camera's names."""
+    lefts = [f"pair{i:02d}_cam0.jpg" for i in range(1, 11)]
+    rights = [f"pair{i:02d}_cam1.jpg" for i in range(1, 11)]
+    assert calmod._numbers_differ(lefts, rights, lefts) == []
+    assert calmod._numbers_differ(lefts, [*rights[:4], *rights[5:], rights[4]], lefts) != []
+    assert calmod._pair_by_number(lefts, rights[::-1]) == rights
+    gone_l = [f for f in lefts if f != "pair05_cam0.jpg"]
+    gone_r = [f for f in rights if f != "pair09_cam1.jpg"]
+    with pytest.raises(
+        ValueError, match=r"pair09_cam0\.jpg \(no right\), pair05_cam1\.jpg \(no left\)"
+    ):
+        calmod._pair_by_number(gone_l, gone_r)
+    # a number only some names carry alike, or a single name: the last one, as before
+    assert calmod._file_numbers(["a7_1.png", "a8_1.png", None]) == [7, 8, None]
+    assert calmod._file_numbers(["left06.jpg"]) == [6]
+    assert calmod._file_numbers(["l3_0.png", "l12.png"]) == [0, 12]
+    # calibrate itself: OpenCV's pairs under such names, no warning
+    for k, (left, right) in enumerate(zip(*_chessboard_paths(), strict=True)):
+        if k == 5:
+            break
+        (tmp_path / f"pair{k:02d}_cam0.jpg").write_bytes(left.read_bytes())
+        (tmp_path / f"pair{k:02d}_cam1.jpg").write_bytes(right.read_bytes())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _, rep = calibrate(
+            sorted(tmp_path.glob("*_cam0.jpg")), sorted(tmp_path.glob("*_cam1.jpg")),
+            square_size=1.0,
+        )  # fmt: skip
+    assert len(rep.used_pairs) == 5 and rep.warnings == []
+
+
 def test_numbers_shifted_by_a_constant_are_paired_in_order() -> None:
     """Each camera's counter started elsewhere (left_0001..0020, right_0011..0030): the pairs
     are taken in order, said in one line. With the runs overlapping, the number pairing refused

@@ -1285,6 +1285,22 @@ def _file_number(name: str | None) -> int | None:
     return int(digits[-1]) if digits else None
 
 
+def _file_numbers(names: Sequence[str | None]) -> list[int | None]:
+    """Each name's number (:func:`_file_number`) taken from one place in the names of one
+    camera: the last number that differs between them. A number every name of the side
+    carries alike (the camera's index in ``pair03_cam1.jpg``) is not the pair's: the
+    pairs were then said to carry different numbers, and the names did not pair on them."""
+    groups = [re.findall(r"\d+", Path(n).stem) if n else [] for n in names]
+    known = [g for g in groups if g]
+    at = -1
+    if len(known) >= 2 and len({len(g) for g in known}) == 1:
+        for j in range(len(known[0]) - 1, -1, -1):
+            if len({int(g[j]) for g in known}) > 1:
+                at = j - len(known[0])
+                break
+    return [int(g[at]) if g else None for g in groups]
+
+
 def _constant_shift(kl: Sequence[int | None], kr: Sequence[int | None]) -> int | None:
     """``d`` when the right numbers are the left ones + ``d`` (``d != 0``), both an unbroken
     run of as many numbers (``left_0001..0020`` and ``right_0101..0120``, in any order) that
@@ -1311,7 +1327,7 @@ def _numbers_differ(
     """Pairs whose left and right file names both carry a number, and not the same one; none
     when the numbers of two unbroken runs differ by one constant in every pair
     (:func:`_constant_shift`: each camera's counter started elsewhere, nothing shifted)."""
-    kl, kr = [_file_number(a) for a in left_names], [_file_number(b) for b in right_names]
+    kl, kr = _file_numbers(left_names), _file_numbers(right_names)
     shift = _constant_shift(kl, kr)
     if shift is not None and all(
         a is not None and b is not None and b - a == shift for a, b in zip(kl, kr, strict=True)
@@ -2683,8 +2699,7 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     ValueError
         If the numbers pair most images but some have no partner (named, the first few).
     """
-    kl = [_file_number(f) for f in lefts]
-    kr = [_file_number(f) for f in rights]
+    kl, kr = _file_numbers(lefts), _file_numbers(rights)
     if None in kl or None in kr or len(set(kl)) != len(kl) or len(set(kr)) != len(kr):
         return rights
     by_number = dict(zip(kr, rights, strict=True))
