@@ -749,14 +749,22 @@ class CameraState:
 
 
 def _pv() -> Any:
-    import pyvista as pv
+    """pyvista, imported with Ctrl-C held: a KeyboardInterrupt raised while one of VTK's
+    extension modules initialises crashed the process (SIGSEGV, exit 139, 6 of 30 Ctrl-Cs
+    during the import), as ``gui`` interrupted on its way up. The signal is raised once VTK is
+    whole (:class:`~stereovision._interrupt.HeldInterrupts`), so Ctrl-C still stops it."""
+    from stereovision._interrupt import HeldInterrupts
 
-    if not _has_display():
-        # Without X, VTK tries the X window first and logs "bad X server connection" before it
-        # falls back to offscreen rendering: harmless, but it reads like an error in CLI output.
-        import vtk
+    with HeldInterrupts():
+        import pyvista as pv
 
-        vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
+        if not _has_display():
+            # Without X, VTK tries the X window first and logs "bad X server connection" before
+            # it falls back to offscreen rendering: harmless, but it reads like an error in CLI
+            # output.
+            import vtk
+
+            vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
     return pv
 
 

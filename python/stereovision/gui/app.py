@@ -1423,11 +1423,10 @@ class StereoApp:
         sizeless_calib: tuple[str, str | None] | None = None,
         read_timeout: float | None = DEFAULT_READ_TIMEOUT,
     ) -> None:
-        import pyvista as pv
-
         from stereovision.depth import METHODS
-        from stereovision.render import make_plotter
+        from stereovision.render import _pv, make_plotter
 
+        pv = _pv()  # VTK's first import, Ctrl-C held: an interrupt inside it crashed the process
         pv.OFF_SCREEN = True
         self.server = server
         self.state = server.state
