@@ -212,6 +212,46 @@ def test_a_program_calling_the_gui_gets_its_signal_handlers_back(signum: int) ->
     assert (proc.returncode, out) == (0, f"{status} [True, True] -1 [2, 15]\n"), err
 
 
+_CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS = _CALLER_OF_THE_GUI.replace(
+    "status = gui.main(",
+    "from stereovision.gui.app import StereoApp\n"
+    "def fails(self):\n"
+    "    raise OSError('the camera did not close')\n"
+    "StereoApp.stop_work = fails\n"
+    "status = gui.main(",
+)
+
+
+def test_the_callers_signal_handlers_come_back_when_the_close_fails() -> None:
+    """The handlers were put back after the camera's close: a close that raised left them the
+    stopped loop's (a no-op, a wakeup fd into its pipe), the caller's Ctrl+C ignored."""
+    import threading
+
+    pytest.importorskip("trame")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
+    watchdog.start()
+    try:
+        line = proc.stdout.readline()  # the server listens: its signal handlers are set
+        watchdog.cancel()
+        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        watchdog.cancel()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=30)
+    # the close's error said (not the interrupt), then the caller's handlers heard both
+    assert (proc.returncode, out) == (0, "2 [True, True] -1 [2, 15]\n"), err
+    assert err == "stereovision: error: the camera did not close\n"
+
+
 def test_gui_on_a_busy_port_says_so_in_one_line():
     """A busy port: the address was announced first, then
     ``[Errno 98] error while attempting to bind on address ...``. Now nothing is announced and

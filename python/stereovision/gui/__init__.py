@@ -260,11 +260,14 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise err from exc
     finally:
         sys.argv = argv
-        app.stop_work()  # the computation under way is not waited for (a Save is)
-        if app.source is not None:
-            app.source.close()
-        # last: until the Save is whole and the camera closed, a second signal stays the loop's
-        _restore_signals(kept, loops)
+        try:
+            app.stop_work()  # the computation under way is not waited for (a Save is)
+            if app.source is not None:
+                app.source.close()
+        finally:
+            # last: until the Save is whole and the camera closed, a second signal stays the
+            # loop's; put back even if the close failed (its error left them the loop's)
+            _restore_signals(kept, loops)
     return 0
 
 
