@@ -1314,3 +1314,40 @@ def test_filter_windows_past_the_image_are_the_whole_image_up_to_2_31() -> None:
         wide = run(**{key: 10**6})
         assert wide.shape[1] < default.shape[1] / 4, key
         np.testing.assert_array_equal(run(**{key: 2**31 - 1}), wide, err_msg=key)
+
+
+def _sine_pair() -> tuple[np.ndarray, np.ndarray]:
+    yy, xx = np.mgrid[0:60, 0:90].astype(np.float32)
+
+    def scene(s: float) -> np.ndarray:
+        return (0.5 + 0.4 * np.sin((xx + s) / 5.0) * np.cos(yy / 7.0)).astype(np.float32)
+
+    return scene(0.0), scene(3.4)
+
+
+def test_filter_windows_near_the_int32_limit_are_the_whole_image() -> None:
+    """sides_gap 2**31 - 1 wrapped the half-window's outer column negative: mcgm_match raised
+    "RuntimeError: internal error in mcgm_match: index out of bounds"; disc_dx / disc_dy of
+    2**31 - 1 wrapped x + disc_dx negative and the filter kept every match. Now no half-window
+    fits (no match kept), and the discontinuity filter looks along the whole row / column."""
+    left, right = _sine_pair()
+    for gap in (2**31 - 1, 2**31 - 6, 90):
+        m = mcgm.mcgm_match(left, right, max_disparity=8, sides_gap=gap)
+        assert len(m) == 0 and m.stats["n_sides"] == 0, gap
+    ones = {"sides": False, "zncc_check": False}
+    for name, whole in (("disc_dx", 90), ("disc_dy", 60)):
+        huge = mcgm.mcgm_match(left, right, max_disparity=8, **ones, **{name: 2**31 - 1})
+        want = mcgm.mcgm_match(left, right, max_disparity=8, **ones, **{name: whole})
+        assert huge.stats["n_disc"] == want.stats["n_disc"], name
+        assert huge.stats["n_disc"] < huge.stats["n_combined"], name
+        np.testing.assert_array_equal(huge.xl, want.xl)
+
+
+@pytest.mark.parametrize("deg", [90.5, 180, 2**32, 1e30])
+def test_horiz_skip_deg_beyond_90_is_refused(deg: float) -> None:
+    """An angle to the horizontal: above 90 its sine came round again (180 skipped no pixel, as
+    0 does; 2**32 and 1e30 whatever their sine gave) and was taken without a word."""
+    left, right = _sine_pair()
+    with pytest.raises(ValueError, match=r"horiz_skip_deg.*must be in \[0, 90\] degrees"):
+        mcgm.mcgm_match(left, right, max_disparity=8, horiz_skip_deg=deg)
+    assert len(mcgm.mcgm_match(left, right, max_disparity=8, horiz_skip_deg=90)) == 0

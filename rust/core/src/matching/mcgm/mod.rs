@@ -378,6 +378,14 @@ fn validate_params(p: &McgmParams) -> Result<()> {
             ));
         }
     }
+    // An angle to the horizontal: above 90 degrees its sine (the skip's threshold) came round
+    // again, 180 skipping nothing and 1e30 what sin(1e30 deg) happened to give.
+    if p.horiz_skip_deg > 90.0 {
+        return Err(CoreError::param(
+            "horiz_skip_deg",
+            format!("must be in [0, 90] degrees, got {}", p.horiz_skip_deg),
+        ));
+    }
     p.filters.validate()?;
     if !(0..=MAX_RADIUS).contains(&p.fill_radius) {
         return Err(CoreError::param(
@@ -1337,11 +1345,11 @@ fn sides_ok(
     if yl - hh < 0 || yr - hh < 0 || yl + hh >= h || yr + hh >= h {
         return false;
     }
-    // Saturating: validate bounds sides_gap below only (>= 0): at i32::MAX the sums wrapped
-    // negative, passed the fit test and indexed out of the image (a panic).
+    // Saturating and in i64: a `sides_gap` near i32::MAX (validate takes any >= 0) wrapped
+    // `outer` negative, and columns far outside the image were indexed (a panic).
     let inner = f.sides_gap.saturating_add(1);
     let outer = f.sides_gap.saturating_add(f.sides_width);
-    if xi - outer < 0 || xi + outer >= w {
+    if i64::from(xi) - i64::from(outer) < 0 || i64::from(xi) + i64::from(outer) >= i64::from(w) {
         return false;
     }
     let fits =
@@ -1654,8 +1662,8 @@ pub fn edge_filters(
                 return true;
             };
             let d = m.xl - m.xr;
-            // Saturating: a window past the image is the whole image (x + i32::MAX wrapped to a
-            // window ending before the match, which then checked no neighbour).
+            // Saturating: `x + disc_dx` of a disc_dx near i32::MAX wrapped negative and the
+            // neighbourhood was empty (every match kept), where it is the whole row.
             let (x0, x1) = (x.saturating_sub(f.disc_dx), x.saturating_add(f.disc_dx));
             let (y0, y1) = (y.saturating_sub(f.disc_dy), y.saturating_add(f.disc_dy));
             for yy in y0.max(0)..=y1.min(h as i32 - 1) {

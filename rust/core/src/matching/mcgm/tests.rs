@@ -1956,6 +1956,90 @@ fn discontinuity_filter_neighbourhood_and_tolerance() {
     }
 }
 
+/// Window sizes near i32::MAX (the binding takes any i32 >= 0) act as the whole image: a
+/// `disc_dx` / `disc_dy` of i32::MAX wrapped `x + disc_dx` negative (every match kept; a panic
+/// in a debug build), and a `sides_gap` near it wrapped the half-window's outer column
+/// negative and indexed far outside the image (a panic, `_core.mcgm_match`'s "internal error").
+#[test]
+fn huge_filter_windows_are_the_whole_image() {
+    let img = Image::filled(40, 30, 0.5).unwrap();
+    let f = FilterParams {
+        sides: false,
+        zncc_check: false,
+        ..FilterParams::default()
+    };
+    let base = match_at(20.0, 15.0, 5.0);
+    for (dx, dy, x, y, expect) in [
+        (i32::MAX, 2, 2.0, 15.0, [false, false]),
+        (40, 2, 2.0, 15.0, [false, false]),
+        (i32::MAX, 2, 2.0, 16.0, [false, false]),
+        (i32::MAX, 0, 2.0, 16.0, [true, true]),
+        (6, i32::MAX, 20.0, 1.0, [false, false]),
+        (6, 30, 20.0, 1.0, [false, false]),
+        (i32::MAX, i32::MAX, 38.0, 28.0, [false, false]),
+        (0, i32::MAX, 21.0, 28.0, [true, true]),
+    ] {
+        let g = FilterParams {
+            disc_dx: dx,
+            disc_dy: dy,
+            ..f
+        };
+        let ms = [base, match_at(x, y, 7.0)];
+        let (keep, counts) = edge_filters(&img, &img, &ms, &g, (0, 16)).unwrap();
+        assert_eq!(keep, expect, "disc_dx {dx} disc_dy {dy}: ({x}, {y})");
+        assert_eq!(counts.disc, expect.iter().filter(|&&k| k).count());
+    }
+    // No half-window of `sides_gap + 1 ..= sides_gap + sides_width` columns fits: nothing kept.
+    let (l, r) = (blobs(64, 40, 0.0), blobs(64, 40, 3.0));
+    let ms: Vec<Match> = (0..64).map(|x| match_at(x as f32, 20.0, 0.0)).collect();
+    let sides = FilterParams {
+        sides_mad: 1.0,
+        sides_best: false,
+        disc: false,
+        zncc_check: false,
+        ..FilterParams::default()
+    };
+    for gap in [i32::MAX, i32::MAX - 5, i32::MAX - 6, 1 << 30, 64] {
+        let g = FilterParams {
+            sides_gap: gap,
+            ..sides
+        };
+        let (keep, _) = edge_filters(&l, &r, &ms, &g, (0, 16)).unwrap();
+        assert!(keep.iter().all(|&k| !k), "sides_gap {gap}");
+    }
+    // ... and the limit itself still keeps what fits.
+    let (keep, _) = edge_filters(&l, &r, &ms, &sides, (0, 16)).unwrap();
+    assert!(keep.iter().any(|&k| k));
+}
+
+/// `horiz_skip_deg` is an angle to the horizontal, [0, 90]: beyond 90 its sine came round
+/// again (180 skipped nothing, as 0; 2**32 and 1e30 whatever their sine gave).
+#[test]
+fn horiz_skip_deg_beyond_90_is_refused() {
+    let (l, r) = (blobs(90, 60, 0.0), blobs(90, 60, 3.0));
+    for bad in [90.5f32, 180.0, 4_294_967_296.0, 1e30] {
+        let p = McgmParams {
+            horiz_skip_deg: bad,
+            ..McgmParams::default()
+        };
+        let err = mcgm_match(&l, &r, &p).unwrap_err();
+        assert!(
+            matches!(&err, CoreError::InvalidParameter { name, .. } if *name == "horiz_skip_deg"),
+            "{bad}: {err}"
+        );
+    }
+    // 90 skips every tangent but the exactly vertical ones; 0 skips none.
+    let at = |deg: f32| {
+        let p = McgmParams {
+            horiz_skip_deg: deg,
+            ..McgmParams::default()
+        };
+        mcgm_match(&l, &r, &p).unwrap().n_combined
+    };
+    let (none, some, all) = (at(0.0), at(20.0), at(90.0));
+    assert!(none > some && some > all, "{none} {some} {all}");
+}
+
 /// A segment's disparity window: the lower median of the prior at its pixels' centres in
 /// full-resolution pixels (`2 x + 1` at half resolution), divided by the scale, floor / ceil
 /// of `+- width`, clipped to the channel's range.
