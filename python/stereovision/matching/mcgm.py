@@ -74,7 +74,8 @@ DEFAULTS: dict[str, Any] = {
     "dg_slope": 10.0,  # steepness of the compatibility sigmoid (B.2)
     "max_sweeps": 100,  # bound on network sweeps
     "seed": 0,  # update-order seed
-    "horiz_skip_deg": 20.0,  # no per-pixel disparity where the tangent is this near horizontal
+    # no per-pixel disparity where the tangent is this near horizontal (degrees, 0 to 90)
+    "horiz_skip_deg": 20.0,
     "prior_radius_sigmas": 4.0,  # coarse prior spread radius, in coarse sigmas (B.4.11)
     "prior_width_sigmas": 2.0 * float(np.sqrt(2.0)),  # window around the prior, fine sigmas
     "fill_radius": 1,  # coarser matches only where no finer one within +- 1 column
