@@ -1031,3 +1031,61 @@ def test_fused_dense_speckle_area_rounds_down_as_its_docstring_says() -> None:
     assert kept[5, 5] == 30.0 and np.isnan(dropped[5, 5])
     assert np.isnan(dropped).sum() == 1 and not np.isnan(kept).any()
     assert "int(speckle_area * H * W)" in (fused_dense.__doc__ or "")
+
+
+def test_the_docs_settings_are_the_codes_defaults() -> None:
+    """The settings refine.md, fusion.md and the README state in prose (the audit of
+    2026-12-06 checked each by hand against the code) are each held to the default they
+    describe: a default changed without its page (or the reverse) fails here."""
+    from stereovision import refine
+    from stereovision.calibrate import DEFAULT_READ_TIMEOUT
+    from stereovision.matching import planes, sgm
+    from stereovision.matching.fusion import _EDGE_MEMBERS, DENSE_DEFAULTS, census_clear
+
+    r, d, s = refine.DEFAULTS, DENSE_DEFAULTS, sgm.DEFAULTS
+    (step1, min1), (step2, min2) = planes.DEFAULTS["passes"]
+    [(fill_sigma, fill_zncc)] = r["fills"]
+    assert r["step"] == 0.5  # refine.md: "half a pixel apart"
+    clear = inspect.signature(census_clear).parameters
+    words = {3: "three", 5: "five", 7: "seven", 9: "nine"}
+    area = f"{d['speckle_area']:.0e}".replace("e-0", "e-")  # 5e-5, as the page writes it
+    said = {
+        "refine.md": [
+            f"three box passes, sigma {r['base_sigma']:g} px",
+            f"for {words[2 * r['search'] + 1]} shifts `s` half a pixel apart",
+            f"(sigma {r['win_sigma']:g} px, {2 * r['win_radius'] + 1} x {2 * r['win_radius'] + 1})",
+            f"sigma {fill_sigma:g} px: on KITTI's",
+            f"within {r['fill_search']} px of it (whole-pixel shifts)",
+            f"ZNCC is at least {fill_zncc:g}",
+            f"get a depth, confidence {r['fill_confidence']:g}",
+        ],
+        "fusion.md": [
+            f"a member within {d['radius']:g} px vetoes a Gabor value more than {d['tau']:g} px",
+            f"holes within {d['fill_radius']:g} px of a member take its value",
+            f"differ by more than {d['second_tol']:g} px the pixel becomes a hole",
+            f"takes its value (confidence {d['second_confidence']:g}, with a depth)",
+            f"stands more than {d['occlusion_tau']:g} px above the row fill",
+            f"fewer pixels than {area} of the image rounded down: "
+            f"{int(d['speckle_area'] * 450 * 375)} at 450x375",
+            f"a disparity jump of more than {d['edge_jump']:g} px",
+            f"looks {d['edge_radius']} px either side",
+            f"(sigma {planes.DEFAULTS['blur']:g} px) and quantised in steps of {step1} grey",
+            f"(median residual at most {planes.DEFAULTS['max_residual']:g} px, {min1} measured",
+            f"(steps of {step2} levels, {min2} measured pixels or more",
+            f"Its settings (P1 {s['p1']}, P2 {s['p2']} halved per {s['gamma']:g} grey levels",
+            f"uniqueness {s['uniqueness']} %, left-right {s['lr_tol']} level)",
+            f"more than {clear['jump'].default:g} px below the member's disparity within "
+            f"{clear['radius'].default} px",
+            f"{_EDGE_MEMBERS[0]} px either side, an intensity step {_EDGE_MEMBERS[1]:g} x",
+        ],
+        "README.md": [
+            f"--read-timeout 30 # a camera slow to open or start (default "
+            f"{DEFAULT_READ_TIMEOUT:g} s)"
+        ],
+    }
+    unsaid = []
+    for name, phrases in said.items():
+        page = ROOT / ("README.md" if name == "README.md" else f"docs/{name}")
+        text = " ".join(page.read_text().split())
+        unsaid += [f"{name}: {p!r}" for p in phrases if p not in text]
+    assert not unsaid, f"the docs do not say the code's defaults: {unsaid}"
