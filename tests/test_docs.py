@@ -261,7 +261,15 @@ def test_every_default_a_help_text_names_is_the_parsers() -> None:
     assert not wrong, f"a help names another default than the parser's: {wrong}"
     # The options above, not a pattern that matches nothing (18 since 70673a2 and 9681991
     # made --serve, --host and --fill/--no-fill default to None, applied where used).
-    assert checked >= 15, checked
+    assert checked >= 18, checked
+    # stream --serve and --host are held to FrameServer's own defaults, applied where served.
+    from stereovision.stream import FrameServer
+
+    server = inspect.signature(FrameServer.__init__).parameters
+    stream = commands.choices["stream"]
+    for option, param in (("--serve", "port"), ("--host", "host")):
+        action = next(a for a in stream._actions if option in a.option_strings)
+        assert f"(default {server[param].default})" in (action.help or ""), (option, action.help)
 
 
 def test_board_side_options_say_their_unit() -> None:
