@@ -197,3 +197,20 @@ def test_a_one_channel_texture_gives_a_one_channel_image() -> None:
     assert one.shape == (60, 80, 1) and one.dtype == np.uint8
     np.testing.assert_array_equal(one[:, :, 0], grey)
     assert render_plane(np.dstack([tex] * 4), *args, **kw).shape == (60, 80, 4)
+
+
+def test_the_fisheye_solve_reads_k_as_opencv_does_skew_ignored() -> None:
+    """cv2.fisheye's undistortPoints and distortPoints ignore K's skew K[0, 1] (the rays of
+    the pixels they solve are those of the unskewed K), but the solve past theta_d = 90
+    degrees subtracted K[0, 1] y: its ray then failed the round trip through distortPoints,
+    and every such pixel saw the background (K[0, 1] = 2: 484 of 48240 pixels)."""
+    k = np.array([[100.0, 2.0, 100.0], [0.0, 100.0, 100.0], [0.0, 0.0, 1.0]])
+    d = np.array([0.3, 0.1, 0.0, 0.0])
+    tex = np.full((400, 400), 200.0, np.float32)
+    kw = {"image_size": (240, 201), "model": "fisheye", "supersample": 1, "background": 60.0}
+    out = render_plane(tex, 0.1, k, d, np.zeros(3), [-20.0, -20.0, 1.0], **kw)
+    np.testing.assert_array_equal(out, 200.0)
+    plain = k.copy()
+    plain[0, 1] = 0.0
+    rays = pixel_rays(k, d, (240, 201), 1, "fisheye")
+    np.testing.assert_array_equal(rays, pixel_rays(plain, d, (240, 201), 1, "fisheye"))

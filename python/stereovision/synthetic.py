@@ -78,8 +78,10 @@ def _fisheye_rays(px: F64, K: F64, D: F64) -> F64:
     ``theta_d`` to 90 degrees, which a lens with k1 > 0 exceeds in front of the camera).
     """
     lim = np.pi / 2 * 0.999
+    # K's skew K[0, 1] ignored, as cv2.fisheye's undistortPoints and distortPoints ignore it:
+    # a ray solved with it failed their round trip below and the pixel saw the background
     yd = (px[:, 1] - K[1, 2]) / K[1, 1]
-    xd = (px[:, 0] - K[0, 2] - K[0, 1] * yd) / K[0, 0]
+    xd = (px[:, 0] - K[0, 2]) / K[0, 0]
     theta_d = np.hypot(xd, yd)
 
     def poly(t: F64) -> F64:
