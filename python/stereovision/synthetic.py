@@ -91,9 +91,14 @@ def _fisheye_rays(px: F64, K: F64, D: F64) -> F64:
     # the first crossing (the smallest theta) lies below the first grid angle past theta_d
     grid = np.linspace(0.0, lim, 2049)
     vals = poly(grid)
+    out = np.full((len(px), 2), np.nan)
+    # past the polynomial's largest value no angle within the limit reaches theta_d: no ray.
+    # Those are most of a wide image's pixels (behind the camera), and solving them too
+    # made render_plane 2.5 times slower (f 300 px on 2000 x 1500: 1.24 s vs 0.49 s before)
+    sel = np.flatnonzero(theta_d <= vals.max())
+    px, xd, yd, theta_d = px[sel], xd[sel], yd[sel], theta_d[sel]
     # the first grid value >= theta_d is the first of their running maximum (sorted)
-    first = np.minimum(np.searchsorted(np.maximum.accumulate(vals), theta_d), len(grid) - 1)
-    has = vals[first] >= theta_d
+    first = np.searchsorted(np.maximum.accumulate(vals), theta_d)
     i0 = np.maximum(first - 1, 0)
     lo, hi = grid[i0], grid[first]
     # the chord's angle, then Newton within the bracket (the bracket is 0.0008 rad wide:
@@ -109,9 +114,9 @@ def _fisheye_rays(px: F64, K: F64, D: F64) -> F64:
         scale = np.where(theta_d > 0, np.tan(theta) / theta_d, 1.0)
     rays = np.stack([xd * scale, yd * scale], axis=1)
     back = cv2.fisheye.distortPoints(rays.reshape(-1, 1, 2), K, D).reshape(-1, 2)
-    ok = has & (np.hypot(*(np.asarray(back, np.float64) - px).T) <= 0.01)
-    rays[~ok] = np.nan
-    return rays
+    ok = np.hypot(*(np.asarray(back, np.float64) - px).T) <= 0.01
+    out[sel[ok]] = rays[ok]
+    return out
 
 
 def render_plane(
