@@ -120,6 +120,28 @@ def test_gui_port_0_announces_the_port_it_got():
         proc.wait(timeout=30)
 
 
+def _signal_the_serving_gui(argv: list[str], signum: int) -> tuple[int, str, str]:
+    """Start ``argv`` (a GUI serving on a free port), send ``signum`` once the server listens
+    (its signal handlers are then set), and give back its exit status, stdout and stderr."""
+    import threading
+
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
+    watchdog.start()
+    try:
+        line = proc.stdout.readline()  # the server listens: its signal handlers are set
+        watchdog.cancel()
+        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
+        proc.send_signal(signum)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        watchdog.cancel()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=30)
+    return proc.returncode, out, err
+
+
 @pytest.mark.parametrize(
     ("entry", "signum", "status", "said"),
     [
@@ -135,30 +157,10 @@ def test_gui_stopped_by_ctrl_c_exits_130_as_the_cli(
     """Ctrl+C on a serving GUI exited 0 without a word (aiohttp's signal handlers stop the
     server quietly and trame's start returns), SIGTERM too: the CLI's other commands exit 130
     (143) and say so. Both entry points now do."""
-    import threading
-
     pytest.importorskip("trame")
-    cmd = [sys.executable, "-m", entry, *(["gui"] if entry == "stereovision" else [])]
-    proc = subprocess.Popen(
-        [*cmd, "--no-browser", "--port", "0"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
-    watchdog.start()
-    try:
-        line = proc.stdout.readline()  # the server listens: its signal handlers are set
-        watchdog.cancel()
-        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
-        proc.send_signal(signum)
-        out, err = proc.communicate(timeout=60)
-    finally:
-        watchdog.cancel()
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait(timeout=30)
-    assert (proc.returncode, out, err) == (status, "", f"stereovision: {said}\n")
+    command = [sys.executable, "-m", entry, *(["gui"] if entry == "stereovision" else [])]
+    code, out, err = _signal_the_serving_gui([*command, "--no-browser", "--port", "0"], signum)
+    assert (code, out, err) == (status, "", f"stereovision: {said}\n")
 
 
 _CALLER_OF_THE_GUI = """
@@ -185,31 +187,11 @@ def test_a_program_calling_the_gui_gets_its_signal_handlers_back(signum: int) ->
     pipe) and kept them once it had stopped: a program that ran ``gui.main`` and went on had
     its own handlers replaced, every later Ctrl+C ignored. They are put back, the wakeup fd
     too."""
-    import threading
-
     pytest.importorskip("trame")
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _CALLER_OF_THE_GUI],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
-    watchdog.start()
-    try:
-        line = proc.stdout.readline()  # the server listens: its signal handlers are set
-        watchdog.cancel()
-        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
-        proc.send_signal(signum)
-        out, err = proc.communicate(timeout=60)
-    finally:
-        watchdog.cancel()
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait(timeout=30)
+    code, out, err = _signal_the_serving_gui([sys.executable, "-c", _CALLER_OF_THE_GUI], signum)
     status = 130 if signum == signal.SIGINT else 143
     # the signal stopped the GUI; the caller's handlers then heard the two sent after it
-    assert (proc.returncode, out) == (0, f"{status} [True, True] -1 [2, 15]\n"), err
+    assert (code, out) == (0, f"{status} [True, True] -1 [2, 15]\n"), err
 
 
 _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS = _CALLER_OF_THE_GUI.replace(
@@ -225,30 +207,12 @@ _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS = _CALLER_OF_THE_GUI.replace(
 def test_the_callers_signal_handlers_come_back_when_the_close_fails() -> None:
     """The handlers were put back after the camera's close: a close that raised left them the
     stopped loop's (a no-op, a wakeup fd into its pipe), the caller's Ctrl+C ignored."""
-    import threading
-
     pytest.importorskip("trame")
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    code, out, err = _signal_the_serving_gui(
+        [sys.executable, "-c", _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS], signal.SIGINT
     )
-    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
-    watchdog.start()
-    try:
-        line = proc.stdout.readline()  # the server listens: its signal handlers are set
-        watchdog.cancel()
-        assert line.startswith("stereovision gui on http://127.0.0.1:"), (line, proc.poll())
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=60)
-    finally:
-        watchdog.cancel()
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait(timeout=30)
     # the close's error said (not the interrupt), then the caller's handlers heard both
-    assert (proc.returncode, out) == (0, "2 [True, True] -1 [2, 15]\n"), err
+    assert (code, out) == (0, "2 [True, True] -1 [2, 15]\n"), err
     assert err == "stereovision: error: the camera did not close\n"
 
 
