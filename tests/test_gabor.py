@@ -147,23 +147,30 @@ def test_lr_check_matches_reference() -> None:
     assert 0.2 < ours.mean() < 0.95
 
 
-def test_the_reference_rounds_half_pixel_shifts_as_the_kernel() -> None:
-    """On a map of half-integer disparities: the Newton step reads the right stability at
-    round(x - d) with ties to even and the left-right check rounds x - d half away from zero;
-    the reference rounded both half up (floor(s + 0.5)), so its confidence differed by up to
-    0.99 at 12 % of the pixels (the update by up to 4 px) and its mask passed pixels matched
-    half a pixel left of the row."""
+def _constant_steps_agree(disparities: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The Newton step of kernel and reference agree on a tsukuba crop at each constant
+    disparity given (within the step tolerances, with a confident pixel); gives the crop."""
     left, right = _grey("middlebury2001/tsukuba", (slice(100, 160), slice(100, 220)))
     chans = [ref.channel(0.25, t) for t in ref.ORIENTATIONS]
     lv, rv = ref.level_data(left, chans), ref.level_data(right, chans)
     thr2 = ref.thresholds2(lv, rv, 0.02)
-    for d in (-1.5, 0.5, 2.5, 3.5):
+    for d in disparities:
         disp = np.full(left.shape, d, np.float32)
         d_ours, c_ours = _core.gabor_newton_step(left, right, disp)
         d_ref, c_ref = ref.newton_step(lv, rv, chans, thr2, disp.astype(np.float64))
         assert c_ours.max() > 0.5, d
         assert np.abs(c_ours - c_ref).max() <= STEP_ATOL_CONF, d
         assert np.abs(d_ours - d_ref).max() <= STEP_ATOL_PX, d
+    return left, right
+
+
+def test_the_reference_rounds_half_pixel_shifts_as_the_kernel() -> None:
+    """On a map of half-integer disparities: the Newton step reads the right stability at
+    round(x - d) with ties to even and the left-right check rounds x - d half away from zero;
+    the reference rounded both half up (floor(s + 0.5)), so its confidence differed by up to
+    0.99 at 12 % of the pixels (the update by up to 4 px) and its mask passed pixels matched
+    half a pixel left of the row."""
+    _constant_steps_agree((-1.5, 0.5, 2.5, 3.5))
     # The mask with any tolerance is "x - d rounds into the row": x - d of 7.5 (the last
     # pixel, 8), -0.5 (-1), 8.5 (9, past the row's end) and -0.4 (-0, the first pixel).
     dl = np.array([[-7.5, 1.5, -6.5, -5.5, 4.5, -3.0, 6.0, 7.4, 8.5]], np.float32)
@@ -182,18 +189,10 @@ def test_the_reference_computes_x_minus_d_in_float32_as_the_kernel() -> None:
     them, the update by 4 px), its search one pixel off, and its left-right check kept a pixel
     matched past the row's end and dropped a difference the kernel's float32 makes exactly
     ``tol``."""
-    left, right = _grey("middlebury2001/tsukuba", (slice(100, 160), slice(100, 220)))
-    chans = [ref.channel(0.25, t) for t in ref.ORIENTATIONS]
-    lv, rv = ref.level_data(left, chans), ref.level_data(right, chans)
-    thr2 = ref.thresholds2(lv, rv, 0.02)
     up = np.float32(np.inf)
-    for d in (np.nextafter(np.float32(0.5), up), np.nextafter(np.float32(-1.5), up)):
-        disp = np.full(left.shape, d, np.float32)
-        d_ours, c_ours = _core.gabor_newton_step(left, right, disp)
-        d_ref, c_ref = ref.newton_step(lv, rv, chans, thr2, disp.astype(np.float64))
-        assert c_ours.max() > 0.5, d
-        assert np.abs(c_ours - c_ref).max() <= STEP_ATOL_CONF, d
-        assert np.abs(d_ours - d_ref).max() <= STEP_ATOL_PX, d
+    left, right = _constant_steps_agree(
+        (np.nextafter(np.float32(0.5), up), np.nextafter(np.float32(-1.5), up))
+    )
     # x 119 (the last pixel) - (-0.49999997) is 119.5 in float32: 120, past the row; at x 10,
     # 1.7 - 0.7 (dr at round(8.3)) is exactly 1 in float32 (1 + 6e-8 in float64): within tol 1.
     dl = np.zeros((1, 120), np.float32)
