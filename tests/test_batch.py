@@ -2775,3 +2775,62 @@ def test_workers_with_a_scheduler_is_refused_before_any_work(
         "cluster's own: give one of them\n"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
+
+
+def test_camera_folders_pair_names_whose_camera_index_is_not_the_pairs_number(
+    tmp_path: Path,
+) -> None:
+    """Camera folders of names carrying the camera's index last (OpenCV's pair01_cam0.png /
+    pair01_cam1.png) paired nothing: batch read each name's last number, the camera index (0
+    on every left, 1 on every right). Each side's names are now read as calibrate reads them
+    (the last number that differs between them), the numbers after it not compared; those
+    before it still are (cam0_pair01.png + cam1_pair01.png, KITTI's other frames: not
+    paired). Images without a partner stay unpaired."""
+    import stereovision.batch as batch
+    from stereovision.calibrate import _file_numbers
+
+    img = np.zeros((8, 8, 3), np.uint8)
+    files = [
+        *("a/left/pair01_cam0.png", "a/left/pair02_cam0.png", "a/left/pair03_cam0.png"),
+        *("a/right/pair01_cam1.png", "a/right/pair03_cam1.png", "a/right/pair04_cam1.png"),
+        *("b/left/cam0_pair9.png", "b/left/cam0_pair10.png"),
+        *("b/right/cam1_pair09.png", "b/right/cam1_pair10.png"),
+        *("c/left/left_001_2026.png", "c/left/left_002_2026.png"),
+        *("c/right/right_001_2026.png", "c/right/right_002_2026.png"),
+        # one image on a side: nothing tells its numbers apart, the names pair as before
+        *("d/left/seq_5_left_0001.png", "d/left/seq_5_left_0002.png"),
+        *("d/right/seq_5_right_0001.png",),
+        *("e/left/left_001_2026.png", "e/left/left_002_2026.png", "e/right/right_001_2026.png"),
+        # the numbers before the pair's are compared: other KITTI frames, other cameras
+        *("k/image_2/000000_10.png", "k/image_2/000000_11.png"),
+        *("k/image_3/000001_10.png", "k/image_3/000001_11.png"),
+    ]
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(tmp_path / f), img)
+    pairs, unpaired, _ = batch._scan(tmp_path)
+    assert [(j.left.name, j.right.name) for j in pairs] == [
+        ("pair01_cam0.png", "pair01_cam1.png"),
+        ("pair03_cam0.png", "pair03_cam1.png"),
+        ("left_001_2026.png", "right_001_2026.png"),
+        ("left_002_2026.png", "right_002_2026.png"),
+        ("seq_5_left_0001.png", "seq_5_right_0001.png"),
+        ("left_001_2026.png", "right_001_2026.png"),
+    ]
+    assert sorted(u.present.name for u in unpaired) == [
+        "000000_10.png",
+        "000000_11.png",
+        "000001_10.png",
+        "000001_11.png",
+        "cam0_pair10.png",
+        "cam0_pair9.png",
+        "cam1_pair09.png",
+        "cam1_pair10.png",
+        "left_002_2026.png",
+        "pair02_cam0.png",
+        "pair04_cam1.png",
+        "seq_5_left_0002.png",
+    ]
+    # one rule with calibrate: the numbers batch paired on are calibrate's
+    lefts = ["pair01_cam0.png", "pair02_cam0.png", "pair03_cam0.png"]
+    assert _file_numbers(lefts) == [1, 2, 3]

@@ -200,8 +200,9 @@ def find_pairs(
       (``00/image_2/000000``). Images with ``left`` or ``right`` in their names are paired by
       name as above; the images left over (and those named so without the other beside them)
       by the number in their names, in the same sub-folder, the names otherwise the same
-      but for ``left`` / ``right`` (``seq/left/left_0001.png`` +
-      ``seq/right/right_0001.png`` -> ``seq/0001``); an image without the other is not a pair
+      but for ``left`` / ``right`` and numbers after the frame's, which a camera's names share
+      (``seq/left/left_0001.png`` + ``seq/right/right_0001.png`` -> ``seq/0001``,
+      ``pair01_cam0.png`` + ``pair01_cam1.png``); an image without the other is not a pair
       (reported as above). Only
       ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
 
@@ -544,29 +545,54 @@ def _lone_named_images(folder: Path) -> set[str]:
 
 def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
     """Images of two camera folders paired by the number in their names (the frame number,
-    :func:`stereovision.calibrate._file_number`), in the same sub-folder, whose names are
-    otherwise the same but for ``left`` / ``right`` and separators (``left_0001.png`` +
-    ``right_1.png``; not ``000000_11.png`` + ``000001_11.png``, other frames of a KITTI pair);
-    a number two images of one side carry is not paired (which is meant is not guessed)."""
-    from stereovision.calibrate import _file_number
+    read as ``calibrate`` reads it: the last number that differs between the names of one side
+    in one sub-folder, :func:`stereovision.calibrate._number_place`), in the same sub-folder,
+    whose names are otherwise the same but for ``left`` / ``right``, separators and the numbers
+    after the pair's, which all of a side's names there share (``left_0001.png`` +
+    ``right_1.png``, ``pair01_cam0.png`` + ``pair01_cam1.png``; not ``000000_11.png`` +
+    ``000001_11.png``, other frames of a KITTI pair); the images left then by each name's last
+    number alone, as before; a number two images of one side carry is not paired (which is
+    meant is not guessed)."""
+    from stereovision.calibrate import _number_place
 
-    def rest(f: str) -> str:
+    def rest(f: str, drop: list[tuple[int, int]]) -> str:
         stem = Path(f).stem
+        for a, b in sorted(drop, reverse=True):  # the numbers not compared, marked
+            stem = stem[:a] + "\0" + stem[b:]
         m = _last_left(stem) or _last(_RIGHT_RE, stem)
         if m is not None:
             stem = stem[: m.start()] + stem[m.end() :]
-        return re.sub(r"[-_. ]", "", re.sub(r"\d+(?!.*\d)", "", stem))
+        return re.sub(r"[-_. \0]", "", stem)
 
-    def index(files: set[str]) -> dict[tuple[str, str, int], str]:
+    def index(files: set[str], by_side: bool) -> dict[tuple[str, str, int], str]:
+        by_folder: dict[str, list[str]] = {}
+        for f in sorted(files):
+            by_folder.setdefault(Path(f).parent.as_posix(), []).append(f)
         found: dict[tuple[str, str, int], list[str]] = {}
-        for f in files:
-            k = _file_number(f)
-            if k is not None:
-                found.setdefault((Path(f).parent.as_posix(), rest(f), k), []).append(f)
+        for folder, names in by_folder.items():
+            runs = [list(re.finditer(r"\d+", Path(f).stem)) for f in names]
+            groups = [[m.group(0) for m in r] for r in runs]
+            at = _number_place(groups) if by_side else -1
+            for f, r in zip(names, runs, strict=True):
+                if r:
+                    # the numbers after the pair's, which all of the side's names share (the
+                    # camera's index in pair01_cam0.png, a year), told the two sides apart;
+                    # those before it are compared (KITTI's 000000_10 is not 000001_10)
+                    drop = [m.span() for m in r[len(r) + at :]]
+                    key = (folder, rest(f, drop), int(r[at].group(0)))
+                    found.setdefault(key, []).append(f)
         return {key: v[0] for key, v in found.items() if len(v) == 1}
 
-    il, ir = index(lefts), index(rights)
-    return sorted((il[k], ir[k]) for k in il.keys() & ir.keys())
+    il, ir = index(lefts, True), index(rights, True)
+    pairs = [(il[k], ir[k]) for k in il.keys() & ir.keys()]
+    # then each name on its own, by its last number (a side of one image, or names carrying
+    # different counts of numbers, tells no place apart: seq_5_left_0001 + seq_5_right_0001)
+    taken = {f for p in pairs for f in p}
+    il, ir = index(lefts, False), index(rights, False)
+    pairs += [
+        (il[k], ir[k]) for k in il.keys() & ir.keys() if il[k] not in taken and ir[k] not in taken
+    ]
+    return sorted(pairs)
 
 
 def _without_side(sub: str) -> str:

@@ -1291,14 +1291,21 @@ def _file_numbers(names: Sequence[str | None]) -> list[int | None]:
     carries alike (the camera's index in ``pair03_cam1.jpg``) is not the pair's: the
     pairs were then said to carry different numbers, and the names did not pair on them."""
     groups = [re.findall(r"\d+", Path(n).stem) if n else [] for n in names]
+    at = _number_place(groups)
+    return [int(g[at]) if g else None for g in groups]
+
+
+def _number_place(groups: Sequence[Sequence[str]]) -> int:
+    """Where the pair's number sits among the numbers (digit runs) ``groups`` of one camera's
+    names, counted from the end: the last place whose number differs between them; ``-1`` (the
+    last number) when none differs, when the names carry different counts of numbers, or
+    when fewer than two carry any (:func:`_file_numbers`, and batch's camera folders)."""
     known = [g for g in groups if g]
-    at = -1
     if len(known) >= 2 and len({len(g) for g in known}) == 1:
         for j in range(len(known[0]) - 1, -1, -1):
             if len({int(g[j]) for g in known}) > 1:
-                at = j - len(known[0])
-                break
-    return [int(g[at]) if g else None for g in groups]
+                return j - len(known[0])
+    return -1
 
 
 def _constant_shift(kl: Sequence[int | None], kr: Sequence[int | None]) -> int | None:
