@@ -2834,3 +2834,42 @@ def test_camera_folders_pair_names_whose_camera_index_is_not_the_pairs_number(
     # one rule with calibrate: the numbers batch paired on are calibrate's
     lefts = ["pair01_cam0.png", "pair02_cam0.png", "pair03_cam0.png"]
     assert _file_numbers(lefts) == [1, 2, 3]
+
+
+def test_camera_folders_do_not_pair_other_frames_by_a_number_after_the_pairs(
+    tmp_path: Path,
+) -> None:
+    """74be79a left the numbers after the pair's out of the comparison, so a KITTI image_2
+    holding only the _10 frames and an image_3 holding only the _11 ones paired 000000_10 with
+    000000_11 (another frame), and left_001_2026 with right_001_2027; before it they were not
+    paired. Only a number glued to a word (the camera's index in pair01_cam0.png) is now left
+    out; a number on its own after the pair's (a frame, a year) is compared."""
+    import stereovision.batch as batch
+
+    img = np.zeros((8, 8, 3), np.uint8)
+    files = [
+        *("k/image_2/000000_10.png", "k/image_2/000001_10.png"),
+        *("k/image_3/000000_11.png", "k/image_3/000001_11.png"),
+        *("y/left/left_001_2026.png", "y/left/left_002_2026.png"),
+        *("y/right/right_001_2027.png", "y/right/right_002_2027.png"),
+        *("c/left/pair01_cam0.png", "c/left/pair02_cam0.png"),
+        *("c/right/pair01_cam1.png", "c/right/pair02_cam1.png"),
+    ]
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(tmp_path / f), img)
+    pairs, unpaired, _ = batch._scan(tmp_path)
+    assert [(j.name, j.left.name, j.right.name) for j in pairs] == [
+        ("c/pair01_cam0", "pair01_cam0.png", "pair01_cam1.png"),
+        ("c/pair02_cam0", "pair02_cam0.png", "pair02_cam1.png"),
+    ]
+    assert sorted(u.present.name for u in unpaired) == [
+        "000000_10.png",
+        "000000_11.png",
+        "000001_10.png",
+        "000001_11.png",
+        "left_001_2026.png",
+        "left_002_2026.png",
+        "right_001_2027.png",
+        "right_002_2027.png",
+    ]

@@ -200,9 +200,10 @@ def find_pairs(
       (``00/image_2/000000``). Images with ``left`` or ``right`` in their names are paired by
       name as above; the images left over (and those named so without the other beside them)
       by the number in their names, in the same sub-folder, the names otherwise the same
-      but for ``left`` / ``right`` and numbers after the frame's, which a camera's names share
-      (``seq/left/left_0001.png`` + ``seq/right/right_0001.png`` -> ``seq/0001``,
-      ``pair01_cam0.png`` + ``pair01_cam1.png``); an image without the other is not a pair
+      but for ``left`` / ``right`` and a number after the frame's glued to a word, which a
+      camera's names share (its index; ``seq/left/left_0001.png`` +
+      ``seq/right/right_0001.png`` -> ``seq/0001``, ``pair01_cam0.png`` + ``pair01_cam1.png``;
+      not ``000000_10.png`` + ``000000_11.png``); an image without the other is not a pair
       (reported as above). Only
       ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
 
@@ -548,17 +549,22 @@ def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
     read as ``calibrate`` reads it: the last number that differs between the names of one side
     in one sub-folder, :func:`stereovision.calibrate._number_place`), in the same sub-folder,
     whose names are otherwise the same but for ``left`` / ``right``, separators and the numbers
-    after the pair's, which all of a side's names there share (``left_0001.png`` +
-    ``right_1.png``, ``pair01_cam0.png`` + ``pair01_cam1.png``; not ``000000_11.png`` +
-    ``000001_11.png``, other frames of a KITTI pair); the images left then by each name's last
+    after the pair's glued to a word, which all of a side's names there share (the camera's
+    index: ``left_0001.png`` + ``right_1.png``, ``pair01_cam0.png`` + ``pair01_cam1.png``; not
+    ``000000_11.png`` + ``000001_11.png`` nor ``000000_10.png`` + ``000000_11.png``, other
+    frames of a KITTI pair); the images left then by each name's last
     number alone, as before; a number two images of one side carry is not paired (which is
     meant is not guessed)."""
     from stereovision.calibrate import _number_place
 
     def rest(f: str, drop: list[tuple[int, int]]) -> str:
         stem = Path(f).stem
-        for a, b in sorted(drop, reverse=True):  # the numbers not compared, marked
-            stem = stem[:a] + "\0" + stem[b:]
+        # the pair's number (first) is not compared, nor one after it glued to a word (the
+        # camera's index in pair01_cam0); one on its own (KITTI's frame in 000000_10, a year)
+        # is, else 000000_10 paired with 000000_11
+        for i, (a, b) in sorted(enumerate(drop), key=lambda x: -x[1][0]):
+            word = i > 0 and a > 0 and stem[a - 1].isalpha()
+            stem = stem[:a] + ("\0" if i == 0 or word else f"\0{int(stem[a:b])}") + stem[b:]
         m = _last_left(stem) or _last(_RIGHT_RE, stem)
         if m is not None:
             stem = stem[: m.start()] + stem[m.end() :]
