@@ -2873,3 +2873,36 @@ def test_camera_folders_do_not_pair_other_frames_by_a_number_after_the_pairs(
         "right_001_2027.png",
         "right_002_2027.png",
     ]
+
+
+def test_camera_folders_pair_a_side_of_one_image_at_the_other_sides_number(
+    tmp_path: Path,
+) -> None:
+    """74be79a read each side's pair number where that side's names differ; a side holding one
+    image (a camera folder with gaps) tells no place, its last number (the camera's index in
+    pair01_cam1.png) was read and pair01_cam0.png + pair01_cam1.png was not paired. Such a side
+    is now read at the other side's place; a side's names that tell one keep their own."""
+    import stereovision.batch as batch
+
+    img = np.zeros((8, 8, 3), np.uint8)
+    files = [
+        *("a/left/pair01_cam0.png", "a/left/pair02_cam0.png", "a/right/pair02_cam1.png"),
+        *("b/left/pair05_cam0.png", "b/right/pair05_cam1.png", "b/right/pair06_cam1.png"),
+        # KITTI's frames still told apart: a lone _10 does not take the other side's _11
+        *("k/image_2/000000_10.png", "k/image_3/000000_11.png", "k/image_3/000001_11.png"),
+    ]
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(tmp_path / f), img)
+    pairs, unpaired, _ = batch._scan(tmp_path)
+    assert [(j.name, j.left.name, j.right.name) for j in pairs] == [
+        ("a/pair02_cam0", "pair02_cam0.png", "pair02_cam1.png"),
+        ("b/pair05_cam0", "pair05_cam0.png", "pair05_cam1.png"),
+    ]
+    assert sorted(u.present.name for u in unpaired) == [
+        "000000_10.png",
+        "000000_11.png",
+        "000001_11.png",
+        "pair01_cam0.png",
+        "pair06_cam1.png",
+    ]

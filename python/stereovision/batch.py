@@ -547,7 +547,8 @@ def _lone_named_images(folder: Path) -> set[str]:
 def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
     """Images of two camera folders paired by the number in their names (the frame number,
     read as ``calibrate`` reads it: the last number that differs between the names of one side
-    in one sub-folder, :func:`stereovision.calibrate._number_place`), in the same sub-folder,
+    in one sub-folder, :func:`stereovision.calibrate._number_place`, or of the other side when
+    this one holds one image there), in the same sub-folder,
     whose names are otherwise the same but for ``left`` / ``right``, separators and the numbers
     after the pair's glued to a word, which all of a side's names there share (the camera's
     index: ``left_0001.png`` + ``right_1.png``, ``pair01_cam0.png`` + ``pair01_cam1.png``; not
@@ -570,16 +571,31 @@ def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
             stem = stem[: m.start()] + stem[m.end() :]
         return re.sub(r"[-_. \0]", "", stem)
 
-    def index(files: set[str], by_side: bool) -> dict[tuple[str, str, int], str]:
-        by_folder: dict[str, list[str]] = {}
+    def by_folder(files: set[str]) -> dict[str, list[tuple[str, list[re.Match[str]]]]]:
+        out: dict[str, list[tuple[str, list[re.Match[str]]]]] = {}
         for f in sorted(files):
-            by_folder.setdefault(Path(f).parent.as_posix(), []).append(f)
+            out.setdefault(Path(f).parent.as_posix(), []).append(
+                (f, list(re.finditer(r"\d+", Path(f).stem)))
+            )
+        return out
+
+    def places(files: set[str]) -> dict[str, int]:
+        """Each sub-folder's pair-number place where two or more names carry numbers (-1,
+        the last, when their counts differ)."""
+        told = {}
+        for folder, names in by_folder(files).items():
+            known = [[m.group(0) for m in r] for _, r in names if r]
+            if len(known) >= 2:
+                told[folder] = _number_place(known)
+        return told
+
+    def index(files: set[str], at_of: dict[str, int]) -> dict[tuple[str, str, int], str]:
         found: dict[tuple[str, str, int], list[str]] = {}
-        for folder, names in by_folder.items():
-            runs = [list(re.finditer(r"\d+", Path(f).stem)) for f in names]
-            groups = [[m.group(0) for m in r] for r in runs]
-            at = _number_place(groups) if by_side else -1
-            for f, r in zip(names, runs, strict=True):
+        for folder, names in by_folder(files).items():
+            for f, r in names:
+                at = at_of.get(folder, -1)
+                if r and len(r) < -at:  # fewer numbers than the other side's place needs
+                    at = -1
                 if r:
                     # the numbers after the pair's, which all of the side's names share (the
                     # camera's index in pair01_cam0.png, a year), told the two sides apart;
@@ -589,12 +605,15 @@ def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
                     found.setdefault(key, []).append(f)
         return {key: v[0] for key, v in found.items() if len(v) == 1}
 
-    il, ir = index(lefts, True), index(rights, True)
+    # a side whose names there tell no place (one image: a camera folder with gaps) is read at
+    # the other side's (pair01_cam0.png alone + pair01_cam1.png, pair02_cam1.png)
+    pl, pr = places(lefts), places(rights)
+    il, ir = index(lefts, pr | pl), index(rights, pl | pr)
     pairs = [(il[k], ir[k]) for k in il.keys() & ir.keys()]
     # then each name on its own, by its last number (a side of one image, or names carrying
     # different counts of numbers, tells no place apart: seq_5_left_0001 + seq_5_right_0001)
     taken = {f for p in pairs for f in p}
-    il, ir = index(lefts, False), index(rights, False)
+    il, ir = index(lefts, {}), index(rights, {})
     pairs += [
         (il[k], ir[k]) for k in il.keys() & ir.keys() if il[k] not in taken and ir[k] not in taken
     ]
