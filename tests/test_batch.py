@@ -2777,6 +2777,19 @@ def test_workers_with_a_scheduler_is_refused_before_any_work(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
 
 
+def _scan_tiny_images(tmp_path: Path, files: list[str]) -> tuple[list, list]:
+    """Write an 8x8 image at each of ``files`` (relative to ``tmp_path``) and give back the
+    pairs and unpaired images batch's scan finds there."""
+    import stereovision.batch as batch
+
+    img = np.zeros((8, 8, 3), np.uint8)
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(tmp_path / f), img)
+    pairs, unpaired, _ = batch._scan(tmp_path)
+    return pairs, unpaired
+
+
 def test_camera_folders_pair_names_whose_camera_index_is_not_the_pairs_number(
     tmp_path: Path,
 ) -> None:
@@ -2786,10 +2799,8 @@ def test_camera_folders_pair_names_whose_camera_index_is_not_the_pairs_number(
     (the last number that differs between them), the numbers after it not compared; those
     before it still are (cam0_pair01.png + cam1_pair01.png, KITTI's other frames: not
     paired). Images without a partner stay unpaired."""
-    import stereovision.batch as batch
     from stereovision.calibrate import _file_numbers
 
-    img = np.zeros((8, 8, 3), np.uint8)
     files = [
         *("a/left/pair01_cam0.png", "a/left/pair02_cam0.png", "a/left/pair03_cam0.png"),
         *("a/right/pair01_cam1.png", "a/right/pair03_cam1.png", "a/right/pair04_cam1.png"),
@@ -2805,10 +2816,7 @@ def test_camera_folders_pair_names_whose_camera_index_is_not_the_pairs_number(
         *("k/image_2/000000_10.png", "k/image_2/000000_11.png"),
         *("k/image_3/000001_10.png", "k/image_3/000001_11.png"),
     ]
-    for f in files:
-        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
-        cv2.imwrite(str(tmp_path / f), img)
-    pairs, unpaired, _ = batch._scan(tmp_path)
+    pairs, unpaired = _scan_tiny_images(tmp_path, files)
     assert [(j.left.name, j.right.name) for j in pairs] == [
         ("pair01_cam0.png", "pair01_cam1.png"),
         ("pair03_cam0.png", "pair03_cam1.png"),
@@ -2844,9 +2852,6 @@ def test_camera_folders_do_not_pair_other_frames_by_a_number_after_the_pairs(
     000000_11 (another frame), and left_001_2026 with right_001_2027; before it they were not
     paired. Only a number glued to a word (the camera's index in pair01_cam0.png) is now left
     out; a number on its own after the pair's (a frame, a year) is compared."""
-    import stereovision.batch as batch
-
-    img = np.zeros((8, 8, 3), np.uint8)
     files = [
         *("k/image_2/000000_10.png", "k/image_2/000001_10.png"),
         *("k/image_3/000000_11.png", "k/image_3/000001_11.png"),
@@ -2855,10 +2860,7 @@ def test_camera_folders_do_not_pair_other_frames_by_a_number_after_the_pairs(
         *("c/left/pair01_cam0.png", "c/left/pair02_cam0.png"),
         *("c/right/pair01_cam1.png", "c/right/pair02_cam1.png"),
     ]
-    for f in files:
-        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
-        cv2.imwrite(str(tmp_path / f), img)
-    pairs, unpaired, _ = batch._scan(tmp_path)
+    pairs, unpaired = _scan_tiny_images(tmp_path, files)
     assert [(j.name, j.left.name, j.right.name) for j in pairs] == [
         ("c/pair01_cam0", "pair01_cam0.png", "pair01_cam1.png"),
         ("c/pair02_cam0", "pair02_cam0.png", "pair02_cam1.png"),
@@ -2882,19 +2884,13 @@ def test_camera_folders_pair_a_side_of_one_image_at_the_other_sides_number(
     image (a camera folder with gaps) tells no place, its last number (the camera's index in
     pair01_cam1.png) was read and pair01_cam0.png + pair01_cam1.png was not paired. Such a side
     is now read at the other side's place; a side's names that tell one keep their own."""
-    import stereovision.batch as batch
-
-    img = np.zeros((8, 8, 3), np.uint8)
     files = [
         *("a/left/pair01_cam0.png", "a/left/pair02_cam0.png", "a/right/pair02_cam1.png"),
         *("b/left/pair05_cam0.png", "b/right/pair05_cam1.png", "b/right/pair06_cam1.png"),
         # KITTI's frames still told apart: a lone _10 does not take the other side's _11
         *("k/image_2/000000_10.png", "k/image_3/000000_11.png", "k/image_3/000001_11.png"),
     ]
-    for f in files:
-        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
-        cv2.imwrite(str(tmp_path / f), img)
-    pairs, unpaired, _ = batch._scan(tmp_path)
+    pairs, unpaired = _scan_tiny_images(tmp_path, files)
     assert [(j.name, j.left.name, j.right.name) for j in pairs] == [
         ("a/pair02_cam0", "pair02_cam0.png", "pair02_cam1.png"),
         ("b/pair05_cam0", "pair05_cam0.png", "pair05_cam1.png"),
