@@ -352,6 +352,21 @@ unsafe fn hamming_kernel512(a: u64, right: *const u64, out: *mut u8, n: usize) -
         best = _mm_mask_min_epu8(best, km, best, b);
         worst = _mm_mask_max_epu8(worst, km, worst, b);
     }
+    fold_min_max(best, worst)
+}
+
+/// The least of `best`'s 16 bytes and the greatest of `worst`'s: both Hamming kernels' last
+/// step, halving the vectors four times.
+///
+/// # Safety
+/// SSE2 only, which every x86_64 CPU has.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn fold_min_max(
+    best: std::arch::x86_64::__m128i,
+    worst: std::arch::x86_64::__m128i,
+) -> (u8, u8) {
+    use std::arch::x86_64::*;
     let lo = _mm_min_epu8(best, _mm_srli_si128::<8>(best));
     let hi = _mm_max_epu8(worst, _mm_srli_si128::<8>(worst));
     let lo = _mm_min_epu8(lo, _mm_srli_si128::<4>(lo));
@@ -462,15 +477,7 @@ unsafe fn hamming_kernel(a: u64, right: *const u64, out: *mut u8, n: usize) -> (
         _mm256_castsi256_si128(worst),
         _mm256_extracti128_si256::<1>(worst),
     );
-    let lo = _mm_min_epu8(lo, _mm_srli_si128::<8>(lo));
-    let hi = _mm_max_epu8(hi, _mm_srli_si128::<8>(hi));
-    let lo = _mm_min_epu8(lo, _mm_srli_si128::<4>(lo));
-    let hi = _mm_max_epu8(hi, _mm_srli_si128::<4>(hi));
-    let lo = _mm_min_epu8(lo, _mm_srli_si128::<2>(lo));
-    let hi = _mm_max_epu8(hi, _mm_srli_si128::<2>(hi));
-    let lo = _mm_min_epu8(lo, _mm_srli_si128::<1>(lo));
-    let hi = _mm_max_epu8(hi, _mm_srli_si128::<1>(hi));
-    (_mm_cvtsi128_si32(lo) as u8, _mm_cvtsi128_si32(hi) as u8)
+    fold_min_max(lo, hi)
 }
 
 /// The cost volume `C[(y * w + x) * n + k]` for disparity `d_min + k`.
