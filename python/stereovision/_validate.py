@@ -311,20 +311,25 @@ def _said_with(words: str, found: re.Match[str]) -> str:
     return words.format(**found.groupdict())
 
 
-def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
+def _warn_low_uint16(arr: np.ndarray, name: str, effect: str | None = None) -> None:
     """Warn when a uint16 image uses only its lowest 12 bits: it is scaled by 65535 (by 257 to
     8 bits), so its 8-bit copy (colours, the fill's colour segments) has 0-16 grey levels of a
-    12-bit camera's image; the matchers read all its bits, the automatic range stretches it."""
+    12-bit camera's image; the matchers read all its bits, the automatic range stretches it.
+    ``effect``, with its leading separator, says what the scaling does to another reader
+    (refine's contrast floor) instead."""
     import warnings
 
     top = int(arr.max())
     if top < LOW_UINT16_MAX:
+        if effect is None:
+            effect = (
+                "; the matchers read all its bits, but its 8-bit copy (colours, the fill's "
+                f"colour segments) keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits "
+                "of it"
+            )
         warnings.warn(
             f"{name}: uint16 image whose largest value is {top} (12-bit or 8-bit data in a "
-            "16-bit container?): it is scaled as 16-bit; the matchers read all its bits, but its "
-            f"8-bit copy (colours, the fill's colour segments) "
-            f"keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; "
-            f"{LOW_UINT16_ADVICE}",
+            f"16-bit container?): it is scaled as 16-bit{effect}; {LOW_UINT16_ADVICE}",
             UserWarning,
             stacklevel=user_stacklevel(),  # reached at many depths: as_gray_float, depth_map, match
         )

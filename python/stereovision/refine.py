@@ -19,7 +19,6 @@ with a metric calibration this stage brings the median depth error below OpenCV 
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,15 +26,13 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
-    LOW_UINT16_ADVICE,
-    LOW_UINT16_MAX,
+    _warn_low_uint16,
     check_index_range,
     check_unit_range,
     disparity_range,
     number_shown,
     real_number,
     refuse_unknown,
-    user_stacklevel,
 )
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
@@ -120,16 +117,10 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
     if image and arr.dtype in (np.uint8, np.uint16):
         # 8- and 16-bit images at full scale, as every matcher takes them: the range check's
         # advice ("pass the uint8 array itself") refused the uint8 array it had been given
-        if arr.dtype == np.uint16 and int(arr.max()) < LOW_UINT16_MAX:
+        if arr.dtype == np.uint16:
             # as the matchers warn (as_gray_float): 12-bit data scaled by 65535 lies 16 times
             # darker, its contrast below var_floor (teddy: 16 % fewer pixels kept), unsaid
-            warnings.warn(
-                f"{name}: uint16 image whose largest value is {int(arr.max())} (12-bit or 8-bit "
-                "data in a 16-bit container?): it is scaled as 16-bit, its contrast then below "
-                f"the refinement's var_floor; {LOW_UINT16_ADVICE}",
-                UserWarning,
-                stacklevel=user_stacklevel(),
-            )
+            _warn_low_uint16(arr, name, ", its contrast then below the refinement's var_floor")
         return np.ascontiguousarray(arr, dtype=np.float32) / np.float32(np.iinfo(arr.dtype).max)
     return np.ascontiguousarray(arr, dtype=np.float32)
 
