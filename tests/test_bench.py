@@ -344,7 +344,42 @@ def test_bench_reports_the_median_of_the_timed_runs_after_a_warm_up(
     assert out["bad_2.0_filled"] == 0.0 and out["density"] == round(raw.density, 3)
     sparse = [c for c in cases if c.kind == "sparse"]  # type: ignore[attr-defined]
     # precision@1 (not @2) over the 2 matches with GT (not the 3 given)
-    assert sparse and all(c.accuracy == {"precision@1.0": 50.0, "count": 2} for c in sparse)
+    assert sparse and all(c.accuracy["precision@1.0"] == 50.0 for c in sparse)
+    assert all(c.accuracy["count"] == 2 for c in sparse)
+
+
+def test_bench_reports_every_figure_of_evaluation_md_together(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """evaluation.md: the dense figures are reported together (bad-0.5 to bad-4.0, density,
+    avgerr, rms) and sparse precision@1 with @0.5, @2 and the 4x4 coverage of the count. The
+    bench gave bad-2.0 and density alone, and precision@1 and the count alone."""
+    gt = np.full((8, 32), 2.0, np.float32)
+    gt[0, :4] = 3.0  # errors of 1 px: bad-0.5 and bad-1.0 tell apart, avgerr and rms not 0
+    cases, _, disp = _fake_bench(monkeypatch, gt)
+    by = {c.case: c.as_dict() for c in cases}  # type: ignore[attr-defined]
+    raw = dense_metrics(disp, gt)
+    want = {
+        "bad_0.5": 100 * 5 / 256,  # the hole and the 4 pixels 1 px off
+        "bad_1.0": 100 * 1 / 256,  # the hole alone
+        "bad_2.0": 100 * 1 / 256,
+        "bad_4.0": 100 * 1 / 256,
+        "density": 100 * 255 / 256,
+        "avgerr": 4 / 255,
+        "rms": (4 / 255) ** 0.5,
+    }
+    for name in ("pipeline", "StereoBM", "SGBM-3WAY", *METHODS):
+        for key, value in want.items():
+            assert by[name][key] == round(value, 3), (name, key)
+        assert by[name]["avgerr"] == round(raw.avgerr, 3) and by[name]["bad_2.0_filled"] == 0.0
+        assert "n_gt" not in by[name] and "n_both" not in by[name]
+    sparse = [c.as_dict() for c in cases if c.kind == "sparse"]  # type: ignore[attr-defined]
+    # errors 0 and 1.5 px on the 2 matches with GT, both in the grid's top-left cell
+    assert sparse and all(
+        (s["precision@0.5"], s["precision@1.0"], s["precision@2.0"], s["count"], s["coverage"])
+        == (50.0, 50.0, 100.0, 2, 1)
+        for s in sparse
+    )
 
 
 def test_bench_without_gt_reports_times_only(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -9,13 +9,15 @@ time of each is reported with its ratio to OpenCV StereoSGBM 3-way's, beside its
   pair (converted once, outside the timing, as OpenCV's is loaded once);
 * ``pipeline``: :func:`stereovision.depth_map` with the default method from the BGR pair and
   the scene's calibration: input checks, conversion, matching, triangulation and point cloud;
-* each sparse method of :data:`stereovision.match.METHODS` (precision@1 and count instead of
-  bad-2.0 and density);
+* each sparse method of :data:`stereovision.match.METHODS` (precision@0.5/1/2, count and 4x4
+  coverage instead of the dense figures);
 * ``StereoBM`` and ``SGBM-3WAY``: :mod:`stereovision.baselines`, evaluation.md's configuration.
 
-All use every core (OpenCV's and rayon's default thread pools). A table is printed, then one JSON
-object per case (``--json``: only those); a figure with nothing to measure (a scene without a
-known GT pixel, a sparse method without a match on GT) is ``null`` there, as in ``eval --json``.
+All use every core (OpenCV's and rayon's default thread pools). A table is printed (bad-2.0,
+filled, density; precision@1, count), then one JSON object per case with every figure of
+:attr:`BenchCase.accuracy` (``--json``: only those); a figure with nothing to measure (a scene
+without a known GT pixel, a sparse method without a match on GT) is ``null`` there, as in
+``eval --json``.
 """
 
 from __future__ import annotations
@@ -61,8 +63,11 @@ class BenchCase:
     ratio : float
         ``ms`` / SGBM-3WAY's ``ms`` in the same run (< 1 = faster than SGBM).
     accuracy : dict
-        Dense: ``bad_2.0`` (holes counted), ``bad_2.0_filled`` (after the reference row fill),
-        ``density`` (percent). Sparse: ``precision@1.0``, ``count``. Empty without GT.
+        evaluation.md's figures, reported together. Dense: ``bad_0.5`` to ``bad_4.0`` (holes
+        counted), ``bad_2.0_filled`` (after the reference row fill), ``density`` (percent),
+        ``avgerr`` and ``rms`` (px). Sparse: ``precision@0.5``, ``precision@1.0``,
+        ``precision@2.0``, ``count`` and ``coverage`` (cells of the 4 x 4 grid). Empty without
+        GT.
     width, height : int
         The scene's image size, pixels.
     max_disparity : int
@@ -116,7 +121,25 @@ def _dense_accuracy(disp: np.ndarray, gt: np.ndarray | None) -> dict[str, float]
         return {}
     raw = dense_metrics(disp, gt)
     filled = dense_metrics(row_fill(disp), gt)
-    return {"bad_2.0": raw.bad[2.0], "bad_2.0_filled": filled.bad[2.0], "density": raw.density}
+    # evaluation.md: "report all of them together": bad-2.0 and density alone left out bad-0.5,
+    # -1.0 and -4.0, avgerr and rms, which eval reports of the same maps
+    acc = {"bad_2.0": raw.bad[2.0], "bad_2.0_filled": filled.bad[2.0], "density": raw.density}
+    others = raw.as_dict().items()  # its pixel counts n_gt, n_both are no figure of the case
+    acc.update({k: float(v) for k, v in others if k not in acc and not k.startswith("n_")})
+    return acc
+
+
+def _sparse_accuracy(matches: Any, gt: np.ndarray | None) -> dict[str, float]:
+    from stereovision.evaluate import sparse_metrics
+
+    if gt is None:
+        return {}
+    sm = sparse_metrics(matches.xl, matches.yl, matches.xr, gt)
+    # evaluation.md: precision@1 "also report @0.5 and @2", and the count's spread over a 4x4
+    # grid: precision@1 and the count alone hid both
+    acc: dict[str, float] = {f"precision@{t:.1f}": v for t, v in sm.precision.items()}
+    acc.update(count=sm.count, coverage=sm.coverage)
+    return acc
 
 
 def sparse_name(method: str) -> str:
@@ -180,7 +203,6 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     from stereovision import baselines
     from stereovision._validate import as_gray_float
     from stereovision.depth import METHODS, _run_matcher, depth_map
-    from stereovision.evaluate import sparse_metrics
     from stereovision.match import METHODS as SPARSE_METHODS
     from stereovision.match import match
 
@@ -232,13 +254,7 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     result = []
     for name, kind, _ in cases:
         out = outputs[name]
-        if kind == "sparse":
-            acc: dict[str, float] = {}
-            if gt is not None:
-                sm = sparse_metrics(out.xl, out.yl, out.xr, gt)
-                acc = {"precision@1.0": sm.precision[1.0], "count": sm.count}
-        else:
-            acc = _dense_accuracy(out, gt)
+        acc = _sparse_accuracy(out, gt) if kind == "sparse" else _dense_accuracy(out, gt)
         result.append(
             BenchCase(
                 scene.name, name, kind, w, h, md, runs, med[name], med[name] / med[REFERENCE], acc
