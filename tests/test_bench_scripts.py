@@ -197,6 +197,34 @@ def test_a_matcher_without_matches_is_a_null_count_not_a_crash(
     assert row["reference"]["count"] > 0
 
 
+def test_bench_sgm_density_is_over_the_gt_pixels(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """bench_sgm's density column is evaluation.md's: the share of the GT pixels with a value.
+    It was the share of all pixels (tsukuba's GT leaves a border unknown: 79 % of the image;
+    KITTI's LiDAR a fifth of it)."""
+    import runpy
+
+    from stereovision.evaluate import dense_metrics
+    from stereovision.io import load_scene
+    from stereovision.matching.sgm import sgm_disparity
+
+    name = "middlebury2001/tsukuba"
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import _common
+
+    monkeypatch.setattr(_common, "gt_scenes", lambda: [name])
+    monkeypatch.setattr(sys, "argv", ["bench_sgm.py", "--runs", "5"])
+    runpy.run_path(str(BENCHES / "bench_sgm.py"), run_name="__main__")
+    row = next(json.loads(ln) for ln in capsys.readouterr().out.splitlines() if '"scene"' in ln)
+    sc = load_scene(data_dir / name)
+    assert sc.gt is not None
+    d = sgm_disparity(sc.left, sc.right, max_disparity=sc.max_disparity)
+    want = dense_metrics(d, sc.gt).density
+    assert row["scene"] == name and row["density"] == pytest.approx(want)
+    assert abs(want - 100 * float(np.isfinite(d).mean())) > 1  # the two differ here
+
+
 def test_eval_gabor_scenes_times_ours_beside_sgbm(data_dir: Path) -> None:
     # our time was of one run, beside no timed reference
     assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
