@@ -386,6 +386,28 @@ def test_bgra_and_grey_frames(data_dir: Path) -> None:
             assert (out[0][..., 3] == 255).all()
 
 
+def test_a_new_light_leaves_bgra_alpha_alone(data_dir: Path) -> None:
+    """A BGRA rig (alpha 255 on every frame) whose light dims by 20 %: the colour means are
+    relit, the alpha is not light and stays 255. It was scaled with them: 214 on the first dim
+    pair (the mean of 255s), creeping back over the following pairs."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(8)
+    tf = TemporalFilter()
+    for gain in (1.0, 1.0, 1.0, 1.0, 0.8, 0.8):
+        left, right = (
+            cv2.cvtColor(
+                noisy(np.clip(i * gain, 0, 255).astype(np.uint8), 8.0, rng), cv2.COLOR_BGR2BGRA
+            )
+            for i in (sc.left, sc.right)
+        )
+        out = tf(left, right)
+        assert (out[0][..., 3] == 255).all() and (out[1][..., 3] == 255).all(), gain
+    assert tf.restarts == 0 and tf.relit == 2
+    bgr = tuple(cv2.cvtColor(o, cv2.COLOR_BGRA2BGR) for o in out)
+    for o, img in zip(bgr, (sc.left, sc.right), strict=True):  # the dimmed light, averaged
+        assert np.abs(o.astype(float) - img * 0.8).mean() < 3.0
+
+
 def test_k_beyond_64_bits() -> None:
     # np.isfinite(2**70) was NumPy's TypeError "ufunc 'isfinite' not supported", naming no k
     assert TemporalFilter(k=2**70).k == 2**70

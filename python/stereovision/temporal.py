@@ -370,7 +370,12 @@ class TemporalFilter:
                 self.restarts += 1
                 return self._restart(imgs)
             if abs(gain - 1.0) > _GAIN_TOL:
-                m.mean = np.clip(m.mean * np.float32(gain), 0, 255)
+                if m.mean.ndim == 3 and m.mean.shape[2] == 4:
+                    # alpha is no light: relit with the colours, a BGRA frame's opaque 255
+                    # came out 214 after a 20 % dimming, and crept back over max_frames pairs
+                    m.mean[..., :3] = np.clip(m.mean[..., :3] * np.float32(gain), 0, 255)
+                else:
+                    m.mean = np.clip(m.mean * np.float32(gain), 0, 255)
                 self.relit += 1
                 d = _core.temporal_grey_difference(img, m.mean)
             diffs.append(d)
