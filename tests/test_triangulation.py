@@ -265,6 +265,21 @@ def test_depth_from_disparity_hand_computed() -> None:
         depth_from_disparity(np.zeros(3), c)
 
 
+def test_a_depth_past_float32_is_no_depth() -> None:
+    """A positive disparity so small that f B / d overflows float32 (8.4e4 mm px over 1e-35 px,
+    or 1e-300 px in float64) is no depth, as in depth_map's kernel: it was +inf, with NumPy's
+    "overflow encountered in cast", and reproject's X, Y were -inf, +inf or NaN."""
+    c = rect_calib()
+    d = np.array([[1e-35, 1e-300, 4.0, 3e-34]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow warning either
+        z = depth_from_disparity(d, c, unit="mm")
+        pts = reproject(d, c, unit="mm")
+    assert np.isnan(z[0, :2]).all() and np.isnan(pts[0, :2]).all()
+    np.testing.assert_allclose(z[0, 2:], [21000.0, 2.8e38], rtol=1e-6)  # f32 max: 3.4e38
+    np.testing.assert_allclose(pts[0, 2], [(2 - 330) * 30.0, -240 * 30.0, 21000.0], rtol=1e-6)
+
+
 def test_depth_from_disparity_refuses_a_bool_map() -> None:
     # a validity mask passed for the disparity was read as 1 px and 0 px: 700 px * 0.12 m / 7 px
     # and / 6 px, depths where nothing was measured (gt_depth, the Table-1 GT, reads through it)

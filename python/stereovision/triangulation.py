@@ -345,8 +345,8 @@ def depth_from_disparity(
     """Depth from a rectified disparity map (algorithms.md E.3).
 
     ``Z = f B / (d + doffs)``, with ``f`` the rectified focal length (px), ``B`` the baseline
-    and ``doffs = cx_right - cx_left``; ``d + doffs <= 0`` and non-finite ``d`` give NaN. For an
-    unrectified calibration the disparity must be in the frame of
+    and ``doffs = cx_right - cx_left``; ``d + doffs <= 0``, non-finite ``d`` and a depth past
+    float32 give NaN. For an unrectified calibration the disparity must be in the frame of
     :meth:`Calibration.rectify` (``alpha=0``) and :meth:`Calibration.rectified_calibration` is
     used.
 
@@ -394,8 +394,11 @@ def _depth(d: F64, calib: Calibration, unit: str) -> npt.NDArray[np.float32]:
     denom = d + cal.doffs_px
     with np.errstate(all="ignore"):
         z = cal.focal_px * cal.baseline * scale / denom
-    z[~(np.isfinite(denom) & (denom > 0))] = np.nan
-    return z.astype(np.float32)
+        # past float32 (a disparity of 1e-34 px at f B = 3.8e5 mm px) the depth was +inf, with
+        # NumPy's "overflow encountered in cast": no depth, as the depth_map kernel's NaN
+        z32 = z.astype(np.float32)
+    z32[~(np.isfinite(denom) & (denom > 0) & np.isfinite(z32))] = np.nan
+    return z32
 
 
 def reproject(
