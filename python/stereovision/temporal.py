@@ -20,7 +20,7 @@ camera's frames while the scene holds still and starts again where it does not:
   change of light); a gain outside 0.5-2 counts as another view.
 - **The noise**: estimated from each frame itself (:func:`noise_sigma`, a Laplacian's mean over
   the image's flattest 30 %; Immerkaer 1996), the median of the last 8 frames' estimates (a
-  frame all black or white has none, and is left out).
+  frame all black or white has none, and is left out; a new frame size starts them again).
 
 A still, noiseless pair comes out unchanged (the mean of equal frames is the frame).
 
@@ -351,6 +351,11 @@ class TemporalFilter:
         check_index_range(imgs[0].shape, "left")  # before the copies and the float32 means
         imgs = [np.ascontiguousarray(img) for img in imgs]
         self.frames += 1
+        if self._means and self._means[0].mean.shape != imgs[0].shape:
+            # Another size is another camera mode (binning, a crop, another camera): its noise
+            # is its own. The old median (8.3 from noise 12) let a clean (noise 2) rig moving
+            # 1 px a pair average three pairs into a smear before its own estimates took over.
+            self._sigmas.clear()
         # A black (or white) frame has no estimate, not one of 0: a webcam's dark frames while
         # it starts took the median to 0 and the first still frames after them were each
         # "moving" (6 dark frames: 3 restarts more, the next 4 frames not averaged).
