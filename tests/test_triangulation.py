@@ -570,6 +570,10 @@ def test_triangulate_gives_both_frames_in_the_unit_asked() -> None:
     np.testing.assert_allclose(m.XR, want_r, rtol=1e-9)
     np.testing.assert_allclose(ft.XR, want_r / 0.3048, rtol=1e-9)
     np.testing.assert_allclose(ft.XR, ft.XL @ c.R.T + c.T / 304.8, rtol=1e-9)
+    # the unit a plain str, as known_unit gives it (an np.str_ one was kept as given)
+    named = triangulate(xl, xr, c, unit=np.str_("ft"))
+    assert type(named.unit) is str and "np.str_" not in repr(named)
+    np.testing.assert_array_equal(named.XL, ft.XL)
 
 
 def test_a_map_resized_with_a_pixel_of_rounding_is_warned_about() -> None:

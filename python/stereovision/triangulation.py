@@ -259,6 +259,8 @@ def triangulate(
     pr = _points(xr, "xr")
     if pl.shape != pr.shape:
         raise ValueError(f"xl and xr must have the same shape, got {pl.shape} and {pr.shape}")
+    # a plain str: an np.str_ unit was kept as given, and the result's repr read np.str_('ft')
+    unit = known_unit(unit, UNIT_TO_METRES)
     scale = _unit_scale(calib, unit)
     # 0 or -5 iterations, a tol of 0, -1 or NaN made every point NaN without a word (never
     # converged); "1" was NumPy's UFuncTypeError from the comparison
