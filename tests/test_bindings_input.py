@@ -299,6 +299,18 @@ def test_an_empty_8_bit_image_is_called_empty() -> None:
         _core.gray_u8(np.zeros((0, 5, 3), np.uint8), LUMA_WEIGHTS_BGR)
 
 
+@pytest.mark.parametrize("shape", [(0, 5), (4, 0, 3)])
+def test_an_empty_temporal_frame_is_called_empty_by_its_size(shape: tuple[int, ...]) -> None:
+    """The temporal kernels know only a pixel count: a 5x0 or 0x4 frame was "got 0x0"."""
+    frame, mean = np.zeros(shape, np.uint8), np.zeros(shape, np.float32)
+    grid = (np.zeros(shape[:2], np.uint8), np.zeros(shape[:2], np.float32))
+    says = re.escape(f"image is empty: got {shape[1]}x{shape[0]} pixels")
+    with pytest.raises(ValueError, match=says):
+        _core.temporal_grey_difference(frame, mean)
+    with pytest.raises(ValueError, match=says):
+        _core.temporal_running_mean(frame, mean, *grid, 3.0, 8)
+
+
 @pytest.mark.parametrize(
     ("name", "args"),
     [
