@@ -213,6 +213,37 @@ unsafe impl GlobalAlloc for BlockCache {
     }
 }
 
+/// The process that first locked a process-wide cache ([`cache_lock`]).
+static CACHE_HOME: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+
+/// The lock of a process-wide cache of buffers (the Gabor planes' pool, the census matcher's
+/// kept volume and rows), or None in a forked process when it is held: the caller then works
+/// without the cache (fresh buffers, the same results).
+///
+/// Why: `fork()` copies a lock held by another thread of the parent (a kernel running in a
+/// Python thread while another forks: multiprocessing's "fork" start method) as held, and no
+/// thread of the child ever releases it: a blocking `lock` waited forever on the child's first
+/// kernel (seen on about 1 fork in 200 while the parent ran Gabor in a thread). The process
+/// that first took such a lock keeps waiting for it as before; any other process (a forked
+/// one) only tries it.
+pub(crate) fn cache_lock<T>(m: &Mutex<T>) -> Option<std::sync::MutexGuard<'_, T>> {
+    use std::sync::atomic::Ordering;
+    let pid = std::process::id();
+    let home = match CACHE_HOME.compare_exchange(0, pid, Ordering::AcqRel, Ordering::Acquire) {
+        Ok(_) => pid,
+        Err(p) => p,
+    };
+    // A poisoned lock still holds consistent data: the caches only move whole vectors.
+    if home == pid {
+        return Some(m.lock().unwrap_or_else(std::sync::PoisonError::into_inner));
+    }
+    match m.try_lock() {
+        Ok(g) => Some(g),
+        Err(std::sync::TryLockError::Poisoned(e)) => Some(e.into_inner()),
+        Err(std::sync::TryLockError::WouldBlock) => None,
+    }
+}
+
 /// `bytes` for a message: "6.00 GiB (6442450944 bytes)".
 pub fn human_bytes(bytes: usize) -> String {
     let (v, unit) = if bytes >= 1 << 30 {
@@ -347,7 +378,7 @@ where
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -617,5 +648,66 @@ mod tests {
         try_reserve_len(&mut v, 10, "v").unwrap();
         assert!(v.capacity() >= 10 && v.capacity() < 13, "{}", v.capacity());
         assert_eq!(v, [1, 1, 1]);
+    }
+
+    /// Runs `f` in a child forked while another thread of this process holds `m` (as a kernel
+    /// running in another thread holds a cache's lock); true when the child ends normally
+    /// within 20 s (an `alarm` kills a child that waits for the lock). `f` must start no
+    /// thread and use no rayon pool: the child has only the forking thread.
+    #[cfg(target_os = "linux")]
+    pub(crate) fn ends_in_a_child_forked_while_held<T: Send>(
+        m: &'static Mutex<T>,
+        f: fn(),
+    ) -> bool {
+        extern "C" {
+            fn fork() -> i32;
+            fn waitpid(pid: i32, status: *mut i32, options: i32) -> i32;
+            fn alarm(seconds: u32) -> u32;
+            fn _exit(status: i32) -> !;
+        }
+        let (held_tx, held_rx) = std::sync::mpsc::channel();
+        let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+        let holder = std::thread::spawn(move || {
+            // Through cache_lock: this process is the cache's first, which waits for it.
+            let guard = cache_lock(m);
+            held_tx.send(guard.is_some()).unwrap();
+            done_rx.recv().unwrap();
+        });
+        assert!(
+            held_rx.recv().unwrap(),
+            "the parent could not take the lock"
+        );
+        // SAFETY: the child calls only `alarm`, `f` (allocations: glibc's malloc is fork-safe)
+        // and `_exit`.
+        let pid = unsafe { fork() };
+        assert!(pid >= 0, "fork failed");
+        if pid == 0 {
+            // SAFETY: plain libc calls in the child.
+            unsafe { alarm(20) };
+            let ok = std::panic::catch_unwind(f).is_ok();
+            // SAFETY: ends the child without running the parent's exit handlers.
+            unsafe { _exit(if ok { 0 } else { 1 }) };
+        }
+        let mut status = 0;
+        // SAFETY: waits for our own child; `status` is a valid pointer.
+        let waited = unsafe { waitpid(pid, &mut status, 0) };
+        done_tx.send(()).unwrap();
+        holder.join().unwrap();
+        waited == pid && status == 0
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_cache_held_in_the_parent_at_fork_is_skipped_in_the_child() {
+        // The first process takes the lock as a blocking `lock` does (a second thread waits
+        // for it); a forked one whose copy is held goes without it instead of waiting forever.
+        static M: Mutex<Vec<u8>> = Mutex::new(Vec::new());
+        cache_lock(&M).unwrap().push(1);
+        assert_eq!(*cache_lock(&M).unwrap(), [1]);
+        assert!(ends_in_a_child_forked_while_held(&M, || {
+            assert!(cache_lock(&M).is_none());
+        }));
+        // Once released, the parent has it again.
+        assert_eq!(*cache_lock(&M).unwrap(), [1]);
     }
 }

@@ -1120,14 +1120,17 @@ mod kept {
         pairs: Vec::new(),
     });
 
-    fn lock() -> std::sync::MutexGuard<'static, Kept> {
-        // Moves of whole vectors only: a panic cannot leave it inconsistent.
-        KEPT.lock().unwrap_or_else(|e| e.into_inner())
+    /// What is kept, or None in a forked process whose copy of it is held by a thread it does
+    /// not have ([`crate::alloc::cache_lock`]): the call then allocates its own buffers.
+    fn lock() -> Option<std::sync::MutexGuard<'static, Kept>> {
+        crate::alloc::cache_lock(&KEPT)
     }
 
     /// The kept volume (any length) and the kept rows of exactly `row_len` values.
     pub fn take(row_len: usize) -> (Vec<u8>, Vec<Vec<u16>>) {
-        let mut k = lock();
+        let Some(mut k) = lock() else {
+            return (Vec::new(), Vec::new());
+        };
         let volume = std::mem::take(&mut k.volume);
         let rows = std::mem::take(&mut k.rows);
         drop(k);
@@ -1138,7 +1141,10 @@ mod kept {
     /// Keeps the volume, then as many rows as fit under [`KEEP_MAX_BYTES`].
     /// The three-path rows kept stay, and count against the limit.
     pub fn put(volume: Vec<u8>, mut rows: Vec<Vec<u16>>) {
-        let mut room = KEEP_MAX_BYTES.saturating_sub(pairs_bytes(&lock().pairs));
+        let Some(kept_pairs) = lock().map(|k| pairs_bytes(&k.pairs)) else {
+            return; // freed, not kept
+        };
+        let mut room = KEEP_MAX_BYTES.saturating_sub(kept_pairs);
         let volume = if volume.capacity() <= room {
             room -= volume.capacity();
             volume
@@ -1147,7 +1153,9 @@ mod kept {
         };
         let per_row = rows.first().map_or(1, |r| (r.capacity() * 2).max(1));
         rows.truncate(room / per_row);
-        let mut k = lock();
+        let Some(mut k) = lock() else {
+            return;
+        };
         k.volume = volume;
         k.rows = rows;
     }
@@ -1161,7 +1169,9 @@ mod kept {
 
     /// The kept three-path rows of exactly `row_len` levels.
     pub fn take_pairs(row_len: usize) -> Vec<(Vec<u8>, Vec<u16>)> {
-        let pairs = std::mem::take(&mut lock().pairs);
+        let pairs = lock()
+            .map(|mut k| std::mem::take(&mut k.pairs))
+            .unwrap_or_default();
         pairs
             .into_iter()
             .filter(|(c, _)| c.len() == row_len)
@@ -1174,7 +1184,9 @@ mod kept {
         let per = pairs
             .first()
             .map_or(1, |(c, a)| (c.capacity() + 2 * a.capacity()).max(1));
-        let mut k = lock();
+        let Some(mut k) = lock() else {
+            return; // freed, not kept
+        };
         let room = KEEP_MAX_BYTES.saturating_sub(
             k.volume.capacity() + k.rows.iter().map(|r| r.capacity() * 2).sum::<usize>(),
         );
@@ -1184,7 +1196,9 @@ mod kept {
 
     /// Bytes kept.
     pub fn held_bytes() -> usize {
-        let k = lock();
+        let Some(k) = lock() else {
+            return 0;
+        };
         k.volume.capacity()
             + k.rows.iter().map(|r| r.capacity() * 2).sum::<usize>()
             + pairs_bytes(&k.pairs)
@@ -1193,11 +1207,31 @@ mod kept {
     /// Frees what is kept; returns the bytes.
     pub fn release() -> usize {
         let held = held_bytes();
-        let mut k = lock();
+        let Some(mut k) = lock() else {
+            return 0;
+        };
         k.volume = Vec::new();
         k.rows = Vec::new();
         k.pairs = Vec::new();
         held
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_child_forked_while_the_kept_buffers_are_held_goes_without_them() {
+        // The lock, held by a thread of the parent at fork (a census match running in another
+        // Python thread), stayed held in the child: its first match waited forever.
+        assert!(crate::alloc::tests::ends_in_a_child_forked_while_held(
+            &KEPT,
+            || {
+                let (volume, rows) = take(8);
+                assert!(volume.is_empty() && rows.is_empty());
+                put(vec![1; 64], vec![vec![2; 8]]); // freed, not kept
+                assert!(take_pairs(8).is_empty());
+                put_pairs(vec![(vec![1; 8], vec![2; 8])]);
+                assert_eq!((held_bytes(), release()), (0, 0));
+            }
+        ));
     }
 }
 

@@ -23,9 +23,10 @@ pub const POOL_MAX_BYTES: usize = 256 << 20;
 
 static POOL: Mutex<Vec<Vec<f32>>> = Mutex::new(Vec::new());
 
-fn lock() -> std::sync::MutexGuard<'static, Vec<Vec<f32>>> {
-    // A panic while holding the lock cannot leave the list inconsistent (push/remove only).
-    POOL.lock().unwrap_or_else(|e| e.into_inner())
+/// The pool, or None in a forked process whose copy of it is held by a thread it does not have
+/// ([`crate::alloc::cache_lock`]): the planes are then allocated and freed without it.
+fn lock() -> Option<std::sync::MutexGuard<'static, Vec<Vec<f32>>>> {
+    crate::alloc::cache_lock(&POOL)
 }
 
 /// A zero-initialised `f32` buffer that returns its memory to the pool when dropped.
@@ -52,8 +53,7 @@ impl Buf {
     /// entirely: skips the zero fill of a reused buffer.
     pub fn scratch(n: usize) -> Result<Buf> {
         if n >= MIN_POOLED {
-            let taken = {
-                let mut p = lock();
+            let taken = lock().and_then(|mut p| {
                 let best = p
                     .iter()
                     .enumerate()
@@ -61,7 +61,7 @@ impl Buf {
                     .min_by_key(|(_, b)| b.len())
                     .map(|(i, _)| i);
                 best.map(|i| p.swap_remove(i))
-            };
+            });
             if let Some(v) = taken {
                 return Ok(Buf { v, n });
             }
@@ -106,7 +106,9 @@ impl Drop for Buf {
         if v.len() < MIN_POOLED {
             return;
         }
-        let mut p = lock();
+        let Some(mut p) = lock() else {
+            return; // freed without the pool
+        };
         p.push(v);
         // Keep the total under the cap, dropping the oldest buffers first.
         let mut total: usize = p.iter().map(|b| b.capacity() * 4).sum();
@@ -119,18 +121,38 @@ impl Drop for Buf {
 
 /// Bytes the pool holds between uses.
 pub fn held_bytes() -> usize {
-    lock().iter().map(|b| b.capacity() * 4).sum()
+    lock().map_or(0, |p| p.iter().map(|b| b.capacity() * 4).sum())
 }
 
 /// Frees every pooled buffer; returns the bytes they held.
 pub fn release() -> usize {
-    let all = std::mem::take(&mut *lock());
+    let all = lock()
+        .map(|mut p| std::mem::take(&mut *p))
+        .unwrap_or_default();
     all.iter().map(|b| b.capacity() * 4).sum()
 }
 
 #[cfg(test)]
 mod tests {
     use super::Buf;
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_child_forked_while_the_pool_is_held_gets_its_planes() {
+        // The pool's lock, held by a thread of the parent at fork (a Gabor kernel running in
+        // another Python thread), stayed held in the child: its first plane waited forever.
+        assert!(crate::alloc::tests::ends_in_a_child_forked_while_held(
+            &super::POOL,
+            || {
+                let mut b = Buf::zeroed(super::MIN_POOLED + 3).unwrap();
+                assert!(b.iter().all(|&v| v == 0.0));
+                b[0] = 1.0;
+                drop(b); // freed without the pool
+                assert_eq!(super::held_bytes(), 0);
+                assert_eq!(super::release(), 0);
+            }
+        ));
+    }
 
     #[test]
     fn reused_buffers_are_zeroed() {
