@@ -389,12 +389,19 @@ try:
             _core.hopfield_interest(np.broadcast_to(np.float32(0.5), (1, 2**31 + 1)))
         except ValueError as e:
             print("ValueError:", e)
-    elif case in ("plane_fill_too_large", "speckles_too_large"):
+    elif case in (
+        "plane_fill_too_large", "speckles_too_large", "regions_too_large", "fill_planes_too_large"
+    ):
         d = np.broadcast_to(np.float32(1.0), (2**16, 2**16))
+        img = np.broadcast_to(np.uint8(5), (2**16, 2**16, 3))
         try:
             if case == "plane_fill_too_large":
                 labels = np.broadcast_to(np.uint32(0), (2**16, 2**16))
                 _core.plane_fill(d, labels, 3, 1.0, 0.0, 2.0)
+            elif case == "regions_too_large":
+                _core.quantised_regions(img, 16, 0)
+            elif case == "fill_planes_too_large":
+                _core.fill_planes(d, img, [(16, 5)], 1.0)
             else:
                 _core.gabor_remove_speckles(d, 10, 1.0)
         except ValueError as e:
@@ -511,12 +518,15 @@ def test_hopfield_interest_refuses_a_row_past_int32_before_copying_it() -> None:
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
-@pytest.mark.parametrize("case", ["plane_fill_too_large", "speckles_too_large"])
+@pytest.mark.parametrize(
+    "case",
+    ["plane_fill_too_large", "speckles_too_large", "regions_too_large", "fill_planes_too_large"],
+)
 def test_in_place_kernels_refuse_2_to_the_32_pixels_before_copying(case: str) -> None:
-    """``plane_fill`` (no size check: its u32 pixel lists wrapped) and
-    ``gabor_remove_speckles`` (the kernel's check came after the copy) copied a 65536 x 65536
-    (broadcast) map first: a 16 GiB MemoryError under ``ulimit -v``, not the size's
-    ValueError."""
+    """``plane_fill`` (no size check: its u32 pixel lists wrapped), ``gabor_remove_speckles``,
+    ``quantised_regions`` and ``fill_planes`` (the kernel's check came after the copy) copied a
+    65536 x 65536 (broadcast) map or image first: a 12-16 GiB MemoryError under ``ulimit -v``,
+    not the size's ValueError."""
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     want = (

@@ -130,6 +130,10 @@ pub fn quantised_regions<'py>(
             "step must be in 1-255 and offset in 0-255, got step={step}, offset={offset}"
         )));
     }
+    // The kernel's size check came after the copy: a broadcast 65536 x 65536 image was a
+    // 12 GiB MemoryError (a (1, 2**31 + 1) one 2 GiB copied in 7 s) before the size's
+    // ValueError. Refused from the shape now, as `graph_segments` and `plane_fill` do.
+    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
     let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         guard("quantised_regions", || {
@@ -161,6 +165,9 @@ pub fn fill_planes<'py>(
         )));
     }
     non_negative("max_residual", max_residual)?;
+    // The kernel (`quantised_regions`) refused the size only after the image and the map were
+    // copied (a 12 GiB MemoryError for a broadcast 65536 x 65536 pair): from the shape now.
+    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
     let img = row_major(&image, "image")?;
     let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("fill_planes", || {
