@@ -777,6 +777,45 @@ def test_a_port_in_use_is_said_with_its_number() -> None:
         FrameServer("no.such.host.invalid", 0)
 
 
+def _request_threads() -> list[threading.Thread]:
+    """The FrameServer's request handlers still running (socketserver names each thread after
+    its target)."""
+    return [t for t in threading.enumerate() if "process_request_thread" in t.name]
+
+
+@pytest.mark.timeout(60)
+def test_a_viewer_that_disconnects_mid_answer_prints_no_traceback(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A browser tab closed, or ffplay quit, while the view answered it (the page, a frame,
+    the MJPEG stream's headers): socketserver printed its ~20-line traceback of the
+    ConnectionResetError on the stream's stderr, among its reports. A viewer gone is no error:
+    nothing is said, and the view still serves the next client."""
+    import socket
+    import struct
+
+    srv = FrameServer("127.0.0.1", 0)
+    try:
+        rng = np.random.default_rng(0)  # a frame that does not compress to nothing
+        left = rng.integers(0, 256, (240, 320, 3), dtype=np.uint8)
+        srv.update(left, rng.random((240, 320), dtype=np.float32) * 64, 64.0)
+        for path in ("/", "/frame.jpg", "/stream.mjpg"):
+            client = socket.create_connection(("127.0.0.1", srv.port), timeout=10)
+            client.sendall(f"GET {path} HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+            # closed at once with a reset (SO_LINGER 0), as a killed player's socket is
+            client.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+            client.close()
+        # answered after the server accepted the three (one thread each, started at the accept)
+        assert _get(srv.url + "frame.jpg")[:2] == (200, "image/jpeg")
+        deadline = time.monotonic() + 20
+        while _request_threads() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert _request_threads() == []
+    finally:
+        srv.close()
+    assert capsys.readouterr().err == ""
+
+
 @PIPELINED
 def test_a_stream_stopped_before_its_first_frame_leaves_no_empty_bag(
     videos: dict[str, Path], data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -298,6 +298,20 @@ def _view_bgr(img: np.ndarray) -> np.ndarray:
     return img[:, :, :3]  # BGRA: without its alpha
 
 
+class _ViewServer(ThreadingHTTPServer):
+    """The view's HTTP server: a viewer that goes away mid-answer is no error."""
+
+    daemon_threads = True
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        # A browser tab closed or a player quit while it was answered (the page, a frame, the
+        # MJPEG headers): socketserver printed a 20-line traceback of the reset on the
+        # stream's stderr, among its reports. Any other error is still printed.
+        if isinstance(sys.exc_info()[1], ConnectionError):
+            return
+        super().handle_error(request, client_address)
+
+
 class FrameServer:
     """A tiny MJPEG-over-HTTP view of the latest result.
 
@@ -385,7 +399,7 @@ class FrameServer:
                     return
 
         try:
-            self._httpd = ThreadingHTTPServer((host, port), Handler)
+            self._httpd = _ViewServer((host, port), Handler)
         except OSError as exc:
             # "[Errno 98] Address already in use" named neither the port nor the way out
             import errno
@@ -399,7 +413,6 @@ class FrameServer:
             err = OSError(f"cannot serve the view on {host}:{port}: {why} ({hint})")
             err.errno = exc.errno
             raise err from None
-        self._httpd.daemon_threads = True
         self._thread = threading.Thread(
             target=self._httpd.serve_forever, name="stereovision-serve", daemon=True
         )
