@@ -2734,6 +2734,40 @@ def test_the_view_listens_on_the_loopback_by_default() -> None:
         srv.close()
 
 
+def _ipv6_loopback() -> bool:
+    import socket
+
+    try:
+        with socket.socket(socket.AF_INET6) as s:
+            s.bind(("::1", 0))
+    except OSError:
+        return False
+    return True
+
+
+@pytest.mark.skipif(not _ipv6_loopback(), reason="no IPv6 loopback here")
+def test_the_view_serves_on_an_ipv6_address() -> None:
+    """``--host ::1`` (or ``::``, every interface) was refused: the server was IPv4 only,
+    'cannot serve the view on ::1:8765: Address family for hostname not supported', where
+    ``gui --host ::1`` serves. It serves now, its address said with the brackets a URL needs;
+    an IPv4 address still serves as before."""
+    srv = FrameServer("::1", 0)
+    try:
+        assert srv.url == f"http://[::1]:{srv.port}/"
+        assert srv._httpd.server_address[0] == "::1"
+        assert _get(srv.url + "frame.jpg")[:2] == (503, "text/plain")
+        srv.update(np.zeros((8, 8, 3), np.uint8), np.zeros((8, 8), np.float32), 16.0)
+        assert _get(srv.url + "frame.jpg")[:2] == (200, "image/jpeg")
+        import errno
+
+        with pytest.raises(OSError) as info:  # its port taken: the address as a URL says it
+            FrameServer("::1", srv.port)
+        assert info.value.errno == errno.EADDRINUSE
+        assert str(info.value).startswith(f"cannot serve the view on [::1]:{srv.port}: ")
+    finally:
+        srv.close()
+
+
 @pytest.mark.parametrize("json_out", [True, False])
 @PIPELINED
 def test_each_report_line_is_flushed_as_it_is_written(

@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import math
 import queue
+import socket
 import statistics
 import sys
 import threading
@@ -312,6 +313,18 @@ class _ViewServer(ThreadingHTTPServer):
         super().handle_error(request, client_address)
 
 
+class _ViewServer6(_ViewServer):
+    """:class:`_ViewServer` on an IPv6 address (``--host ::1``, ``::``): the IPv4 socket
+    refused it ("Address family for hostname not supported")."""
+
+    address_family = socket.AF_INET6
+
+
+def _host_port(host: str, port: int) -> str:
+    """``host:port`` as a URL says it: an IPv6 address in brackets (``[::1]:8765``)."""
+    return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
+
+
 class FrameServer:
     """A tiny MJPEG-over-HTTP view of the latest result.
 
@@ -321,7 +334,8 @@ class FrameServer:
     Parameters
     ----------
     host : str
-        Address to listen on (``127.0.0.1`` by default: robots are often on shared networks).
+        Address to listen on (``127.0.0.1`` by default: robots are often on shared networks);
+        an IPv6 one (``::1``, ``::``) too.
     port : int
         TCP port; 0 picks a free one (see :attr:`port`).
 
@@ -399,7 +413,8 @@ class FrameServer:
                     return
 
         try:
-            self._httpd = _ViewServer((host, port), Handler)
+            server_class = _ViewServer6 if ":" in host else _ViewServer
+            self._httpd = server_class((host, port), Handler)
         except OSError as exc:
             # "[Errno 98] Address already in use" named neither the port nor the way out
             import errno
@@ -410,7 +425,7 @@ class FrameServer:
                 if exc.errno == errno.EADDRINUSE
                 else "check --host, or --no-display"
             )
-            err = OSError(f"cannot serve the view on {host}:{port}: {why} ({hint})")
+            err = OSError(f"cannot serve the view on {_host_port(host, port)}: {why} ({hint})")
             err.errno = exc.errno
             raise err from None
         self._thread = threading.Thread(
@@ -425,8 +440,8 @@ class FrameServer:
 
     @property
     def url(self) -> str:
-        """``http://host:port/``."""
-        return f"http://{self._host}:{self.port}/"
+        """``http://host:port/`` (an IPv6 host in brackets: ``http://[::1]:8765/``)."""
+        return f"http://{_host_port(self._host, self.port)}/"
 
     @property
     def closed(self) -> bool:
