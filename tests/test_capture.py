@@ -2419,6 +2419,50 @@ def test_a_frame_the_source_says_it_could_not_decode_is_refused() -> None:
     assert (ei.value.side, ei.value.end) == ("right", False)
 
 
+class _Delivers(_FakeCap):
+    """A capture of the user's (a camera SDK's wrapper) that hands out the given frames in turn."""
+
+    def __init__(self, name: str, frames: list[np.ndarray]) -> None:
+        super().__init__(name, [], frames=len(frames))
+        self.frames = frames
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, self.frames[len(self.frames) - 1 - self.left]
+
+
+@pytest.mark.parametrize(
+    ("bad", "said"),
+    [
+        (np.zeros((0, 0, 3), np.uint8), "delivered an empty frame (0x0)"),
+        (np.zeros((SMALL[1], 0), np.uint8), "delivered an empty frame (0x240)"),
+        (np.zeros(SMALL[0], np.uint8), "delivered a frame of shape (320,), not an image"),
+        (
+            np.zeros((*SMALL[::-1], 2), np.uint8),
+            "delivered a frame of shape (240, 320, 2), not an image",
+        ),
+    ],
+)
+def test_a_frame_that_is_no_image_is_refused_naming_the_source(
+    bad: np.ndarray, said: str, tmp_path: Path
+) -> None:
+    """A capture that says True with an empty frame (a dropped frame of a camera SDK's wrapper)
+    or an array that is no image: an empty one was taken as the frame, and after a first pair
+    its size divided by zero (ZeroDivisionError out of capture and stream); a 1-D one raised
+    IndexError. Each is now a failed frame, as one that does not decode is (``end`` False),
+    naming the side; the pair saved before it is kept."""
+    good = _numbered(0)
+    cam = StereoCamera(_FakeCap("L", [], frames=2), _Delivers("R", [good, bad]))
+    with pytest.raises(SourceError) as ei:
+        capture(cam, tmp_path, count=2)
+    cam.close()
+    assert str(ei.value) == (
+        f"right source _Delivers {said} after 1 pair; 1 of 2 pairs were saved in {tmp_path} "
+        "and are kept"
+    )
+    assert (ei.value.side, ei.value.end) == ("right", False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["left_0001.png", "right_0001.png"]
+
+
 def test_pairs_are_saved_whole_without_hard_links(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -1912,7 +1912,8 @@ class StereoCamera(PairSource):
             message names the source that ended, the frames read, whether the other still had
             frames and whether a file ended before the frames its header announces (attributes
             ``side``, ``frames``, ``other_had_frames``, ``expected_frames``; ``end`` True). A
-            frame that does not decode or of another shape raises it with ``end`` False.
+            frame that does not decode, of another shape, empty or no image (a capture of the
+            user's) raises it with ``end`` False.
         """
         timeout = _READ_TIMEOUT.get()
         name = " and ".join(_describe_source(src) for src in self.sources.values())
@@ -1960,6 +1961,14 @@ class StereoCamera(PairSource):
             ok, img = got[side]
             if not ok or img is None:
                 raise self._fail(side, "could not decode a frame")
+            # a capture of the user's (a camera SDK's wrapper) that said True: an empty frame
+            # (a dropped one) divided by zero in _fit once a pair had fixed the size, and an
+            # array that is no image raised IndexError or failed in OpenCV further on
+            img = np.asarray(img)
+            if img.ndim not in (2, 3) or (img.ndim == 3 and img.shape[2] not in (1, 3, 4)):
+                raise self._fail(side, f"delivered a frame of shape {img.shape}, not an image")
+            if img.size == 0:
+                raise self._fail(side, f"delivered an empty frame ({img.shape[1]}x{img.shape[0]})")
             if img.ndim == 2 or img.shape[2] == 1:
                 img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
             elif img.shape[2] == 4:  # an image sequence's PNGs with alpha: BGR as the rest
