@@ -3226,16 +3226,17 @@ def _number_options() -> list[tuple[str, str]]:
     import argparse
 
     from stereovision.capture import fourcc_code
-    from stereovision.cli import build_parser
+    from stereovision.cli import build_parser, listen_address
 
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
     return [
         (name, action.option_strings[-1])
         for name, parser in sub.choices.items()
         for action in parser._actions
-        # --fourcc's type checks four characters, not a number ('25mm' is a fourcc)
+        # --fourcc's type checks four characters, not a number ('25mm' is a fourcc); --host's
+        # that an address is given ('25mm' may be a host name)
         if action.option_strings
-        and action.type not in (None, str, fourcc_code)
+        and action.type not in (None, str, fourcc_code, listen_address)
         and action.nargs != 0
     ]
 
@@ -3404,6 +3405,27 @@ def test_a_bad_fourcc_is_refused_in_the_options_name(
     assert err == (
         f"stereovision {command}: error: argument --fourcc: expected four characters such as "
         f"'MJPG' or 'YUYV', got {code!r} (see stereovision {command} --help)\n"
+    )
+
+
+@pytest.mark.parametrize("host", ["", " "])
+@pytest.mark.parametrize("command", ["stream", "gui"])
+def test_an_empty_host_is_refused_in_the_options_name(
+    capsys: pytest.CaptureFixture[str], command: str, host: str
+) -> None:
+    """``--host ""`` (an unset shell variable: ``--host "$HOST"``) served the view on every
+    interface (0.0.0.0, the empty address of a bind), where the default serves this machine
+    alone, and said it as ``http://:8765/``; it is refused by argparse now, before any camera
+    opens: one line, exit 2."""
+    with pytest.raises(SystemExit) as exit_:
+        main([command, "--left", "0", "--right", "1", "--host", host])
+    assert exit_.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err == (
+        f"stereovision {command}: error: argument --host: expected an address to listen on "
+        f"(127.0.0.1: this machine alone; 0.0.0.0: every interface), got {host!r} "
+        f"(see stereovision {command} --help)\n"
     )
 
 

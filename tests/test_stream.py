@@ -2732,6 +2732,10 @@ def test_the_view_listens_on_the_loopback_by_default() -> None:
         assert srv._httpd.server_address[0] == "127.0.0.1"
     finally:
         srv.close()
+    # an empty host (a bind's "every interface") is refused, not served on 0.0.0.0
+    for host in ("", " "):
+        with pytest.raises(ValueError, match=rf"^host: expected an address .*got {host!r}$"):
+            FrameServer(host, 0)
 
 
 def _ipv6_loopback() -> bool:

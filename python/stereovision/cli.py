@@ -2110,6 +2110,30 @@ def port_number(text: str) -> int:
     return value
 
 
+def listen_address(text: str) -> str:
+    """argparse type of ``stream --host`` and ``gui --host``: an address to listen on, not
+    empty (an empty one binds every interface: ``--host "$HOST"`` with the variable unset)."""
+    try:
+        return check_listen_address(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(_listen_address_words(text)) from None
+
+
+def _listen_address_words(text: object) -> str:
+    return (
+        "expected an address to listen on (127.0.0.1: this machine alone; 0.0.0.0: every "
+        f"interface), got {text!r}"
+    )
+
+
+def check_listen_address(host: str, name: str = "--host") -> str:
+    """``host`` when it is an address to listen on; ValueError (naming ``name``) for an empty
+    or blank one, which a bind takes for every interface (0.0.0.0)."""
+    if not isinstance(host, str) or not host.strip():
+        raise ValueError(f"{name}: {_listen_address_words(host)}")
+    return host
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with its errors in one line, as the command's own (not the usage block)."""
 

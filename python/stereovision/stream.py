@@ -351,6 +351,10 @@ class FrameServer:
         if whole is None or not 0 <= whole <= 65535:
             raise ValueError(f"port: expected 0 to 65535 (0 = any free port), got {port!r}")
         port = whole
+        from stereovision.cli import check_listen_address
+
+        # "" is a bind's every interface (0.0.0.0), said as http://:8765/
+        check_listen_address(host, "host")
         self._cond = threading.Condition()
         self._latest: tuple[np.ndarray, np.ndarray, float] | None = None
         self._seq = 0
@@ -1654,6 +1658,7 @@ def add_cli(subparsers: Any) -> None:
     from stereovision.cli import (
         CALIB_FILES_HELP,
         add_calib_unit,
+        listen_address,
         port_number,
         positive_count,
         positive_pixels,
@@ -1731,7 +1736,7 @@ def add_cli(subparsers: Any) -> None:
         metavar="PORT",
         help=f"view port (default {DEFAULT_PORT})",
     )
-    p.add_argument("--host", help="view address (default 127.0.0.1)")
+    p.add_argument("--host", type=listen_address, help="view address (default 127.0.0.1)")
     p.add_argument("--json", action="store_true", help="one JSON object per second on stdout")
     p.add_argument(
         "--no-check",

@@ -337,7 +337,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=DEFAULT_PORT,
         help=f"port the page is served on (default {DEFAULT_PORT})",
     )
-    p.add_argument("--host", default=DEFAULT_HOST, help=f"listen address (default {DEFAULT_HOST})")
+    from stereovision.cli import listen_address
+
+    p.add_argument(
+        "--host",
+        type=listen_address,
+        default=DEFAULT_HOST,
+        help=f"listen address (default {DEFAULT_HOST})",
+    )
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
 
 
