@@ -687,6 +687,55 @@ def test_pixel_format_refused_is_named() -> None:
         StereoCamera(_FakeCap("L", log), _FakeCap("R", log), fourcc="YUYV").close()
 
 
+class _RateCap(_FakeCap):
+    """A webcam stand-in that keeps a frame rate asked of it only among the ones it has (V4L2
+    answers a rate it cannot give with its nearest), and reports its rate."""
+
+    def __init__(self, name: str, rates: tuple[float, ...]) -> None:
+        super().__init__(name, [])
+        self.rates, self.fps = rates, rates[0]
+
+    def get(self, prop: int) -> float:
+        return self.fps if prop == cv2.CAP_PROP_FPS else super().get(prop)
+
+    def set(self, prop: int, value: float) -> bool:
+        if prop == cv2.CAP_PROP_FPS:
+            self.fps = min(self.rates, key=lambda r: abs(r - value))
+        return super().set(prop, value)
+
+
+def test_a_frame_rate_the_camera_does_not_give_is_said() -> None:
+    """``--fps 60`` of a webcam that gives 30 at that size streamed at 30 without a word (the
+    size and the format asked are said when not given; stream prints no describe() line, and
+    capture's says no rate asked). One warning per side that reports another rate; none for a
+    rate given (within 1 %: V4L2's 29.97 for 30), for a camera reporting none (0), or for a file,
+    which is read as it is."""
+    with pytest.warns(UserWarning) as rec:
+        cam = StereoCamera(_RateCap("L", (30.0, 15.0)), _RateCap("R", (60.0, 30.0)), fps=60)
+    assert [str(w.message) for w in rec] == [
+        "left source _RateCap reports 30 fps, not the 60 fps asked (a rate this camera does "
+        "not give at this size and format?)"
+    ]
+    assert rec[0].filename == __file__  # said at the caller's line
+    assert cam.delivered_fps == {"left": 30.0, "right": 60.0}
+    cam.close()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        StereoCamera(_RateCap("L", (29.97,)), _RateCap("R", (30.0,)), fps=30).close()
+        StereoCamera(_FakeCap("L", []), _FakeCap("R", []), fps=60).close()  # reports no rate
+        StereoCamera(_RateCap("L", (30.0,)), _RateCap("R", (30.0,))).close()  # none asked
+
+
+def test_a_frame_rate_asked_of_a_file_is_not_said(tmp_path: Path) -> None:
+    """A video file is read as it is (``--fps`` asks the cameras): no warning for its rate."""
+    left = _write_video(tmp_path / "l.avi", [_numbered(i) for i in range(2)], fps=10.0)
+    right = _write_video(tmp_path / "r.avi", [_numbered(i) for i in range(2)], fps=10.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with StereoCamera(left, right, fps=30) as cam:
+            assert cam.delivered_fps == {"left": 10.0, "right": 10.0}
+
+
 def test_fourcc_codes() -> None:
     assert parse_fourcc(None) is None and parse_fourcc("Y800") == "Y800"
     for bad in ("MJPEG", "YUV", "", "MJ\tG", 1196444237):

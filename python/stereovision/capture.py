@@ -1526,7 +1526,8 @@ class StereoCamera(PairSource):
         DeprecationWarning (the attribute stays :attr:`size`).
     fps : float, optional
         Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
-        :attr:`delivered_fps`.
+        :attr:`delivered_fps`. A camera or stream that reports another rate (more than 1 %
+        off; 0 is none reported) gets one :class:`UserWarning`; a file is read as it is.
     fourcc : str, optional
         Pixel format asked of the sources before the size and rate (``CAP_PROP_FOURCC``; with
         V4L2 the format decides which sizes and rates a webcam offers): ``"YUYV"`` for
@@ -1708,6 +1709,24 @@ class StereoCamera(PairSource):
                     f"{side} source {_describe_source(src)} delivers "
                     f"{repr(got) if got else 'no reported format'}, not "
                     f"{self.requested_fourcc!r}",
+                    UserWarning,
+                    stacklevel=4,  # _open, __init__, renamed_keyword's wrapper, the caller
+                )
+            except BaseException:  # made an error: this capture is not in _caps to close
+                cap.release()
+                raise
+        rate = self.delivered_fps.get(side, 0.0)
+        # a camera's or stream's (a file is read as it is): --fps 60 of a webcam that gives 30
+        # at that size streamed at 30 without a word; 0 is no rate reported, nothing to compare
+        live = not isinstance(src, (str, os.PathLike)) or (
+            "://" in os.fspath(src) or _camera_device(os.fspath(src)) is not None
+        )
+        if fps is not None and live and rate > 0 and abs(rate - fps) > 0.01 * fps:
+            try:
+                warnings.warn(
+                    f"{side} source {_describe_source(src)} reports {rate:g} fps, not the "
+                    f"{fps:g} fps asked (a rate this camera does not give at this size and "
+                    "format?)",
                     UserWarning,
                     stacklevel=4,  # _open, __init__, renamed_keyword's wrapper, the caller
                 )
