@@ -3108,6 +3108,37 @@ def test_a_camera_opened_by_its_device_node_that_stops_fails_the_stream(
 
 
 @PIPELINED
+def test_a_network_camera_that_stops_delivering_fails_the_stream(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An IP camera's live stream (``rtsp://``, as ``rtmp``, ``srt``, ``udp`` ...) has no end
+    either: its network dropped mid-stream ended the stream as ``"end of stream"``, exit 0,
+    without a word when both went, as a video file's end (only device indexes and nodes were
+    taken for cameras). It fails now as an unplugged camera does; an ``http://`` URL, which may
+    name a video file, still ends."""
+    from stereovision import capture as capmod
+
+    # the URL's capture (_UnpluggedNode: one that reports its backend, as OpenCV's do)
+    monkeypatch.setattr(capmod, "_open_path", lambda path, first: _UnpluggedNode(path[-1]))
+    said = (
+        "left source 'rtsp://cam/0' stopped delivering frames after 3 (disconnected?); right "
+        "source 'srt://cam:9000/1' stopped delivering frames after 3 (disconnected?)"
+    )
+    with StereoCamera("rtsp://cam/0", "srt://cam:9000/1") as cam:
+        rep = run_stream(cam, max_disparity=8, check=False, pipelined=False)
+    assert (rep.frames, rep.ended, rep.error) == (3, "source failed", said)
+    argv = ["stream", "--left", "rtsp://cam/0", "--right", "srt://cam:9000/1", "--no-display"]
+    assert main([*argv, "--no-check", "--json", "--max-disparity", "8"]) == 2
+    out, err = capsys.readouterr()
+    summary = json.loads(out.splitlines()[-1])
+    assert (summary["frames"], summary["ended"]) == (3, "source failed")
+    assert err.splitlines()[-1] == f"stereovision: error: {said}"
+    with StereoCamera("http://host/l.mp4", "https://host/r1.mp4") as cam:
+        rep = run_stream(cam, max_disparity=8, check=False, pipelined=False)
+    assert (rep.frames, rep.ended, rep.error) == (3, "end of stream", None)
+
+
+@PIPELINED
 def test_a_count_of_one_pair_is_said_in_the_singular(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

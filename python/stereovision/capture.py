@@ -1617,8 +1617,9 @@ class StereoCamera(PairSource):
         # whatever was copied into or moved out of its folder while it was read
         self._sequence_start: dict[str, int] = {}
         self._media_offset: float | None = None  # left - right media time of the first pair
-        # which sources are camera devices (an index, /dev/video0, a /dev/v4l/by-id link),
-        # known at the open: a by-id link is gone once its camera is unplugged
+        # which sources are cameras, with no end: devices (an index, /dev/video0, a
+        # /dev/v4l/by-id link), known at the open (a by-id link is gone once its camera is
+        # unplugged), and live network streams (rtsp://, _live_stream)
         self._device: dict[str, bool] = {}
         # The warnings below are inside too: one made an error (python -W error) left both
         # captures open, the object never returned to be closed.
@@ -1626,7 +1627,7 @@ class StereoCamera(PairSource):
             for side, src in self.sources.items():
                 self._caps[side] = self._open(side, src, fps, open_timeout)
                 path = os.fspath(src) if isinstance(src, os.PathLike) else src
-                self._device[side] = _camera_device(path) is not None
+                self._device[side] = _camera_device(path) is not None or _live_stream(path)
             starts = self._sequence_start
             if len(starts) == 2 and starts["left"] != starts["right"]:
                 # pairs are read in order, not by number: left_0001.png deleted (blurred)
@@ -2311,6 +2312,20 @@ def _camera_device(src: object) -> str | None:
     return None
 
 
+#: URL schemes of live streams (an IP camera's RTSP, RTMP, SRT, raw UDP/RTP/TCP), which have
+#: no end: one that stops delivering was lost, as an unplugged camera. ``http(s)://`` is not
+#: among them: it may name a video file, which ends.
+_LIVE_SCHEMES = ("rtsp", "rtsps", "rtmp", "rtmps", "rtp", "srt", "udp", "tcp")
+
+
+def _live_stream(src: object) -> bool:
+    """Whether ``src`` is the URL of a live network stream (:data:`_LIVE_SCHEMES`)."""
+    if not isinstance(src, str):
+        return False
+    m = re.match(r"\s*([A-Za-z][A-Za-z0-9+.-]*)://", src)
+    return m is not None and m.group(1).lower() in _LIVE_SCHEMES
+
+
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     """The :class:`StereoCamera` or :class:`~stereovision.rosbag.BagCamera` the options name.
 
@@ -2827,8 +2842,9 @@ def capture(
         Pairs to save. Without it, capture runs until a source ends (normal for files); when
         one ends before the other, or a video file before the frames its header announces
         (truncated), :attr:`CaptureResult.ended` says so (the CLI prints it). A camera device
-        has no end: one that stops delivering (unplugged) raises :class:`SourceError`, its
-        message saying the pairs saved, which are kept.
+        or a live stream (``rtsp://``, ``srt://``, ...) has no end: one that stops delivering
+        (unplugged, its network gone) raises :class:`SourceError`, its message saying the
+        pairs saved, which are kept.
     chessboard : tuple of int or str, optional
         Pattern (``(9, 6)`` or ``"9x6"``): save only pairs with the board in both images and a
         new pose (:class:`ChessboardCollector`).

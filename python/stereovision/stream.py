@@ -184,7 +184,8 @@ class StreamReport:
         ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C),
         ``"terminated"`` (SIGTERM, under the CLI), ``"source failed"`` (a source failed
         after the first pair: a frame that does not decode or of another shape, a camera
-        device that stopped delivering, unplugged; see :attr:`error`) or ``"output failed"``
+        device or live stream (``rtsp://``) that stopped delivering, unplugged or its network
+        gone; see :attr:`error`) or ``"output failed"``
         (``on_result`` or ``on_stamped_result`` raised an OSError, e.g. a bag on a full disk:
         that pair is not counted; see :attr:`error`).
     rectification : dict or None
@@ -925,11 +926,11 @@ def run_stream(
     ------
     SourceError
         If a source delivers no first frame, or fails on the first pair. A failure after it
-        (a frame that does not decode or of another shape; a camera device, unlike a file,
-        that stops delivering) ends the stream instead: the pairs
-        done are reported, with ``ended`` ``"source failed"`` and the error in ``error``; an
-        OSError of ``on_result`` or ``on_stamped_result`` (an output that cannot be written)
-        ends it likewise, ``ended`` ``"output failed"``.
+        (a frame that does not decode or of another shape; a camera device or a live stream
+        such as ``rtsp://``, unlike a file, that stops delivering) ends the stream instead:
+        the pairs done are reported, with ``ended`` ``"source failed"`` and the error in
+        ``error``; an OSError of ``on_result`` or ``on_stamped_result`` (an output that cannot
+        be written) ends it likewise, ``ended`` ``"output failed"``.
     ValueError
         If ``frames`` is not positive, ``method`` is unknown (before any grab), or the
         calibration does not fit the frames.
