@@ -3109,7 +3109,7 @@ def test_a_camera_opened_by_its_device_node_that_stops_fails_the_stream(
 
 @PIPELINED
 def test_a_network_camera_that_stops_delivering_fails_the_stream(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """An IP camera's live stream (``rtsp://``, as ``rtmp``, ``srt``, ``udp`` ...) has no end
     either: its network dropped mid-stream ended the stream as ``"end of stream"``, exit 0,
@@ -3136,6 +3136,14 @@ def test_a_network_camera_that_stops_delivering_fails_the_stream(
     with StereoCamera("http://host/l.mp4", "https://host/r1.mp4") as cam:
         rep = run_stream(cam, max_disparity=8, check=False, pipelined=False)
     assert (rep.frames, rep.ended, rep.error) == (3, "end of stream", None)
+    # capture without --count: its pairs kept, the loss said (it ended as 'end of stream')
+    from stereovision.capture import SourceError, capture
+
+    with StereoCamera("rtsp://cam/0", "srt://cam:9000/1") as cam:
+        with pytest.raises(SourceError) as info:
+            capture(cam, tmp_path)
+    assert str(info.value) == f"{said}; 3 pairs were saved in {tmp_path} and are kept"
+    assert len(list(tmp_path.glob("right_*.png"))) == 3
 
 
 @PIPELINED
