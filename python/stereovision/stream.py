@@ -344,6 +344,8 @@ class FrameServer:
     ------
     OSError
         If the address cannot be bound (port in use, ...).
+    ValueError
+        If ``port`` is not 0 to 65535, or ``host`` is empty (a bind's every interface).
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
