@@ -634,3 +634,21 @@ def test_gabor_responses_take_a_parameter_read_from_an_array_as_its_number() -> 
     for name, value in plain.items():
         got = gabor_responses(img, **{**plain, name: np.array([value])})
         np.testing.assert_array_equal(got, want, err_msg=name)
+
+
+@pytest.mark.parametrize("name", ["freq", "theta_deg", "bandwidth_oct", "aspect"])
+@pytest.mark.parametrize("value", ["0.3", None, True, [0.3]])
+def test_gabor_responses_name_a_parameter_that_is_no_number(name: str, value: object) -> None:
+    """gabor_responses took no part of gabor_disparity's rule: a string, None or a list was the
+    binding's TypeError "must be real number, not str", naming no parameter, and True ran as 1
+    (aspect=True gave the aspect-1.0 response). Each is a ValueError naming the parameter; a
+    Fraction or a Decimal is still its number."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
+    with pytest.raises(ValueError, match=f"^{name}: expected a number, got "):
+        gabor_responses(img, **{name: value})
+    want = gabor_responses(img, freq=0.25, aspect=0.5)
+    np.testing.assert_array_equal(gabor_responses(img, freq=Fraction(1, 4), aspect=0.5), want)
+    np.testing.assert_array_equal(gabor_responses(img, freq=0.25, aspect=Decimal("0.5")), want)

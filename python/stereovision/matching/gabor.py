@@ -255,8 +255,14 @@ def gabor_responses(
     -------
     numpy.ndarray
         ``(H, W)`` complex64 response ``y = h * image`` (true convolution, reflect-101 borders).
+
+    Raises
+    ------
+    ValueError
+        A bad image (as :func:`gabor_disparity`'s), or a parameter that is no number (a string,
+        None, a bool) or out of the kernel's range, named.
     """
-    values = []
+    values: list[Any] = []
     for name, v in (
         ("freq", freq),
         ("theta_deg", theta_deg),
@@ -267,6 +273,10 @@ def gabor_responses(
             # its number, as gabor_disparity reads freq: np.array([0.25]) was the binding's
             # bare TypeError "only 0-dimensional arrays can be converted"
             v = v.reshape(())[()]
+        # as gabor_disparity's: a string or None was the binding's TypeError "must be real
+        # number, not str", naming no parameter, and True ran as 1 (aspect=True as 1.0)
+        if isinstance(v, NOT_NUMBERS) or not isinstance(v, (numbers.Real, decimal.Decimal)):
+            raise ValueError(f"{name}: expected a number, got {v!r}")
         values.append(float_sized(v, name))  # 10**400: the binding's bare OverflowError
     re, im = _core.gabor_responses(_as_grey(image, "image"), *values)
     return (re + 1j * im).astype(np.complex64)
