@@ -1299,3 +1299,14 @@ def test_the_dpi_named_for_too_small_markers_is_the_least_that_is_taken() -> Non
             dictionary,
             need,
         )
+
+
+@pytest.mark.parametrize("value", ["no", "false", 0.5, 2, -1])
+def test_a_layout_that_is_no_switch_is_refused_by_name(value: object) -> None:
+    """CharucoBoard stored bool(legacy): "no", "false" and 0.5 became True, OpenCV's pre-4.6
+    layout, in which an even-rowed board's ids are read a square off. Only True, False (NumPy's
+    bools, 0 and 1) and None are a layout; anything else is a ValueError naming legacy."""
+    with pytest.raises(ValueError, match=r"^legacy: expected True, False or None, got "):
+        CharucoBoard("7x6", 0.03, 0.02, legacy=value)
+    for ok, want in ((np.False_, False), (1, True), (np.int64(0), False), (None, None)):
+        assert CharucoBoard("7x6", 0.03, 0.02, legacy=ok).legacy is want

@@ -131,7 +131,8 @@ class CharucoBoard:
     ------
     ValueError
         If a size is not positive and finite, the marker does not fit in a square, there are too
-        few squares, or the dictionary is unknown or too small for the board's markers.
+        few squares, the dictionary is unknown or too small for the board's markers, or
+        ``legacy`` is not True, False (0, 1) or None.
     """
 
     squares: tuple[int, int]
@@ -183,7 +184,17 @@ class CharucoBoard:
                 )
             object.__setattr__(self, "dictionary", name)
         if self.legacy is not None:
-            object.__setattr__(self, "legacy", bool(self.legacy))
+            # a switch: bool("no") and bool("false") were True, the pre-4.6 layout, and 0.5
+            # True as well; True/False, NumPy's bools and the integers 0 and 1 are one
+            v = self.legacy
+            flag = isinstance(v, (bool, np.bool_)) or (
+                isinstance(v, (int, np.integer))
+                and not isinstance(v, np.timedelta64)
+                and v in (0, 1)
+            )
+            if not flag:
+                raise ValueError(f"legacy: expected True, False or None, got {v!r}")
+            object.__setattr__(self, "legacy", bool(v))
 
     # ---------------------------------------------------------------------------- geometry
 
