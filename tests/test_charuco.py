@@ -1310,3 +1310,18 @@ def test_a_layout_that_is_no_switch_is_refused_by_name(value: object) -> None:
         CharucoBoard("7x6", 0.03, 0.02, legacy=value)
     for ok, want in ((np.False_, False), (1, True), (np.int64(0), False), (None, None)):
         assert CharucoBoard("7x6", 0.03, 0.02, legacy=ok).legacy is want
+
+
+@pytest.mark.parametrize("ids", [[24], [-1], [0, 30], [1.7], [np.nan], [True]])
+def test_object_points_refuse_ids_off_the_board(ids: list[object]) -> None:
+    """object_points cast the ids to int64 and placed any: id 24 of a 7x5 board's 24 corners
+    (0 to 23) gave a point on a fifth row of its four, -1 one on the board's edge (0.24, 0), 1.7 the
+    point of corner 1. Each is a ValueError naming ids; whole ids (floats too) still give
+    their corners."""
+    board = CharucoBoard("7x5", 0.04, 0.03, "DICT_5X5_100")
+    with pytest.raises(ValueError, match=r"^ids: expected"):
+        board.object_points(ids)
+    got = board.object_points(np.array([0.0, 23.0]))
+    np.testing.assert_array_equal(got, board.object_points([0, 23]))
+    np.testing.assert_allclose(got, [[0.04, 0.04, 0], [0.24, 0.16, 0]], rtol=1e-6)
+    assert board.object_points([]).shape == (0, 3)

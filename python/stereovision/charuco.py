@@ -217,13 +217,41 @@ class CharucoBoard:
     def object_points(self, ids: npt.ArrayLike | None = None) -> npt.NDArray[np.float32]:
         """Board coordinates of corners (``Z = 0``), in the order of ``ids`` (default: all).
 
+        Parameters
+        ----------
+        ids : array_like of int, optional
+            Inner-corner ids, ``0 .. n_corners - 1`` (as :func:`find_charuco_corners` gives
+            them); default: every corner in id order.
+
         Returns
         -------
         numpy.ndarray
             ``(N, 3)`` ``float32``.
+
+        Raises
+        ------
+        ValueError
+            If an id is not a whole number or lies outside ``0 .. n_corners - 1``.
         """
         cols = self.inner[0]
-        i = np.arange(self.n_corners) if ids is None else np.asarray(ids, np.int64).ravel()
+        if ids is None:
+            i = np.arange(self.n_corners)
+        else:
+            raw = np.asarray(ids)
+            # the cast truncated 1.7 to corner 1, and an id past the board (or negative) gave a
+            # point off it (id 24 of a 7x5 board's 24 corners: on a fifth row of its four)
+            whole = raw.dtype.kind in "iu" or (
+                raw.dtype.kind == "f" and bool(np.all(np.isfinite(raw) & (raw == np.round(raw))))
+            )
+            if not whole:
+                raise ValueError(f"ids: expected whole corner ids, got {raw.ravel()[:8]!r}")
+            if raw.size and not 0 <= raw.min() <= raw.max() < self.n_corners:
+                raise ValueError(
+                    f"ids: expected corner ids from 0 to {self.n_corners - 1} (a "
+                    f"{self.squares[0]}x{self.squares[1]} board), got {raw.min():g} to "
+                    f"{raw.max():g}"
+                )
+            i = raw.astype(np.int64).ravel()
         out = np.zeros((i.size, 3), np.float32)
         out[:, 0] = ((i % cols) + 1) * self.square_size
         out[:, 1] = ((i // cols) + 1) * self.square_size
