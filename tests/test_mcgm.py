@@ -1351,3 +1351,19 @@ def test_horiz_skip_deg_beyond_90_is_refused(deg: float) -> None:
     with pytest.raises(ValueError, match=r"horiz_skip_deg.*must be in \[0, 90\] degrees"):
         mcgm.mcgm_match(left, right, max_disparity=8, horiz_skip_deg=deg)
     assert len(mcgm.mcgm_match(left, right, max_disparity=8, horiz_skip_deg=90)) == 0
+
+
+@pytest.mark.parametrize("sigmas", [[1.0, 2.0, 4.0], [4.0, 1.0, 2.0], [2.0, 2.0], np.array([1, 2])])
+def test_sigmas_not_coarse_to_fine_are_named(sigmas: object) -> None:
+    """The kernel reads sigmas coarse to fine (the last the finest, filling first; each
+    channel's matches narrow the next one's search): [1, 2, 4] ran without a word, sigma 4 as
+    the finest channel (at half resolution, a prior only: none of its matches kept) and sigma
+    1 as a prior of sigma 2. Such a list is a ValueError naming sigmas; a decreasing one and a
+    single sigma still run."""
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"^sigmas: expected the channels coarse to fine"):
+        mcgm.mcgm_match(ok, ok, max_disparity=8, sigmas=sigmas)
+    with pytest.raises(ValueError, match=r"^sigmas: expected the channels coarse to fine"):
+        mcgm.curves(ok, sigmas=sigmas)
+    assert [c.sigma for c in mcgm.curves(ok, sigmas=[3.0, 1.0])] == [3.0, 1.0]
+    assert len(mcgm.curves(ok, sigmas=[1.0])) == 1

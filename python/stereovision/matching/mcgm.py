@@ -17,6 +17,7 @@ pixels, left-right check, the same filters).
 
 from __future__ import annotations
 
+import itertools
 import math
 import reprlib
 from dataclasses import dataclass
@@ -193,7 +194,8 @@ class ChannelCurves:
 def _sigmas(sig: object) -> list[float]:
     """``sigmas`` (one number or a 1-D sequence of them) as floats, after a ``ValueError`` naming
     it for anything else: NumPy's conversion read ``True`` and ``"2"`` as sigmas 1 and 2, None
-    as NaN ("got NaN"), and a nested list or a set was a TypeError naming nothing."""
+    as NaN ("got NaN"), and a nested list or a set was a TypeError naming nothing; and for a
+    list not coarse to fine (each sigma smaller than the one before), the kernel's order."""
     if isinstance(sig, np.ndarray) and sig.ndim <= 1:
         items = list(sig.reshape(-1))
     elif isinstance(sig, (list, tuple)):
@@ -206,7 +208,18 @@ def _sigmas(sig: object) -> list[float]:
                 f"sigmas: expected a number of pixels or a list of them, got {reprlib.repr(sig)}"
             )
         float_sized(s, "sigmas")
-    return [float(s) for s in items]
+    out = [float(s) for s in items]
+    # The kernel takes the list as coarse to fine: each channel's matches narrow the next one's
+    # search, the last is the finest and fills first. [1, 2, 4] ran sigma 4 as the finest (at
+    # half resolution: a prior only, none of its matches kept) and sigma 1 as a coarse prior
+    # of sigma 2, without a word (tsukuba, max_disparity 32: 4847 matches, 1.5 % off by over
+    # 1 px, against [4, 2, 1]'s 4877 and 1.3 %).
+    if any(a <= b for a, b in itertools.pairwise(out)):  # NaN: the kernel names it
+        raise ValueError(
+            f"sigmas: expected the channels coarse to fine, each sigma smaller than the one "
+            f"before (as the default {DEFAULTS['sigmas']}), got {reprlib.repr(sig)}"
+        )
+    return out
 
 
 def _shown(v: object) -> str:
@@ -344,8 +357,9 @@ def mcgm_match(
     ------
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter, a value
-        out of range, a ``debug`` that is not True or False, or a ``min_disparity`` not below
-        the image width (as :func:`stereovision.match`: no pixel has a match that far).
+        out of range, ``sigmas`` not coarse to fine, a ``debug`` that is not True or False, or a
+        ``min_disparity`` not below the image width (as :func:`stereovision.match`: no pixel
+        has a match that far).
     MemoryError
         When an image-sized buffer of the kernel cannot be allocated (the message names it and
         its size); the process is not aborted.
