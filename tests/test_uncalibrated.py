@@ -790,6 +790,29 @@ def test_rectify_uses_the_interpolation_given() -> None:
     assert set(np.unique(near)) <= {0, 100}
 
 
+@pytest.mark.parametrize(
+    "interpolation",
+    [True, "linear", None, 5, -1, 99, cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, 1.5],
+)
+def test_rectify_names_an_interpolation_that_is_no_warp_method(interpolation: object) -> None:
+    """True, "linear" or None were OpenCV's bare cv2.error "Overload resolution failed", 5 and
+    -1 its "Unknown interpolation method", and 99 or INTER_LINEAR | WARP_INVERSE_MAP warped
+    without a word (the latter with the inverse homographies: another pair). Each is a
+    ValueError naming interpolation; the five methods (2.0 read as 2, INTER_CUBIC) still warp."""
+    img = np.tile(np.array([0, 100], np.uint8), (8, 6))
+    half = np.array([[1.0, 0, 0.5], [0, 1, 0], [0, 0, 1]])
+    rect = UncalibratedRectification(
+        half, half, (12, 8), (12, 8), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16, (0.0, 0.0),
+        (1.0, 1.0),
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"^interpolation: expected one of OpenCV's"):
+        rect.rectify(img, img, interpolation=interpolation)
+    cubic, _ = rect.rectify(img, img, interpolation=cv2.INTER_CUBIC)
+    np.testing.assert_array_equal(rect.rectify(img, img, interpolation=2.0)[0], cubic)
+    for method in (cv2.INTER_NEAREST, cv2.INTER_AREA, cv2.INTER_LANCZOS4, np.int64(1)):
+        assert rect.rectify(img, img, interpolation=method)[0].shape == (8, 12)
+
+
 def test_the_coarse_probe_widens_the_range_unless_it_ran_out(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

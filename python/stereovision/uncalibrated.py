@@ -49,6 +49,7 @@ from stereovision._validate import (
     number_shown,
     real_number,
     too_large_for_float,
+    whole_value,
     xy_points,
 )
 from stereovision.rectification_check import (
@@ -292,6 +293,16 @@ def _dense_span(
     return float(lo) * k, float(hi) * k
 
 
+#: The interpolation methods OpenCV's warpPerspective takes (INTER_NEAREST to INTER_LANCZOS4).
+_WARP_METHODS = (
+    cv2.INTER_NEAREST,
+    cv2.INTER_LINEAR,
+    cv2.INTER_CUBIC,
+    cv2.INTER_AREA,
+    cv2.INTER_LANCZOS4,
+)
+
+
 def _corners(w: int, h: int) -> F64:
     return np.array([[0.0, 0.0], [w - 1.0, 0.0], [w - 1.0, h - 1.0], [0.0, h - 1.0]])
 
@@ -367,8 +378,20 @@ class UncalibratedRectification:
         ValueError
             If an image is not an image array (as :meth:`Calibration.rectify
             <stereovision.calibration.Calibration.rectify>`: bool, signed integer or other
-            dtypes, a wrong shape) or not of :attr:`input_size`.
+            dtypes, a wrong shape) or not of :attr:`input_size`, or ``interpolation`` is not
+            one of OpenCV's five methods of a warp (``cv2.INTER_NEAREST``, ``INTER_LINEAR``,
+            ``INTER_CUBIC``, ``INTER_AREA``, ``INTER_LANCZOS4``).
         """
+        # True or "linear" were OpenCV's bare "Overload resolution failed" (2.0 too: now 2, as
+        # the package reads a whole number), 5 to 7 its "Unknown interpolation method", and a
+        # flag beside a method warped otherwise without a word (cv2.WARP_INVERSE_MAP: with the
+        # inverse homographies, another pair)
+        method = whole_value(interpolation)
+        if method is None or method not in _WARP_METHODS:
+            raise ValueError(
+                "interpolation: expected one of OpenCV's cv2.INTER_NEAREST, INTER_LINEAR, "
+                f"INTER_CUBIC, INTER_AREA or INTER_LANCZOS4 (0 to 4), got {interpolation!r}"
+            )
         out = []
         for name, img, hom in (("left", left, self.H1), ("right", right, self.H2)):
             # OpenCV's own assertion ("ifunc != 0 in function 'remap'") of a bool or int64
@@ -378,7 +401,7 @@ class UncalibratedRectification:
             work = arr
             if arr.dtype.kind == "f" and arr.dtype.itemsize not in (4, 8):  # float16, long double
                 work = arr.astype(np.float32 if arr.dtype.itemsize == 2 else np.float64)
-            warped = np.asarray(cv2.warpPerspective(work, hom, self.size, flags=interpolation))
+            warped = np.asarray(cv2.warpPerspective(work, hom, self.size, flags=method))
             out.append(warped if warped.dtype == arr.dtype else warped.astype(arr.dtype))
         return out[0], out[1]
 
