@@ -1325,3 +1325,14 @@ def test_object_points_refuse_ids_off_the_board(ids: list[object]) -> None:
     np.testing.assert_array_equal(got, board.object_points([0, 23]))
     np.testing.assert_allclose(got, [[0.04, 0.04, 0], [0.24, 0.16, 0]], rtol=1e-6)
     assert board.object_points([]).shape == (0, 3)
+
+
+def test_board_png_of_a_board_whose_dictionary_is_auto_names_the_dictionary() -> None:
+    """board_png of CharucoBoard("7x5", ..., dictionary="auto") (its default) looked "auto" up
+    in cv2.aruco for its marker check: AttributeError "module 'cv2.aruco' has no attribute
+    'auto'". It is a ValueError naming the dictionary; the same board with one is printed."""
+    auto = CharucoBoard("7x5", 0.04, 0.03)
+    with pytest.raises(ValueError, match=r"^dictionary: a printed board needs its dictionary"):
+        board_png(auto, 0.04, dpi=100)
+    _, size = board_png(replace(auto, dictionary="DICT_5X5_100"), 0.04, dpi=100)
+    assert size == (9 * 157, 7 * 157)  # round(40 mm / 25.4 mm x 100) px, one-square margins

@@ -836,9 +836,23 @@ def board_png(
     -------
     bytes, tuple of int
         The PNG file's bytes and its ``(width, height)`` in pixels.
+
+    Raises
+    ------
+    ValueError
+        A square or dpi giving under 10 or over 20000 px per square, an image over
+        :data:`MAX_IMAGE_PIXELS`, markers too small to be decoded at ``dpi``, a ChArUco board
+        whose dictionary is ``"auto"``, or a chessboard pattern that is none.
     """
     pix, ppm = _board_scale(square_metres, dpi)
     if isinstance(board, CharucoBoard):
+        if board.dictionary == "auto":
+            # its marker check looked the name up in cv2.aruco: AttributeError "module
+            # 'cv2.aruco' has no attribute 'auto'" (`board` picks a dictionary first)
+            raise ValueError(
+                "dictionary: a printed board needs its dictionary ('auto' is found from the "
+                "images of a board already printed): give one, e.g. 'DICT_5X5_100'"
+            )
         cols, rows = board.squares
         # checked here too: image() names its pixels_per_square, which board_png's caller
         # did not give (they gave the square and dpi)
