@@ -1367,3 +1367,27 @@ def test_sigmas_not_coarse_to_fine_are_named(sigmas: object) -> None:
         mcgm.curves(ok, sigmas=sigmas)
     assert [c.sigma for c in mcgm.curves(ok, sigmas=[3.0, 1.0])] == [3.0, 1.0]
     assert len(mcgm.curves(ok, sigmas=[1.0])) == 1
+
+
+def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> None:
+    """zncc_reference reshaped ``pixels`` to (-1, 2) and cast it to int64: a (2, N) array
+    (np.nonzero's rows, or x over y) was paired into other pixels, and (10.7, 20.2) truncated
+    to (10, 20), each without a word. Both are a ValueError naming pixels; whole float
+    positions, one (x, y) pair and an empty list are read as before."""
+    left, right = _zncc_pair()
+    off = {"sides": False, "disc": False, "zncc_check": False}
+    ys, xs = np.mgrid[8:50:6, 12:95:5]
+    pixels = np.stack([xs.ravel(), ys.ravel()], axis=1)
+    want = mcgm.zncc_reference(left, right, max_disparity=8, pixels=pixels, **off)
+    assert len(want) > 5
+    with pytest.raises(ValueError, match=r"^pixels: expected shape \(N, 2\).*transpose"):
+        mcgm.zncc_reference(left, right, max_disparity=8, pixels=pixels.T, **off)
+    for bad in ([[10.7, 20.2]], [[10, np.nan]], [["10", "20"]]):
+        with pytest.raises(ValueError, match=r"^pixels: expected whole \(x, y\) pixel"):
+            mcgm.zncc_reference(left, right, max_disparity=8, pixels=bad, **off)
+    got = mcgm.zncc_reference(left, right, max_disparity=8, pixels=pixels.astype(float), **off)
+    np.testing.assert_array_equal(got.xr, want.xr)
+    one = mcgm.zncc_reference(left, right, max_disparity=8, pixels=pixels[0], **off)
+    first = mcgm.zncc_reference(left, right, max_disparity=8, pixels=pixels[:1], **off)
+    np.testing.assert_array_equal(one.xr, first.xr)
+    assert len(mcgm.zncc_reference(left, right, max_disparity=8, pixels=[], **off)) == 0

@@ -37,6 +37,7 @@ from stereovision._validate import (
     refuse_unknown,
     refuse_unreachable_range,
     too_large_for_float,
+    xy_points,
 )
 from stereovision.matches import Matches
 
@@ -466,6 +467,29 @@ def edge_filters(
     return _core.mcgm_filter(gl, gr, arr, kw)
 
 
+def _pixels(pixels: npt.ArrayLike) -> npt.NDArray[np.int64]:
+    """:func:`zncc_reference`'s ``pixels`` as ``(N, 2)`` int64 ``(x, y)``, after a ``ValueError``
+    naming them for another layout or a position that is no whole pixel: the reshape to
+    ``(-1, 2)`` paired a ``(2, N)`` array's (``np.nonzero(mask)``'s rows, or x over y) values
+    into other pixels, and the cast truncated 10.7 to 10, each without a word."""
+    raw = np.asarray(pixels)
+    if raw.size == 0:
+        return np.zeros((0, 2), np.int64)
+    if raw.dtype.kind not in "iuf":
+        raise ValueError(f"pixels: expected whole (x, y) pixel positions, got dtype {raw.dtype}")
+    # one (x, y) pixel as before; any other shape not (N, 2): xy_points names it
+    pts = xy_points(raw.reshape(1, 2) if raw.shape == (2,) else raw, "pixels")
+    whole = np.isfinite(pts) & (pts == np.round(pts))
+    if not whole.all():
+        i = int(np.argmin(whole.all(axis=1)))
+        raise ValueError(
+            f"pixels: expected whole (x, y) pixel positions, got ({pts[i, 0]:g}, {pts[i, 1]:g}) "
+            f"at row {i}"
+        )
+    out: npt.NDArray[np.int64] = raw.reshape(-1, 2).astype(np.int64)
+    return out
+
+
 def _row(m: npt.NDArray[np.float32]) -> str:
     """One ``[xl, yl, xr, yr]`` row for a message."""
     return "(xl, yl, xr, yr) = (" + ", ".join(f"{float(v):g}" for v in m) + ")"
@@ -509,7 +533,8 @@ def zncc_reference(
     max_disparity, min_disparity : float
         Disparity range (px).
     pixels : array_like, optional
-        ``(N, 2)`` integer ``(x, y)`` left pixels; default: every pixel of a full-resolution
+        ``(N, 2)`` integer ``(x, y)`` left pixels (whole numbers; those whose 7x7 window does
+        not fit in the image are left out); default: every pixel of a full-resolution
         channel's segments, tangent at least ``horiz_skip_deg`` from horizontal.
     **params
         :data:`DEFAULTS` overrides (curves and filters).
@@ -522,7 +547,8 @@ def zncc_reference(
     Raises
     ------
     ValueError
-        As :func:`mcgm_match` (a ``min_disparity`` not below the image width included).
+        As :func:`mcgm_match` (a ``min_disparity`` not below the image width included), or
+        ``pixels`` not of shape ``(N, 2)`` (a ``(2, N)`` array) or not whole pixel positions.
     """
     gl, gr = check_pair(left, right)
     kw = _params(max_disparity, min_disparity, params)
@@ -537,7 +563,7 @@ def zncc_reference(
                 mask |= on
         ys, xs = np.nonzero(mask)
     else:
-        p = np.asarray(pixels, dtype=np.int64).reshape(-1, 2)
+        p = _pixels(pixels)
         xs, ys = p[:, 0], p[:, 1]
     # No disparity reaches past the image: keeps the (D, H, W) score volume bounded.
     lo, hi = min(kw["min_disparity"], w - 1), min(kw["max_disparity"], w - 1)
