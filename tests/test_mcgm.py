@@ -1391,3 +1391,19 @@ def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> No
     first = mcgm.zncc_reference(left, right, max_disparity=8, pixels=pixels[:1], **off)
     np.testing.assert_array_equal(one.xr, first.xr)
     assert len(mcgm.zncc_reference(left, right, max_disparity=8, pixels=[], **off)) == 0
+
+
+@pytest.mark.parametrize("sigma", [True, np.True_, "2", b"2", np.timedelta64(2, "ns")])
+def test_log_filter_refuses_a_bool_a_numeric_string_or_a_time_as_sigma(sigma: object) -> None:
+    """log_filter's float() read True as sigma 1, "2" and b"2" as 2 and 2 ns as 2 (mcgm_match's
+    sigmas refuse each, naming sigmas): each is a ValueError naming sigma; a Fraction, a Decimal
+    and a NumPy float are still their number."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    img = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"^sigma: expected a number of pixels, got "):
+        mcgm.log_filter(img, sigma)  # type: ignore[arg-type]
+    want = mcgm.log_filter(img, 2.0)
+    for same in (Fraction(2), Decimal("2"), np.float32(2.0), 2):
+        np.testing.assert_array_equal(mcgm.log_filter(img, same), want)  # type: ignore[arg-type]

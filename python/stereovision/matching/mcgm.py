@@ -279,6 +279,10 @@ def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
         # its number, as mcgm_match reads sigmas: float() of np.array([2.0]) was NumPy's bare
         # TypeError "only 0-dimensional arrays can be converted"
         sigma = sigma.reshape(())[()]
+    if isinstance(sigma, (*NOT_NUMBERS, str, bytes)):
+        # float() read True as sigma 1, "2" and b"2" as 2, and 2 ns as 2 (mcgm_match's sigmas
+        # refuse them all); a Fraction or a Decimal is still its number
+        raise ValueError(f"sigma: expected a number of pixels, got {reprlib.repr(sigma)}")
     try:
         # 10**400 was float()'s bare OverflowError
         value = float(float_sized(sigma, "sigma"))
