@@ -1336,3 +1336,17 @@ def test_board_png_of_a_board_whose_dictionary_is_auto_names_the_dictionary() ->
         board_png(auto, 0.04, dpi=100)
     _, size = board_png(replace(auto, dictionary="DICT_5X5_100"), 0.04, dpi=100)
     assert size == (9 * 157, 7 * 157)  # round(40 mm / 25.4 mm x 100) px, one-square margins
+
+
+@pytest.mark.parametrize("background", [300, -5, True, "60", None, float("nan")])
+def test_render_charuco_names_a_background_that_is_no_grey_level(background: object) -> None:
+    """render_charuco clipped its uint8 output: background=300 rendered 255 and -5 rendered 0,
+    True was 1 and "60" 60, each without a word. A background that is no grey level from 0 to
+    255 is a ValueError naming it; 0, 255 and 60.0 are still the grey off the board."""
+    board = CharucoBoard("5x4", 0.04, 0.03, "DICT_4X4_50")
+    pose = (np.zeros(3), np.array([-0.1, -0.08, 0.5]))
+    with pytest.raises(ValueError, match=r"^background: expected a grey level from 0 to 255"):
+        render_charuco(board, K1, D1, *pose, background=background)
+    for grey in (0, 255, 60.0):
+        img = render_charuco(board, K1, D1, *pose, background=grey, supersample=1)
+        assert img[0, 0] == round(grey)

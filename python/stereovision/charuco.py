@@ -32,7 +32,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import int_in_range
+from stereovision._validate import int_in_range, real_number
 from stereovision.synthetic import render_plane
 
 __all__ = [
@@ -642,7 +642,7 @@ def render_charuco(
     pixels_per_square : int
         Resolution of the board image that is looked up.
     background : int
-        Grey level off the board (the board is 0 and 255; it is mapped to 25 .. 230).
+        Grey level off the board, 0 to 255 (the board is 0 and 255; it is mapped to 25 .. 230).
     model : str
         ``"pinhole"`` or ``"fisheye"`` (``D`` then holds ``cv2.fisheye``'s k1..k4).
 
@@ -650,8 +650,19 @@ def render_charuco(
     -------
     numpy.ndarray
         ``(height, width)`` ``uint8``.
+
+    Raises
+    ------
+    ValueError
+        A board whose dictionary is not known, ``pixels_per_square`` outside 10 to 2000, a
+        ``background`` that is no grey level from 0 to 255, or a camera, pose, size,
+        ``supersample`` or ``model`` :func:`~stereovision.synthetic.render_plane` refuses.
     """
     p = int_in_range(pixels_per_square, "pixels_per_square", 10, 2000)
+    # a grey level of the uint8 image: 300 and -5 were clipped to 255 and 0, True was 1 and
+    # "60" 60, each without a word
+    if not (real_number(background) and 0 <= background <= 255):
+        raise ValueError(f"background: expected a grey level from 0 to 255, got {background!r}")
     img = board.image(p, margin=p)
     tone = (img.astype(np.float32) * ((230.0 - 25.0) / 255.0) + 25.0).astype(np.float32)
     # Board coordinate 0 is the outer edge of the squares: the image's pixel p - 0.5 (centres).
