@@ -723,3 +723,29 @@ def test_textureless_right_windows_are_no_candidates_at_any_s_min(s_min: float) 
     assert not np.any((cand[:, 3] >= 43) & (cand[:, 3] <= 66))
     ours = {(int(c[0]), int(c[3])) for c in cand}
     assert ours == {(n["point"], n["xr"]) for n in want}
+
+
+def test_counts_and_reals_are_read_as_the_librarys_numbers() -> None:
+    """The library's one rule of a count (whole_value: gabor's, sgm's, fuse's) was not the
+    network's: k_cand=8.0, Fraction(8) or np.array([8.0]) was "parameter `k_cand`: TypeError:
+    'float' object cannot be interpreted as an integer", and A=np.array([3.0]) "only
+    0-dimensional arrays can be converted". Each gives the plain number's matches; 8.5 is still
+    refused by name."""
+    from fractions import Fraction
+
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    base = {"k_cand": 8, "A": 3.0, "max_sweeps": 50}
+    want = hp.hopfield_match(left, right, max_disparity=8, **base)
+    assert len(want) > 50
+    for kw in (
+        {"k_cand": 8.0},
+        {"k_cand": Fraction(8)},
+        {"k_cand": np.array([8.0]), "max_sweeps": np.float32(50)},
+        {"A": np.array([3.0])},
+    ):
+        got = hp.hopfield_match(left, right, max_disparity=8, **{**base, **kw})
+        np.testing.assert_array_equal(got.xr, want.xr, err_msg=str(kw))
+    with pytest.raises(ValueError, match="k_cand"):
+        hp.hopfield_match(left, right, max_disparity=8, k_cand=8.5)

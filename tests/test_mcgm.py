@@ -1407,3 +1407,32 @@ def test_log_filter_refuses_a_bool_a_numeric_string_or_a_time_as_sigma(sigma: ob
     want = mcgm.log_filter(img, 2.0)
     for same in (Fraction(2), Decimal("2"), np.float32(2.0), 2):
         np.testing.assert_array_equal(mcgm.log_filter(img, same), want)  # type: ignore[arg-type]
+
+
+def test_counts_and_reals_are_read_as_the_librarys_numbers() -> None:
+    """The library's one rule of a count (whole_value: gabor's, sgm's, fuse's) was not the
+    channel's: knn=6.0, Fraction(6) or np.array([6]) was "parameter `knn`: TypeError: 'float'
+    object cannot be interpreted as an integer", and r_graph=np.array([60.0]) "only
+    0-dimensional arrays can be converted". Each gives the plain number's matches; 6.5 is still
+    refused by name."""
+    from fractions import Fraction
+
+    yy, xx = np.mgrid[0:80, 0:120].astype(np.float32)
+
+    def scene(s: float) -> np.ndarray:
+        return (0.5 + 0.4 * np.sin((xx + s) / 5.0) * np.cos(yy / 7.0)).astype(np.float32)
+
+    left, right = scene(0.0), scene(3.4)
+    base = {"knn": 6, "r_graph": 60.0, "disc_dx": 6}
+    want = mcgm.mcgm_match(left, right, max_disparity=8, **base)
+    assert len(want) > 100
+    for kw in (
+        {"knn": 6.0},
+        {"knn": Fraction(6)},
+        {"knn": np.array([6]), "disc_dx": np.float32(6)},
+        {"r_graph": np.array([60.0])},
+    ):
+        got = mcgm.mcgm_match(left, right, max_disparity=8, **{**base, **kw})
+        np.testing.assert_array_equal(got.xr, want.xr, err_msg=str(kw))
+    with pytest.raises(ValueError, match="knn"):
+        mcgm.mcgm_match(left, right, max_disparity=8, knn=6.5)

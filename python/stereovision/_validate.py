@@ -803,6 +803,34 @@ def refuse_not_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> None
             raise ValueError(f"{name}: expected a number, got {v!r}")
 
 
+def read_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> dict[str, Any]:
+    """``params`` with each count (a parameter whose default is an int) that is a whole number
+    as :func:`whole_value` reads it (``8.0``, ``Fraction(8)``, ``np.array([8])``) as that int,
+    and each real (a float default) given as a size-1 array as its number; anything else as
+    given, for the kernel to name. The Hopfield and MCGM kernels took neither: ``k_cand=8.0``
+    was "parameter `k_cand`: TypeError: 'float' object cannot be interpreted as an integer",
+    ``A=np.array([3.0])`` "only 0-dimensional arrays can be converted", where the Gabor and
+    census wrappers take both.
+
+    Examples
+    --------
+    >>> read_numbers({"k": 8.0, "a": np.array([0.5]), "s": "x"}, {"k": 1, "a": 1.0, "s": "y"})
+    {'k': 8, 'a': np.float64(0.5), 's': 'x'}
+    """
+    out = dict(params)
+    for name, v in params.items():
+        d = defaults.get(name)
+        if isinstance(d, bool) or not isinstance(d, (int, float)):
+            continue  # a switch, a choice, a list: the kernel's own
+        if isinstance(d, int):
+            whole = whole_value(v)
+            if whole is not None:
+                out[name] = whole
+        elif isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf":
+            out[name] = v.reshape(())[()]
+    return out
+
+
 def _real_scalar(value: object) -> float:
     """``value`` as a float when it is one real number: a Python or NumPy int or float, or a
     size-1 NumPy array of them (``np.array(3.0)``, ``np.array([3.0])``: a value read from an

@@ -29,6 +29,7 @@ from stereovision._validate import (
     float_sized,
     int_in_range,
     luma_weights,
+    read_numbers,
     real_number,
     refuse_not_numbers,
     refuse_unknown,
@@ -196,6 +197,7 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
         if not real_number(v) or not finite or v < 0:
             raise ValueError(f"{name} must be a non-negative number of pixels, got {_shown(v)}")
     refuse_not_numbers(params, DEFAULTS)  # the kernel read True as 1 (A=True), 3 ns as 3
+    params = read_numbers(params, DEFAULTS)  # k_cand=8.0, A=np.array([3.0]): their numbers
     # The kernel clips the range to the image; the clip here keeps it within its integers (2**70
     # was the binding's "OverflowError: int too big to convert").
     big = 2**31 - 1

@@ -32,6 +32,7 @@ from stereovision._validate import (
     as_gray_float,
     check_pair,
     float_sized,
+    read_numbers,
     real_number,
     refuse_not_numbers,
     refuse_unknown,
@@ -231,6 +232,7 @@ def _shown(v: object) -> str:
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown("MCGM parameter", params, DEFAULTS, "stereovision.matching.mcgm.DEFAULTS")
     refuse_not_numbers(params, DEFAULTS)  # the kernel read True as 1 (A=True), 3 ns as 3
+    params = read_numbers(params, DEFAULTS)  # knn=6.0, r_graph=np.array([60.0]): their numbers
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if (
             not real_number(v)  # a bool, 3 ns
