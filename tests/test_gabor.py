@@ -520,10 +520,11 @@ def test_input_types_taken_and_refused() -> None:
             gabor_disparity(lft, rgt, max_disparity=8, **kw)
 
 
-@pytest.mark.parametrize("value", ["ab", [None], [0.0, "x"]])
+@pytest.mark.parametrize("value", ["ab", [None], [0.0, "x"], np.array(0.0)])
 def test_orientations_of_another_type_are_named(value: object) -> None:
     """orientations_deg="ab" was "could not convert string to float: 'a'" and [None] float()'s
-    bare TypeError, naming no parameter."""
+    bare TypeError, naming no parameter; np.array(0.0) (a 0-d array: one number, as 0.0 itself
+    is refused) NumPy's bare TypeError "iteration over a 0-d array"."""
     img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
     with pytest.raises(ValueError, match=r"^orientations_deg must be a sequence of degrees, got "):
         gabor_disparity(img, img, max_disparity=8, orientations_deg=value)

@@ -218,6 +218,9 @@ def gabor_disparity(
     if (
         isinstance(orient, str)
         or not isinstance(orient, (Sequence, np.ndarray))
+        # a 0-d array (one number, as 0.0 itself is refused) was NumPy's bare TypeError
+        # "iteration over a 0-d array", and a 2-D one's rows are no degrees
+        or (isinstance(orient, np.ndarray) and orient.ndim != 1)
         or not all(real_number(t) for t in orient)
     ):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
