@@ -1571,3 +1571,36 @@ def test_both_rectification_checks_refuse_a_tolerance_that_is_no_number_of_pixel
         rect.check(a, a, tolerance=value)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match=said):
         check_rectification(a, a, tolerance=value)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("size", [640.7, 360]),
+        ("size", [True, 360]),
+        ("input_size", [600, 400, 3]),
+        ("input_size", 600),
+        ("matches", 3.9),
+        ("max_disparity", "48"),
+    ],
+)
+def test_a_file_with_a_count_that_is_no_whole_number_is_named(
+    tmp_path: Path, field: str, value: object
+) -> None:
+    """load read the sizes and counts with int(): a hand-edited size of 640.7 was 640, true a
+    1 px wide output, "48" a max_disparity of 48, 3.9 matches 3, and a third size entry was
+    left out, each without a word. Each is refused naming the field; whole floats (640.0), as
+    another JSON writer may give them, are still read."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (640, 360), (600, 400), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
+        48, (0.02, 0.03), (1.001, 0.998), "quasi-euclidean",
+    )  # fmt: skip
+    raw = rect.as_dict()
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps({**raw, field: value}))
+    with pytest.raises(ValueError, match=f"is not an uncalibrated rectification: {field}: "):
+        UncalibratedRectification.load(path)
+    path.write_text(json.dumps({**raw, "size": [640.0, 360.0], "max_disparity": 48.0}))
+    back = UncalibratedRectification.load(path)
+    assert back.size == (640, 360) and back.max_disparity == 48
+    assert type(back.size[0]) is int and type(back.max_disparity) is int

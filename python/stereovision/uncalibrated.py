@@ -625,14 +625,14 @@ class UncalibratedRectification:
             out = cls(
                 mats["H1"],
                 mats["H2"],
-                (int(d["size"][0]), int(d["size"][1])),
-                (int(d["input_size"][0]), int(d["input_size"][1])),
+                _size(d["size"], "size"),
+                _size(d["input_size"], "input_size"),
                 mats["F"],
-                int(d["matches"]),
+                _whole(d["matches"], "matches"),
                 _figure(d["median_dy"]),
                 _figure(d["p95_dy"]),
                 (_figure(d["disparity_range"][0]), _figure(d["disparity_range"][1])),
-                int(d["max_disparity"]),
+                _whole(d["max_disparity"], "max_disparity"),
                 (_figure(d["skew_deg"][0]), _figure(d["skew_deg"][1])),
                 (_figure(d["aspect"][0]), _figure(d["aspect"][1])),
                 str(d.get("model", "projective")),
@@ -661,6 +661,23 @@ class UncalibratedRectification:
             f"{self.max_disparity}); {self.size[0]}x{self.size[1]} px, skew "
             f"{max(self.skew_deg):.2f} deg, aspect {self.aspect[0]:.3f} / {self.aspect[1]:.3f}"
         )
+
+
+def _whole(value: Any, field: str) -> int:
+    """A count of a rectification file (a JSON integer, or a whole float such as 16.0); int()
+    read 40.7 as 40, true as 1 and "16" as 16, so a damaged or hand-edited file passed."""
+    whole = None if isinstance(value, str) else whole_value(value)
+    if whole is None:
+        raise ValueError(f"{field}: expected a whole number, got {value!r}")
+    return whole
+
+
+def _size(value: Any, field: str) -> tuple[int, int]:
+    """A ``[width, height]`` of a rectification file, each :func:`_whole` (a third entry was
+    left out without a word)."""
+    if not isinstance(value, list) or len(value) != 2:
+        raise ValueError(f"{field}: expected [width, height], got {value!r}")
+    return _whole(value[0], field), _whole(value[1], field)
 
 
 def _figure(value: Any) -> float:
