@@ -1050,6 +1050,45 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     assert _summary(out)["run"]["skipped"] == 2
 
 
+def test_batch_skipped_pairs_record_where_their_images_are_now(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An input folder moved (its images' times kept) and run again: its pairs are skipped,
+    and their records name the images where they are now. They named the old place, a path
+    gone, beside the summary's new ``input``; a new drive made at that old place was then
+    taken for the pairs' own images, and its other images replaced the moved drive's
+    outputs without a word (refused for any other folder as 'made from other images')."""
+    one, out = tmp_path / "drive1", tmp_path / "out"
+    names = [f"seq/{i:04d}_{s}.png" for i in range(2) for s in ("left", "right")]
+    _tiny(one, data_dir, *names)
+    args = ["--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(one), "-o", str(out), *args]) == 0
+    moved = tmp_path / "moved"
+    shutil.move(one, moved)  # mv keeps the times: the pairs are skipped
+    assert main(["batch", str(moved), "-o", str(out), *args]) == 0
+    pairs = _summary(out)["pairs"]
+    assert _summary(out)["run"]["skipped"] == 2
+    assert [(pairs[n]["left"], pairs[n]["right"]) for n in ("seq/0000", "seq/0001")] == [
+        (str(moved / f"seq/{i:04d}_left.png"), str(moved / f"seq/{i:04d}_right.png"))
+        for i in range(2)
+    ]
+    # another drive at the first one's old place: its pairs are not the moved drive's
+    _tiny(one, data_dir, *names)
+    _change(one / "seq/0000_left.png")
+    _change(one / "seq/0001_left.png")
+    before = _tree(out)
+    capsys.readouterr()
+    assert main(["batch", str(one), "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        f"stereovision: error: output folder {out} holds the outputs of 2 pair(s) of the same "
+        f"names made from other images (e.g. seq/0000 from "
+        f"{moved / 'seq/0000_left.png'}); give another output folder, or remove those pairs' "
+        "folders to replace them"
+    ]
+    assert _tree(out) == before and _summary(out)["input"] == str(moved)
+
+
 def test_batch_refuses_to_replace_a_file_it_did_not_write(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

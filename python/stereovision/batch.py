@@ -1557,7 +1557,15 @@ def run_batch(
                 )
             if _skip(entry, fp, opts, out, job.name, retry_failed):
                 assert entry is not None
-                entry["this_run"] = "skipped"
+                # its images where they are now: an input moved with its times named the old
+                # place, and a new drive made there passed for these images (not refused as
+                # made from other images, its outputs replacing these)
+                entry.update(
+                    left=_recorded(job.left),
+                    right=_recorded(job.right),
+                    calib=None if job.calib is None else _recorded(job.calib),
+                    this_run="skipped",
+                )
                 (skipped if entry["status"] == "done" else failed_before).append(job.name)
                 continue
             if (
