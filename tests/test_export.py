@@ -1058,6 +1058,24 @@ def test_export_result_formats_as_one_string_is_named(result, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_export_result_formats_given_once_through_are_all_written(result, tmp_path):
+    """Formats given as a generator (or any iterator) were used up by the check of their names,
+    so nothing was written and ``{}`` returned, the folder made empty, without a word; they
+    are written as a tuple of them is. Formats that are no collection of names are named."""
+    wanted = ("npz", "disp16")
+    written = export.export_result(result, tmp_path / "gen", (f for f in wanted))
+    assert sorted(written) == ["depth.npz", "disparity_16.png"]
+    assert sorted(p.name for p in (tmp_path / "gen").iterdir()) == sorted(written)
+    assert written == export.export_result(result, tmp_path / "gen", wanted)
+    for bad in (None, 3):
+        with pytest.raises(TypeError) as info:
+            export.export_result(result, tmp_path / "bad", bad)
+        assert str(info.value) == (
+            f"formats: expected a tuple of format names, got {bad!r} (e.g. ('ply', 'npz'))"
+        )
+    assert not (tmp_path / "bad").exists()
+
+
 def test_pcd_without_the_comment_line_and_with_signed_colours(tmp_path):
     """A PCD may start at VERSION (the comment line is optional); a ``TYPE I`` colour holds
     the bits as a signed integer (opaque red 0xFFFF0000 is -65536)."""

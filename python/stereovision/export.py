@@ -1067,7 +1067,8 @@ def export_result(
     Raises
     ------
     TypeError
-        If ``formats`` is one string (``"ply"``), not a tuple of them.
+        If ``formats`` is one string (``"ply"``), not a tuple of them, or no collection of
+        names at all (None). Any iterable of names is taken (a list, a generator).
     ValueError
         Unknown format, or PLY / PCD / depth PNG asked for a result without calibration.
     IsADirectoryError
@@ -1087,6 +1088,14 @@ def export_result(
             f"formats: expected a tuple of format names, got the string {formats!r} "
             f"(give ({formats!r},))"
         )
+    try:
+        # once, as a tuple: a generator was used up by the check of its names below, and
+        # nothing was written ({} returned, without a word)
+        formats = tuple(formats)
+    except TypeError:  # None, a number: "'NoneType' object is not iterable" named no argument
+        raise TypeError(
+            f"formats: expected a tuple of format names, got {formats!r} (e.g. ('ply', 'npz'))"
+        ) from None
     unknown = set(formats) - set(EXPORT_FORMATS)
     if unknown:
         raise ValueError(
