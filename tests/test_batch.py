@@ -495,6 +495,29 @@ def test_batch_max_disparity_zero_is_refused(tmp_path: Path) -> None:
         run_batch(tmp_path / "missing", tmp_path / "o", max_disparity=0)
 
 
+def test_batch_unknown_method_or_fill_is_refused_before_the_run(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """run_batch(method="censu") or fill="no" started a cluster, failed every pair with the same
+    error ("unknown method 'censu'") and recorded them all as failed (a finished pair's record
+    too), an output folder made; refused by name now, before the input is searched, as
+    depth_map and run_stream refuse them. fill=numpy.True_ is True (it reached the summary's
+    JSON, which cannot hold it)."""
+    from stereovision.batch import run_batch
+
+    root, out = tmp_path / "in", tmp_path / "o"
+    _tiny(root, data_dir, "a_left.png", "a_right.png")
+    with pytest.raises(
+        ValueError, match=r"^unknown method 'censu': expected one of fused, gabor, census, fast$"
+    ):
+        run_batch(root, out, workers=1, method="censu", progress=False)
+    with pytest.raises(TypeError, match=r"^fill: expected True, False or None, got 'no'$"):
+        run_batch(root, out, workers=1, fill="no", progress=False)  # type: ignore[arg-type]
+    assert not out.exists()
+    res = run_batch(root, out, workers=1, max_disparity=16, fill=np.True_, progress=False)
+    assert res.processed == ["a"] and _summary(out)["pairs"]["a"]["options"]["fill"] is True
+
+
 def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Path) -> None:
     """A grid cell of 0.01 m and of 10 m, the bounds, pass the options' check (the missing input
     is the error); past them, and a calib_unit without calib, are refused by name."""

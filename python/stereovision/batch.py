@@ -1448,10 +1448,12 @@ def run_batch(
     FileNotFoundError, NotADirectoryError
         A missing input folder or calibration file.
     ValueError
-        Bad ``workers`` / ``max_disparity``, no pair under the input, an output folder that
-        is a file (or below one), or one holding the outputs of pairs of the same names that
-        a run over another input folder made from other images (they would be replaced), or
-        one that another run is writing into.
+        Bad ``workers`` / ``max_disparity``, an unknown ``method``, no pair under the input,
+        an output folder that is a file (or below one), or one holding the outputs of pairs of
+        the same names that a run over another input folder made from other images (they would
+        be replaced), or one that another run is writing into.
+    TypeError
+        A ``fill`` that is not True, False or None.
     PermissionError
         If the output folder cannot be written.
     OSError
@@ -1472,6 +1474,17 @@ def run_batch(
         raise ValueError(f"grid: expected a cell side from 0.01 to 10 m, got {grid}")
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    import numpy as np
+
+    from stereovision.depth import METHODS
+
+    # refused here, as depth_map refuses them: in the workers every pair failed alike (a
+    # cluster started, each pair recorded as failed, a finished pair's record too)
+    if method is not None and method not in METHODS:
+        raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    if fill is not None and not isinstance(fill, (bool, np.bool_)):
+        raise TypeError(f"fill: expected True, False or None, got {fill!r}")
+    fill = None if fill is None else bool(fill)  # numpy's True_ is no JSON for the summary
     from stereovision.io import check_output_folder
 
     t0 = time.perf_counter()
