@@ -518,6 +518,32 @@ def test_batch_unknown_method_or_fill_is_refused_before_the_run(
     assert res.processed == ["a"] and _summary(out)["pairs"]["a"]["options"]["fill"] is True
 
 
+def test_batch_max_disparity_is_checked_as_depth_map_checks_it(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """max_disparity=True passed the check (True > 0) and every pair failed in the workers
+    ("expected a number of pixels, got True"); "16" was Python's "'<=' not supported between
+    instances of 'str' and 'int'"; NaN passed and failed every pair. All are refused by name
+    now, before the input is searched. A NumPy integer (a range computed with NumPy) crashed
+    the run at the summary's first write ("Object of type int64 is not JSON serializable"):
+    it is taken as the number it is."""
+    from stereovision.batch import run_batch
+
+    root, out = tmp_path / "in", tmp_path / "o"
+    _tiny(root, data_dir, "a_left.png", "a_right.png")
+    for bad in (True, "16"):
+        with pytest.raises(
+            TypeError, match=rf"^max_disparity: expected a number of pixels, got {bad!r}$"
+        ):
+            run_batch(root, out, workers=1, max_disparity=bad, progress=False)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^max_disparity: expected a positive number, got nan$"):
+        run_batch(root, out, workers=1, max_disparity=math.nan, progress=False)  # type: ignore[arg-type]
+    assert not out.exists()
+    res = run_batch(root, out, workers=1, max_disparity=np.int64(16), progress=False)  # type: ignore[arg-type]
+    assert res.processed == ["a"] and _summary(out)["pairs"]["a"]["max_disparity"] == 16
+    assert _summary(out)["pairs"]["a"]["options"]["max_disparity"] == 16
+
+
 def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Path) -> None:
     """A grid cell of 0.01 m and of 10 m, the bounds, pass the options' check (the missing input
     is the error); past them, and a calib_unit without calib, are refused by name."""

@@ -1453,7 +1453,7 @@ def run_batch(
         the same names that a run over another input folder made from other images (they would
         be replaced), or one that another run is writing into.
     TypeError
-        A ``fill`` that is not True, False or None.
+        A ``fill`` that is not True, False or None, a ``max_disparity`` that is not a number.
     PermissionError
         If the output folder cannot be written.
     OSError
@@ -1472,14 +1472,27 @@ def run_batch(
         raise ValueError("grid: the occupancy grid lies on the floor; it needs ground=True")
     if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
         raise ValueError(f"grid: expected a cell side from 0.01 to 10 m, got {grid}")
-    if max_disparity is not None and max_disparity <= 0:
-        raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
     import numpy as np
 
+    from stereovision._validate import number_shown, real_number, too_large_for_float
     from stereovision.depth import METHODS
 
     # refused here, as depth_map refuses them: in the workers every pair failed alike (a
     # cluster started, each pair recorded as failed, a finished pair's record too)
+    if max_disparity is not None:
+        if not real_number(max_disparity):  # True passed as 1, "16" failed in the comparison
+            raise TypeError(f"max_disparity: expected a number of pixels, got {max_disparity!r}")
+        if isinstance(max_disparity, np.generic):  # a NumPy number is no JSON for the summary
+            max_disparity = max_disparity.item()
+        # an int too large for a float (isfinite's OverflowError): compared as it is; a
+        # positive one is each pair's to refuse, as wider than its images
+        if too_large_for_float(max_disparity):
+            positive = max_disparity > 0
+        else:
+            positive = math.isfinite(max_disparity) and max_disparity > 0
+        if not positive:
+            given = number_shown(max_disparity)
+            raise ValueError(f"max_disparity: expected a positive number, got {given}")
     if method is not None and method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     if fill is not None and not isinstance(fill, (bool, np.bool_)):
