@@ -544,6 +544,22 @@ def test_batch_max_disparity_is_checked_as_depth_map_checks_it(
     assert _summary(out)["pairs"]["a"]["options"]["max_disparity"] == 16
 
 
+def test_batch_workers_must_be_a_whole_number(data_dir: Path, tmp_path: Path) -> None:
+    """run_batch(workers=1.5) started the run and failed in the LocalCluster's start ("'float'
+    object cannot be interpreted as an integer"), workers="2" in the check ("'<=' not
+    supported between instances of 'str' and 'int'"), True passed as 1: refused by name, in
+    the words of the CLI's --workers, before the input is searched."""
+    from stereovision.batch import run_batch
+
+    root, out = tmp_path / "in", tmp_path / "o"
+    _tiny(root, data_dir, "a_left.png", "a_right.png")
+    for bad in (1.5, "2", True, 0, math.nan):
+        with pytest.raises(ValueError) as info:
+            run_batch(root, out, workers=bad, progress=False)  # type: ignore[arg-type]
+        assert str(info.value) == f"workers: expected a whole number above 0, got {bad!r}"
+    assert not out.exists()
+
+
 def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Path) -> None:
     """A grid cell of 0.01 m and of 10 m, the bounds, pass the options' check (the missing input
     is the error); past them, and a calib_unit without calib, are refused by name."""

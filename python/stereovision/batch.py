@@ -1448,10 +1448,11 @@ def run_batch(
     FileNotFoundError, NotADirectoryError
         A missing input folder or calibration file.
     ValueError
-        Bad ``workers`` / ``max_disparity``, an unknown ``method``, no pair under the input,
-        an output folder that is a file (or below one), or one holding the outputs of pairs of
-        the same names that a run over another input folder made from other images (they would
-        be replaced), or one that another run is writing into.
+        ``workers`` not a whole number above 0, a bad ``max_disparity``, an unknown
+        ``method``, no pair under the input, an output folder that is a file (or below one), or
+        one holding the outputs of pairs of the same names that a run over another input folder
+        made from other images (they would be replaced), or one that another run is writing
+        into.
     TypeError
         A ``fill`` that is not True, False or None, a ``max_disparity`` that is not a number.
     PermissionError
@@ -1464,8 +1465,11 @@ def run_batch(
         interrupted; its ``result`` tells what was done. An interrupt before the summary is
         first written (while the input is searched) is raised as it came.
     """
-    if workers is not None and workers <= 0:
-        raise ValueError(f"workers: expected a positive number, got {workers}")
+    if workers is not None:
+        from stereovision._validate import positive_whole
+
+        # 1.5 failed in the LocalCluster's start, "2" in a comparison, True passed as 1
+        workers = positive_whole(workers, "workers", "a whole number above 0")
     if words not in ("api", "cli"):
         raise ValueError(f"words: expected 'api' or 'cli', got {words!r}")
     if grid is not None and not ground:
