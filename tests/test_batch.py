@@ -560,6 +560,24 @@ def test_batch_workers_must_be_a_whole_number(data_dir: Path, tmp_path: Path) ->
     assert not out.exists()
 
 
+def test_batch_grid_is_a_number(data_dir: Path, tmp_path: Path) -> None:
+    """run_batch(ground=True, grid=numpy.float32(0.25)) crashed at the summary's first write
+    ("Object of type float32 is not JSON serializable"); grid="0.2" failed in Python's
+    isfinite ("must be real number, not str"). A NumPy float is the number it is; a string is
+    refused by name."""
+    from stereovision.batch import run_batch
+
+    root, out = tmp_path / "in", tmp_path / "o"
+    _tiny(root, data_dir, "a_left.png", "a_right.png")
+    with pytest.raises(TypeError, match=r"^grid: expected a cell side in metres, got '0.2'$"):
+        run_batch(root, out, workers=1, ground=True, grid="0.2", progress=False)  # type: ignore[arg-type]
+    assert not out.exists()
+    # no calibration: the pair fails (ground needs one), recorded with the grid asked for
+    res = run_batch(root, out, workers=1, ground=True, grid=np.float32(0.25), progress=False)  # type: ignore[arg-type]
+    assert res.failed == ["a"]
+    assert _summary(out)["pairs"]["a"]["options"]["grid"] == 0.25
+
+
 def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Path) -> None:
     """A grid cell of 0.01 m and of 10 m, the bounds, pass the options' check (the missing input
     is the error); past them, and a calib_unit without calib, are refused by name."""

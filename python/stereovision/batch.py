@@ -1454,7 +1454,8 @@ def run_batch(
         made from other images (they would be replaced), or one that another run is writing
         into.
     TypeError
-        A ``fill`` that is not True, False or None, a ``max_disparity`` that is not a number.
+        A ``fill`` that is not True, False or None, a ``max_disparity`` or ``grid`` that is not
+        a number.
     PermissionError
         If the output folder cannot be written.
     OSError
@@ -1472,14 +1473,21 @@ def run_batch(
         workers = positive_whole(workers, "workers", "a whole number above 0")
     if words not in ("api", "cli"):
         raise ValueError(f"words: expected 'api' or 'cli', got {words!r}")
-    if grid is not None and not ground:
-        raise ValueError("grid: the occupancy grid lies on the floor; it needs ground=True")
-    if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
-        raise ValueError(f"grid: expected a cell side from 0.01 to 10 m, got {grid}")
     import numpy as np
 
     from stereovision._validate import number_shown, real_number, too_large_for_float
     from stereovision.depth import METHODS
+
+    if grid is not None:
+        # "0.2" failed in isfinite ("must be real number, not str"), a NumPy float32 at the
+        # summary's first write (no JSON)
+        if not real_number(grid):
+            raise TypeError(f"grid: expected a cell side in metres, got {grid!r}")
+        grid = float(grid)
+    if grid is not None and not ground:
+        raise ValueError("grid: the occupancy grid lies on the floor; it needs ground=True")
+    if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
+        raise ValueError(f"grid: expected a cell side from 0.01 to 10 m, got {grid}")
 
     # refused here, as depth_map refuses them: in the workers every pair failed alike (a
     # cluster started, each pair recorded as failed, a finished pair's record too)
