@@ -2170,6 +2170,39 @@ def test_an_image_that_cannot_be_read_fails_its_pair_alone(
     assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)
 
 
+def test_an_image_that_cannot_be_read_when_sent_is_tried_again(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An image whose size and time could be read but not its bytes (permission denied, an I/O
+    error, a network share gone between the check and the read) failed its pair with its
+    images' fingerprint recorded: the next run skipped it as 'failed before' (until
+    --retry-failed), though the file was readable again with the same size and time (chmod
+    changes neither). As an image whose size cannot be read, it is now tried again every run;
+    its record has no options or fingerprint, as batch.md says of such a pair."""
+    from stereovision import batch
+
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    denied = src / "a/right.png"
+    real_read = Path.read_bytes
+
+    def read_bytes(self: Path) -> bytes:
+        if self == denied:
+            raise PermissionError(13, "Permission denied", str(self))
+        return real_read(self)
+
+    monkeypatch.setattr(Path, "read_bytes", read_bytes)
+    first = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
+    assert (first.processed, first.failed) == (["b"], ["a"])
+    entry = _summary(out)["pairs"]["a"]
+    assert entry["error"] == f"PermissionError: [Errno 13] Permission denied: '{denied}'"
+    assert "fingerprint" not in entry and "options" not in entry
+    monkeypatch.setattr(Path, "read_bytes", real_read)  # readable again, same size and time
+    again = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
+    assert (again.processed, again.skipped, again.failed_before) == (["a"], ["b"], [])
+    assert _summary(out)["pairs"]["a"]["status"] == "done"
+
+
 def test_calib_unit_reaches_the_workers(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1988,6 +1988,13 @@ def _run_jobs(
                 task = _task(job, opts, payloads)
             except (OSError, ValueError) as exc:  # unreadable input or calibration (a scene's
                 # Q.dat is read here): a failed pair, not a failed run
+                if isinstance(exc, OSError):
+                    # a file not read (permission denied, an I/O error) is tried again every
+                    # run, as one whose size cannot be read: with its fingerprint the next run
+                    # skipped it as failed before, though it was readable again (chmod
+                    # changes neither its size nor its time)
+                    for key in ("options", "fingerprint"):
+                        summary.pairs[job.name].pop(key, None)
                 record_failure(job, exc)
                 return True
             # read from the bytes shipped: a copy of these files without their times is known
