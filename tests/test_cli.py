@@ -3454,3 +3454,28 @@ def test_fill_and_no_fill_together_are_refused(
 
     for flag, fill in (("--fill", True), ("--no-fill", False)):
         assert build_parser().parse_args([*argv, flag]).fill is fill
+
+
+@pytest.mark.parametrize("command", ["depth", "rectify", "batch"])
+def test_output_folder_dash_is_refused_not_made(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    command: str,
+) -> None:
+    """``-o -`` (standard output, to many tools) made a folder named "-" and exited 0; the
+    outputs are a folder of files, so it is refused in one line before any work."""
+    monkeypatch.chdir(tmp_path)
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    inputs = (
+        [str(scene)] if command == "batch" else [str(scene / n) for n in ("left.png", "right.png")]
+    )
+    assert main([command, *inputs, "-o", "-"]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        "stereovision: error: -o -: the outputs are files in a folder, not a stream for "
+        "standard output: name a folder\n"
+    )
+    assert list(tmp_path.iterdir()) == []
