@@ -163,6 +163,35 @@ def test_gui_stopped_by_ctrl_c_exits_130_as_the_cli(
     assert (code, out, err) == (status, "", f"stereovision: {said}\n")
 
 
+_SIGTERM_WHILE_THE_GUI_STARTS = """
+import os, signal, sys
+import stereovision.gui as gui
+
+def build_app(_args):  # the cameras being opened: SIGTERM from a service manager
+    os.kill(os.getpid(), signal.SIGTERM)
+    raise AssertionError("not interrupted")
+gui.build_app = build_app
+sys.exit(gui.main(["--no-browser", "--port", "0"]))
+"""
+
+
+def test_python_m_stereovision_gui_takes_sigterm_as_the_cli() -> None:
+    """``python -m stereovision.gui`` set no SIGTERM handler before its server's (``stereovision
+    gui`` has the CLI's): a SIGTERM while it started killed it (status -15, no word, the
+    camera not closed). It is now the CLI's Terminated: 143 and one line."""
+    done = subprocess.run(
+        [sys.executable, "-c", _SIGTERM_WHILE_THE_GUI_STARTS],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert (done.returncode, done.stdout, done.stderr) == (
+        143,
+        "",
+        "stereovision: terminated (SIGTERM)\n",
+    )
+
+
 _CALLER_OF_THE_GUI = """
 import os, signal, sys
 import stereovision.gui as gui

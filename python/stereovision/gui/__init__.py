@@ -380,9 +380,13 @@ def _main(argv: Sequence[str] | None) -> int:
     p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
     add_arguments(p)
     args = p.parse_args(argv)
-    from stereovision._interrupt import Terminated
+    from stereovision._interrupt import Terminated, raise_terminated
     from stereovision._validate import BUG_ERRORS, internal_error
 
+    # SIGTERM as the CLI takes it (Terminated): it killed the process where the page's work is
+    # stopped and the camera closed on Ctrl+C
+    main_thread = threading.current_thread() is threading.main_thread()
+    kept = signal.signal(signal.SIGTERM, raise_terminated) if main_thread else None
     try:
         return cmd_gui(args)
     except Terminated:  # as the CLI
@@ -404,3 +408,6 @@ def _main(argv: Sequence[str] | None) -> int:
     except Exception as exc:  # a bug of ours: one line, as the CLI, not a traceback
         print(internal_error(exc), file=sys.stderr)
         return 2
+    finally:
+        if kept is not None:
+            signal.signal(signal.SIGTERM, kept)
