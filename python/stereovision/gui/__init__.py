@@ -230,9 +230,18 @@ def cmd_gui(args: argparse.Namespace) -> int:
                 loop.add_signal_handler(signum, stop_on, signum)
             loops.append(loop)
 
-    app.ctrl.on_server_ready.add(hear_signals)  # before the address is said: Ctrl+C heard
-    app.ctrl.on_server_ready.add(announce)  # after the bind: the real port, and only if it bound
-    argv, sys.argv = sys.argv, sys.argv[:1]  # trame parses sys.argv itself: give it nothing
+    def ready(**_: Any) -> None:
+        # one hook, in this order (trame keeps its hooks in a set, called in no set order): a
+        # Ctrl+C as soon as the address is said stops the server; after the bind: the real
+        # port, and only if it bound
+        hear_signals()
+        announce()
+
+    app.ctrl.on_server_ready.add(ready)
+    # trame parses sys.argv itself: give it only --nosignalhandlers. aiohttp's own handlers (set
+    # when the server is set up, until on_server_ready put ours) stopped it without a trace: a
+    # signal then exited 0; without them Python's (KeyboardInterrupt, the CLI's Terminated) act
+    argv, sys.argv = sys.argv, [*sys.argv[:1], "--nosignalhandlers"]
     try:
         app.server.start(
             port=args.port,
