@@ -131,3 +131,43 @@ def test_ctrl_c_during_vtks_first_import_waits_for_it_to_finish() -> None:
         timeout=120,
     )
     assert (proc.returncode, proc.stdout.strip()) == (0, "interrupted True True"), proc.stderr
+
+
+_CTRL_C_IN_THE_IMPORTS = """
+import importlib.abc, os, runpy, signal, sys
+
+class CtrlC(importlib.abc.MetaPathFinder):  # one Ctrl+C, as {module} is first imported
+    def find_spec(self, name, path=None, target=None):
+        if name == {module!r} and self in sys.meta_path:
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), signal.SIGINT)
+        return None
+
+sys.meta_path.insert(0, CtrlC())
+sys.argv = ["stereovision", *{argv!r}]
+{run}
+"""
+
+#: The console script's wrapper (pyproject's [project.scripts]), ``python -m stereovision``
+#: and ``python -m stereovision.gui``.
+_ENTRIES = {
+    "stereovision": "from stereovision.__main__ import main\nsys.exit(main())",
+    "python -m stereovision": 'runpy.run_module("stereovision", run_name="__main__")',
+    "python -m stereovision.gui": 'runpy.run_module("stereovision.gui", run_name="__main__")',
+}
+
+
+@pytest.mark.parametrize("module", ["numpy", "cv2", "stereovision._core"])
+@pytest.mark.parametrize("entry", list(_ENTRIES))
+def test_ctrl_c_in_the_start_up_imports_is_one_line_and_130(entry: str, module: str) -> None:
+    """A Ctrl+C while the command imported NumPy, OpenCV or the extension (the 0.2 s before
+    the CLI's main ran: ``import stereovision`` imported them all) printed a traceback (4 runs
+    in 60 interrupted at random start-up times). The package imports them on first use now,
+    and the entry points say the interrupt as the CLI: one line, exit 130."""
+    argv = ["--version"] if entry != "python -m stereovision.gui" else ["--port", "-1"]
+    code = _CTRL_C_IN_THE_IMPORTS.format(module=module, argv=argv, run=_ENTRIES[entry])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert (proc.returncode, proc.stdout, proc.stderr) == (130, "", "stereovision: interrupted\n")

@@ -11,18 +11,83 @@ The hot kernels are Rust (``stereovision._core``); this package owns the API.
 """
 
 import functools as _functools
+import importlib as _importlib
+import importlib.util as _importlib_util
+import sys as _sys
+import types as _types
 from collections.abc import Callable as _Callable
+from typing import TYPE_CHECKING, Any
 
-from stereovision import _core, evaluate, io
-from stereovision._core import __version__
-from stereovision.calibration import Calibration
-from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
-from stereovision.ground import GroundPlane, LaserScan, fit_ground_plane, laser_scan, obstacle_mask
-from stereovision.match import match
-from stereovision.matches import Matches
-from stereovision.rectification_check import check_rectification, refine_rectification
-from stereovision.temporal import TemporalFilter
-from stereovision.triangulation import depth_from_disparity, triangulate
+if TYPE_CHECKING:
+    from stereovision import evaluate, io
+    from stereovision._core import __version__
+    from stereovision.calibration import Calibration
+    from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
+    from stereovision.ground import (
+        GroundPlane,
+        LaserScan,
+        fit_ground_plane,
+        laser_scan,
+        obstacle_mask,
+    )
+    from stereovision.match import match
+    from stereovision.matches import Matches
+    from stereovision.rectification_check import check_rectification, refine_rectification
+    from stereovision.temporal import TemporalFilter
+    from stereovision.triangulation import depth_from_disparity, triangulate
+
+#: Where each name of the API lives, imported on its first use: ``import stereovision`` took
+#: 0.18 s (NumPy, OpenCV, the extension) before the command line's entry could run, so a
+#: Ctrl+C in it printed a traceback, not the CLI's one line.
+_WHERE = {
+    "__version__": "stereovision._core",
+    "Calibration": "stereovision.calibration",
+    "DepthResult": "stereovision.depth",
+    "depth_map": "stereovision.depth",
+    "estimate_max_disparity": "stereovision.depth",
+    "GroundPlane": "stereovision.ground",
+    "LaserScan": "stereovision.ground",
+    "fit_ground_plane": "stereovision.ground",
+    "laser_scan": "stereovision.ground",
+    "obstacle_mask": "stereovision.ground",
+    "match": "stereovision.match",
+    "Matches": "stereovision.matches",
+    "check_rectification": "stereovision.rectification_check",
+    "refine_rectification": "stereovision.rectification_check",
+    "TemporalFilter": "stereovision.temporal",
+    "depth_from_disparity": "stereovision.triangulation",
+    "triangulate": "stereovision.triangulation",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """A name of the API (or a submodule: ``stereovision.depth``), imported on first use."""
+    if name in _WHERE:
+        value = getattr(_importlib.import_module(_WHERE[name]), name)
+    elif not name.startswith("__") and _importlib_util.find_spec(f"{__name__}.{name}"):
+        value = _importlib.import_module(f"{__name__}.{name}")  # binds it here too
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # once: later uses do not come here
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(_types.ModuleType):
+    """This package: ``stereovision.match`` stays the function when its module is imported."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # importing a submodule sets it here: the module stereovision.match (imported by the
+        # CLI, depth) replaced the function `match`, as the eager import put it after the module
+        if name == "match" and isinstance(value, _types.ModuleType):
+            value = value.match
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
 
 
 @_functools.cache
@@ -61,6 +126,8 @@ def release_memory() -> int:
     >>> sv.release_memory() >= 0
     True
     """
+    from stereovision import _core
+
     released = _core.release_memory()
     trim = _malloc_trim()
     if trim is not None:

@@ -384,11 +384,15 @@ def _main(argv: Sequence[str] | None) -> int:
     """:func:`main`'s work: parse ``argv`` and run the GUI."""
     # the CLI's parser: a refused value in one line, with the unit hint (``--read-timeout
     # 10s``), where argparse's own printed its usage block and no hint
-    from stereovision.cli import _Parser
+    try:  # the CLI's module and the options' are imported here (0.2 s), as the CLI's _main
+        from stereovision.cli import _Parser
 
-    p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
-    add_arguments(p)
-    args = p.parse_args(argv)
+        p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
+        add_arguments(p)
+        args = p.parse_args(argv)
+    except KeyboardInterrupt:
+        print("stereovision: interrupted", file=sys.stderr)
+        return 130
     from stereovision._interrupt import Terminated, raise_terminated
     from stereovision._validate import BUG_ERRORS, internal_error
 

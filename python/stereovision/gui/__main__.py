@@ -2,6 +2,10 @@
 
 import sys
 
-from stereovision.gui import main
-
-sys.exit(main())
+if __name__ == "__main__":
+    try:  # a Ctrl+C in the imports: one line, exit 130, as the CLI (it printed a traceback)
+        from stereovision.gui import main
+    except KeyboardInterrupt:
+        print("stereovision: interrupted", file=sys.stderr)
+        sys.exit(130)
+    sys.exit(main())
