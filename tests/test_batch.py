@@ -3057,3 +3057,30 @@ def test_camera_folders_pair_a_side_of_one_image_at_the_other_sides_number(
         "pair01_cam0.png",
         "pair06_cam1.png",
     ]
+
+
+@pytest.mark.parametrize(
+    ("address", "says"),
+    [
+        ("bogus", "missing port number in address 'bogus'"),
+        ("foo://a:1", "unknown address scheme 'foo'"),
+        ("tcp://admin:s3cret@127.0.0.1:1", "invalid address 'admin:***@127.0.0.1:1'"),
+    ],
+)
+def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str, says: str
+) -> None:
+    """``--scheduler`` was only read by Dask once a pair was to be done: a rerun with every pair
+    done took any value and exited 0. It is refused before any work now, as Dask says it."""
+    pytest.importorskip("distributed")
+    _noise_pair(tmp_path / "in" / "scene")
+    out = tmp_path / "out"
+    argv = ["batch", str(tmp_path / "in"), "-o", str(out)]
+    assert main([*argv, "--workers", "1"]) == 0
+    summary = (out / "summary.json").read_bytes()
+    capsys.readouterr()
+    assert main([*argv, "--scheduler", address]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"stereovision: error: --scheduler: {says}") and err.count("\n") == 1
+    assert "s3cret" not in err
+    assert (out / "summary.json").read_bytes() == summary

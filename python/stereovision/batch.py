@@ -2086,6 +2086,27 @@ def _run_jobs(
 # ---------------------------------------------------------------------------------------- CLI
 
 
+def _check_scheduler_address(address: str) -> None:
+    """Refuse ``--scheduler``'s address as Dask would (no port, an unknown scheme), before any
+    work: a run whose pairs were all done before never reached Dask, and took any value.
+
+    Raises
+    ------
+    ValueError
+        Dask's reason after ``--scheduler:``, a password in the address said as ``***``.
+    """
+    try:
+        from distributed.comm.addressing import get_address_host_port
+    except ImportError:  # run_batch names the extra to install once it needs Dask
+        return
+    from stereovision.capture import _mask_secrets_of
+
+    try:
+        get_address_host_port(address)
+    except ValueError as exc:
+        raise ValueError(f"--scheduler: {_mask_secrets_of(str(exc), address)}") from None
+
+
 def cmd_batch(args: argparse.Namespace) -> int:
     """``stereovision batch INPUT -o OUT``: exit status 0, 1 when a pair has no outputs, 130 when
     interrupted (Ctrl-C), 143 when terminated (SIGTERM): one line, the summary marked as
@@ -2137,6 +2158,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
                 size = _calib_size(Path(args.calib), _scan(args.input)[0])
         if size is not None or not sizeless:
             load_calibration(args.calib, args.calib_unit, size=size)
+    if args.scheduler is not None:
+        _check_scheduler_address(args.scheduler)
     check_output_folder(args.output, "-o")
     try:
         res = run_batch(
