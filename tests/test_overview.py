@@ -21,6 +21,8 @@ from stereovision.overview import (
     PANEL_WIDTH,
     ColourBar,
     Overview,
+    colour_levels,
+    colour_range,
     overview_image,
     overview_title,
 )
@@ -804,3 +806,23 @@ def test_the_depth_bar_names_its_far_end_past_a_million_metres(unit: str) -> Non
         assert ticks[-1][1].endswith(f" {unit}")
         assert _number(ticks[-1][1]) == pytest.approx(far / size, rel=1e-3)
         _check_labels_inside_their_cells(ov)
+
+
+def test_a_map_of_negative_disparities_is_coloured_by_its_values() -> None:
+    """disparity.png is coloured from 0 px up to the 99th percentile: a map of negative
+    disparities (a swapped pair's) had its top below its bottom, so every pixel took level 0
+    (one colour) and its bar read upside down (-1.4 px at the top, 0 px at the bottom). Its
+    ends are now its 1st and 99th percentiles, the lowest value blue, the highest red."""
+    from stereovision.cli import colorize
+
+    disparity = np.linspace(-40.0, -1.0, 100, dtype=np.float32).reshape(10, 10)
+    lo, hi = colour_range(disparity, 0.0, None)
+    assert (lo, hi) == pytest.approx(
+        (float(np.percentile(disparity, 1)), float(np.percentile(disparity, 99)))
+    )
+    assert lo < hi
+    levels = colour_levels(disparity, lo, hi).ravel()
+    assert levels[0] == 0 and levels[-1] == 255 and np.all(np.diff(levels.astype(int)) >= 0)
+    assert len({tuple(c) for c in colorize(disparity, lo=0.0).reshape(-1, 3)}) > 50
+    # a map reaching above the given end keeps it, as before
+    assert colour_range(np.array([[-5.0, 3.0, 10.0]]), 0.0, None)[0] == 0.0

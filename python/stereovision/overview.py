@@ -63,7 +63,8 @@ def colour_range(
         The map (NaN = none).
     lo, hi : float, optional
         Given ends; a missing one is the 1st (``lo``) or 99th (``hi``) percentile of the finite
-        values.
+        values. When that percentile is not past the given end (``lo=0`` for a map of negative
+        disparities: a swapped pair's), both ends are the percentiles.
 
     Returns
     -------
@@ -74,8 +75,13 @@ def colour_range(
     if not finite.any():
         return None
     v = values[finite]
+    given = (lo, hi)
     lo = float(np.percentile(v, 1)) if lo is None else float(lo)
     hi = float(np.percentile(v, 99)) if hi is None else float(hi)
+    if hi <= lo and None in given:
+        # the given end above the map's values (below them for hi): the map was one colour,
+        # its bar labelled upside down (top -12 px, bottom 0 px)
+        lo, hi = float(np.percentile(v, 1)), float(np.percentile(v, 99))
     return lo, hi
 
 
