@@ -501,7 +501,9 @@ def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
     for argv in (["--port", "65536"], ["--port", "-1"]):
         assert gui.main(argv) == 2
         err = capsys.readouterr().err
-        assert err == f"stereovision: error: --port must be in 0..65535, got {argv[1]}\n"
+        assert err == (
+            f"stereovision: error: --port must be 1 to 65535, or 0 for a free one, got {argv[1]}\n"
+        )
     monkeypatch.setitem(sys.modules, "trame.app", None)  # trame not installed
     assert gui.main([]) == 2
     err = capsys.readouterr().err

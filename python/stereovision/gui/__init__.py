@@ -65,7 +65,8 @@ def build_app(args: argparse.Namespace) -> Any:
         # as capture and calibrate refuse them: the page was served with the topic ignored
         raise ValueError("--left-topic and --right-topic are for --from-bag")
     if not 0 <= args.port <= 65535:
-        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+        # 0 is no port but "a free one": said, as --help does not say it
+        raise ValueError(f"--port must be 1 to 65535, or 0 for a free one, got {args.port}")
     folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
     calib = None
     sizeless = None
