@@ -280,6 +280,34 @@ def test_a_depth_past_float32_is_no_depth() -> None:
     np.testing.assert_allclose(pts[0, 2], [(2 - 330) * 30.0, -240 * 30.0, 21000.0], rtol=1e-6)
 
 
+def test_a_point_past_float32_is_no_point() -> None:
+    """A wide-angle view (fx 300 px over 1280 px: |x - cx| / fx up to 2.1) at a depth near
+    float32's largest (2e38 mm): reproject's X, 4.3e38, was +inf with NumPy's "overflow
+    encountered in cast" though the depth passed; the point is NaN as a whole now, as one
+    whose depth is past float32, and the points that fit keep their bits."""
+    K = np.array([[300.0, 0.0, 640.0], [0.0, 300.0, 360.0], [0.0, 0.0, 1.0]])
+    c = Calibration(
+        K1=K,
+        D1=np.zeros(5),
+        K2=K.copy(),
+        D2=np.zeros(5),
+        R=np.eye(3),
+        T=np.array([-120.0, 0.0, 0.0]),
+        image_size=(1280, 720),
+        unit="mm",
+        rectified=True,
+    )
+    d = np.full((720, 1280), np.nan)
+    d[0, [0, 640, 1279]] = 1.8e-34  # Z = 2.0e38 mm
+    d[1, 1279] = 4.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow warning either
+        pts = reproject(d, c, unit="mm")
+    assert np.isnan(pts[0, [0, 1279]]).all()  # X = -4.3e38, +4.3e38
+    np.testing.assert_allclose(pts[0, 640], [0.0, -2.4e38, 2.0e38], rtol=1e-6)
+    np.testing.assert_allclose(pts[1, 1279], [639 * 30.0, -359 * 30.0, 9000.0], rtol=1e-6)
+
+
 def test_depth_from_disparity_refuses_a_bool_map() -> None:
     # a validity mask passed for the disparity was read as 1 px and 0 px: 700 px * 0.12 m / 7 px
     # and / 6 px, depths where nothing was measured (gt_depth, the Table-1 GT, reads through it)

@@ -429,7 +429,8 @@ def reproject(
     Returns
     -------
     numpy.ndarray
-        ``(H, W, 3)`` ``float32``, NaN where the depth is invalid.
+        ``(H, W, 3)`` ``float32``, NaN where the depth is invalid or a
+        coordinate passes float32.
 
     Warns
     -----
@@ -453,7 +454,12 @@ def _reproject(
     xs = (np.arange(w, dtype=np.float64) - cx) / fx
     ys = (np.arange(h, dtype=np.float64) - cy) / fy
     out = np.empty((h, w, 3), dtype=np.float32)
-    out[:, :, 0] = xs[None, :] * z
-    out[:, :, 1] = ys[:, None] * z
+    with np.errstate(over="ignore"):
+        # a wide view's X, Y pass float32 where Z is near its largest (|x - cx| / fx = 2.1 at
+        # Z = 2e38 mm): +inf, with NumPy's "overflow encountered in cast"; no point, as the
+        # depth past float32 is none
+        out[:, :, 0] = xs[None, :] * z
+        out[:, :, 1] = ys[:, None] * z
     out[:, :, 2] = z
+    out[~np.isfinite(out).all(axis=2)] = np.nan
     return out
