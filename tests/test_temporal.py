@@ -253,6 +253,27 @@ def test_a_new_size_measures_its_own_noise(data_dir: Path) -> None:
     assert tf.restarts == 3 and tf.mean_frames() == 1.0 and tf.frames == 12
 
 
+def test_a_new_size_after_a_saved_pair_measures_its_own_noise(data_dir: Path) -> None:
+    """As above, but the means forgotten first, as capture does after each pair it saves:
+    the size was compared with the means' alone, so a camera that switched mode right after a
+    save kept the old mode's noise median (8.3) and averaged the moving new mode."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(9)
+    tf = TemporalFilter()
+    for _ in range(8):
+        tf(noisy(sc.left, 12.0, rng), noisy(sc.right, 12.0, rng))
+    tf._forget_means()  # capture's saved pair
+    assert tf.sigma > 7.0
+    h, w = sc.left.shape[:2]
+    small = (slice(0, h - 40), slice(0, w - 40))
+    for k in range(1, 5):
+        left, right = (noisy(np.roll(i, k, 1)[small], 2.0, rng) for i in (sc.left, sc.right))
+        out = tf(left, right)
+        assert np.array_equal(out[0], left) and np.array_equal(out[1], right), k
+        assert tf.sigma < 3.0, (k, tf.sigma)
+    assert tf.restarts == 3 and tf.mean_frames() == 1.0 and tf.frames == 12
+
+
 def test_something_moving_through_a_still_view_leaves_no_ghost(data_dir: Path) -> None:
     """A textured patch (cones' left image) crosses the still, noisy venus view 12 px a frame:
     the rig is not taken for moving (no restart), the background keeps averaging, and where

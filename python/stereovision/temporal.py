@@ -266,6 +266,8 @@ class TemporalFilter:
     relit: int = 0
     _means: list[_Mean] = field(default_factory=list, repr=False)
     _sigmas: deque[float] = field(default_factory=lambda: deque(maxlen=8), repr=False)
+    # the last frame's shape, kept when the means are forgotten (capture, after a saved pair)
+    _shape: tuple[int, ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.max_frames, (int, np.integer)) or isinstance(
@@ -293,6 +295,7 @@ class TemporalFilter:
         # another gain) and the counters carried over into what followed
         self._forget_means()
         self._sigmas = deque(maxlen=self._sigmas.maxlen)
+        self._shape = None
         self.frames = self.restarts = self.relit = 0
         self.sigma = 0.0
 
@@ -351,11 +354,14 @@ class TemporalFilter:
         check_index_range(imgs[0].shape, "left")  # before the copies and the float32 means
         imgs = [np.ascontiguousarray(img) for img in imgs]
         self.frames += 1
-        if self._means and self._means[0].mean.shape != imgs[0].shape:
+        if self._shape is not None and self._shape != imgs[0].shape:
             # Another size is another camera mode (binning, a crop, another camera): its noise
             # is its own. The old median (8.3 from noise 12) let a clean (noise 2) rig moving
             # 1 px a pair average three pairs into a smear before its own estimates took over.
+            # The last frame's shape, not the means': capture forgets those after each saved
+            # pair, and a mode switched there kept the old median.
             self._sigmas.clear()
+        self._shape = imgs[0].shape
         # A black (or white) frame has no estimate, not one of 0: a webcam's dark frames while
         # it starts took the median to 0 and the first still frames after them were each
         # "moving" (6 dark frames: 3 restarts more, the next 4 frames not averaged).
