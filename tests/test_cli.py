@@ -3408,7 +3408,7 @@ def test_a_bad_fourcc_is_refused_in_the_options_name(
     )
 
 
-@pytest.mark.parametrize("host", ["", " "])
+@pytest.mark.parametrize("host", ["", " ", "127.0.0.1\n", "local host", "127.0.0.1\t"])
 @pytest.mark.parametrize("command", ["stream", "gui"])
 def test_an_empty_host_is_refused_in_the_options_name(
     capsys: pytest.CaptureFixture[str], command: str, host: str
@@ -3416,7 +3416,9 @@ def test_an_empty_host_is_refused_in_the_options_name(
     """``--host ""`` (an unset shell variable: ``--host "$HOST"``) served the view on every
     interface (0.0.0.0, the empty address of a bind), where the default serves this machine
     alone, and said it as ``http://:8765/``; it is refused by argparse now, before any camera
-    opens: one line, exit 2."""
+    opens: one line, exit 2. So is an address holding a space or a control character
+    (``127.0.0.1\\n`` read from a file): it reached the bind, after the cameras opened, and
+    the error was cut at its newline ('cannot serve the view on 127.0.0.1')."""
     with pytest.raises(SystemExit) as exit_:
         main([command, "--left", "0", "--right", "1", "--host", host])
     assert exit_.value.code == 2
@@ -3427,6 +3429,26 @@ def test_an_empty_host_is_refused_in_the_options_name(
         f"(127.0.0.1: this machine alone; 0.0.0.0: every interface), got {host!r} "
         f"(see stereovision {command} --help)\n"
     )
+
+
+@pytest.mark.parametrize("command", ["stream", "gui"])
+def test_a_bracketed_ipv6_host_is_the_address_inside(command: str) -> None:
+    """``--host [::1]``, an IPv6 address as a URL writes it, was bound as a host name (not
+    found: 'cannot serve the view on [[::1]]:8765: Name or service not known') and the gui
+    said it 'http://[[::1]]:8080/'; the address inside is taken. An IPv4 address, a host
+    name and an unbracketed IPv6 address are kept as given."""
+    from stereovision.cli import build_parser
+
+    base = [command, "--left", "0", "--right", "1", "--host"]
+    for given, taken in [
+        ("[::1]", "::1"),
+        ("[::]", "::"),
+        ("::1", "::1"),
+        ("::ffff:127.0.0.1", "::ffff:127.0.0.1"),
+        ("0.0.0.0", "0.0.0.0"),
+        ("localhost", "localhost"),
+    ]:
+        assert build_parser().parse_args([*base, given]).host == taken
 
 
 @pytest.mark.parametrize("command", ["depth", "batch", "stream"])

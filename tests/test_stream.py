@@ -2732,9 +2732,12 @@ def test_the_view_listens_on_the_loopback_by_default() -> None:
         assert srv._httpd.server_address[0] == "127.0.0.1"
     finally:
         srv.close()
-    # an empty host (a bind's "every interface") is refused, not served on 0.0.0.0
-    for host in ("", " "):
-        with pytest.raises(ValueError, match=rf"^host: expected an address .*got {host!r}$"):
+    # an empty host (a bind's "every interface") is refused, not served on 0.0.0.0; a host
+    # with a newline (read from a file) reached the bind, its error cut at the newline
+    for host in ("", " ", "127.0.0.1\n", "local host"):
+        with pytest.raises(
+            ValueError, match=rf"^host: expected an address .*got {re.escape(repr(host))}$"
+        ):
             FrameServer(host, 0)
 
 
@@ -2768,6 +2771,14 @@ def test_the_view_serves_on_an_ipv6_address() -> None:
             FrameServer("::1", srv.port)
         assert info.value.errno == errno.EADDRINUSE
         assert str(info.value).startswith(f"cannot serve the view on [::1]:{srv.port}: ")
+    finally:
+        srv.close()
+    # as a URL writes it: it was bound as a host name (not found), said '[[::1]]:0'
+    srv = FrameServer("[::1]", 0)
+    try:
+        assert srv.url == f"http://[::1]:{srv.port}/"
+        assert srv._httpd.server_address[0] == "::1"
+        assert _get(srv.url + "frame.jpg")[:2] == (503, "text/plain")
     finally:
         srv.close()
 

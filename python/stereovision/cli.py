@@ -2112,7 +2112,8 @@ def port_number(text: str) -> int:
 
 def listen_address(text: str) -> str:
     """argparse type of ``stream --host`` and ``gui --host``: an address to listen on, not
-    empty (an empty one binds every interface: ``--host "$HOST"`` with the variable unset)."""
+    empty (an empty one binds every interface: ``--host "$HOST"`` with the variable unset);
+    an IPv6 one may come in a URL's brackets (``[::1]``), given without them."""
     try:
         return check_listen_address(text)
     except ValueError:
@@ -2127,10 +2128,21 @@ def _listen_address_words(text: object) -> str:
 
 
 def check_listen_address(host: str, name: str = "--host") -> str:
-    """``host`` when it is an address to listen on; ValueError (naming ``name``) for an empty
-    or blank one, which a bind takes for every interface (0.0.0.0)."""
-    if not isinstance(host, str) or not host.strip():
+    """``host`` when it is an address to listen on, an IPv6 one in a URL's brackets
+    (``[::1]``) without them; ValueError (naming ``name``) for an empty or blank one, which a
+    bind takes for every interface (0.0.0.0), or one holding a space or control character."""
+    # "127.0.0.1\n" (a host read from a file) reached the bind, and its error was cut at
+    # the newline: no address holds one, and said as repr the refusal is one line
+    if (
+        not isinstance(host, str)
+        or not host.strip()
+        or any(c.isspace() or not c.isprintable() for c in host)
+    ):
         raise ValueError(f"{name}: {_listen_address_words(host)}")
+    if host.startswith("[") and host.endswith("]") and ":" in host:
+        # "[::1]" as a URL writes it was bound as a host name (not found) and said
+        # "[[::1]]:8765"; the address is inside
+        return host[1:-1]
     return host
 
 

@@ -357,7 +357,7 @@ class FrameServer:
         from stereovision.cli import check_listen_address
 
         # "" is a bind's every interface (0.0.0.0), said as http://:8765/
-        check_listen_address(host, "host")
+        host = check_listen_address(host, "host")
         self._cond = threading.Condition()
         self._latest: tuple[np.ndarray, np.ndarray, float] | None = None
         self._seq = 0
