@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 import re
 from collections.abc import Callable
+from decimal import Decimal
 from pathlib import Path
 
 import cv2
@@ -749,3 +750,27 @@ def test_counts_and_reals_are_read_as_the_librarys_numbers() -> None:
         np.testing.assert_array_equal(got.xr, want.xr, err_msg=str(kw))
     with pytest.raises(ValueError, match="k_cand"):
         hp.hopfield_match(left, right, max_disparity=8, k_cand=8.5)
+
+
+@pytest.mark.parametrize(
+    ("value", "shown"),
+    [
+        (1e300, "1e+300"),
+        (-1e300, "-1e+300"),
+        (Decimal("1e4000"), "Decimal('1E+4000')"),
+        (np.array([1e300]), "array([1.e+300])"),
+        (10**400, "an integer of 401 digits"),
+        (10**5000, "an integer of 5001 digits"),
+    ],
+    ids=["1e300", "-1e300", "Decimal", "array", "10**400", "10**5000"],
+)
+def test_a_count_beyond_64_bits_is_shown_as_given(value: object, shown: str) -> None:
+    """read_numbers turned a whole count into its int before the kernel named it, so
+    k_cand=1e300 was "... got 1000000000000000052504760255204420248704468581108159..." (301
+    digits: not what was given), Decimal('1e4000') 4001 digits, and an int of over 4300 digits
+    "got ?". A count past any 64-bit integer is now named as given, on one short line."""
+    left = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError) as exc:
+        hp.hopfield_match(left, left, max_disparity=8, k_cand=value)
+    msg = str(exc.value)
+    assert msg == f"k_cand: expected an integer of at most 64 bits, got {shown}"

@@ -1436,3 +1436,13 @@ def test_counts_and_reals_are_read_as_the_librarys_numbers() -> None:
         np.testing.assert_array_equal(got.xr, want.xr, err_msg=str(kw))
     with pytest.raises(ValueError, match="knn"):
         mcgm.mcgm_match(left, right, max_disparity=8, knn=6.5)
+
+
+def test_a_count_beyond_64_bits_is_shown_as_given() -> None:
+    """knn=1e300 was read as its int before the kernel named it: "... got
+    1000000000000000052504760255204420248704468581108159..." (301 digits, not what was
+    given). It is named as given, as the network's counts are."""
+    left = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError) as exc:
+        mcgm.mcgm_match(left, left, max_disparity=8, knn=1e300)
+    assert str(exc.value) == "knn: expected an integer of at most 64 bits, got 1e+300"

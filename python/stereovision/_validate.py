@@ -20,6 +20,7 @@ import math
 import numbers
 import os
 import re
+import reprlib
 import sys
 import warnings
 from collections.abc import Callable, Iterable
@@ -812,6 +813,12 @@ def read_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> dict[str, 
     ``A=np.array([3.0])`` "only 0-dimensional arrays can be converted", where the Gabor and
     census wrappers take both.
 
+    Raises
+    ------
+    ValueError
+        A count past any 64-bit integer, named as given: the kernel named the int it was read
+        as (``1e300``: 301 digits; an int of over 4300 digits: "got ?").
+
     Examples
     --------
     >>> read_numbers({"k": 8.0, "a": np.array([0.5]), "s": "x"}, {"k": 1, "a": 1.0, "s": "y"})
@@ -824,6 +831,9 @@ def read_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> dict[str, 
             continue  # a switch, a choice, a list: the kernel's own
         if isinstance(d, int):
             whole = whole_value(v)
+            if whole is not None and not -(2**63) <= whole < 2**64:
+                shown = too_large_for_float(v, why=False) or reprlib.repr(v)
+                raise ValueError(f"{name}: expected an integer of at most 64 bits, got {shown}")
             if whole is not None:
                 out[name] = whole
         elif isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf":
