@@ -1327,6 +1327,18 @@ def test_object_points_refuse_ids_off_the_board(ids: list[object]) -> None:
     assert board.object_points([]).shape == (0, 3)
 
 
+def test_object_points_names_ids_that_are_not_whole_on_one_line() -> None:
+    """The message showed the ids as NumPy's repr, which wraps past 75 characters: eight ids
+    such as 0.12345679 broke it over two lines (a message is one line)."""
+    board = CharucoBoard("7x5", 0.04, 0.03, "DICT_5X5_100")
+    with pytest.raises(ValueError) as exc:
+        board.object_points(np.arange(10) + 0.123456789)
+    assert str(exc.value) == (
+        "ids: expected whole corner ids, got [0.12345679, 1.12345679, 2.12345679, 3.12345679, "
+        "4.12345679, 5.12345679, 6.12345679, 7.12345679, ...]"
+    )
+
+
 def test_board_png_of_a_board_whose_dictionary_is_auto_names_the_dictionary() -> None:
     """board_png of CharucoBoard("7x5", ..., dictionary="auto") (its default) looked "auto" up
     in cv2.aruco for its marker check: AttributeError "module 'cv2.aruco' has no attribute

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import struct
+import sys
 import zlib
 from dataclasses import dataclass, replace
 from typing import Any
@@ -244,7 +245,11 @@ class CharucoBoard:
                 raw.dtype.kind == "f" and bool(np.all(np.isfinite(raw) & (raw == np.round(raw))))
             )
             if not whole:
-                raise ValueError(f"ids: expected whole corner ids, got {raw.ravel()[:8]!r}")
+                # on one line: NumPy's repr wrapped eight ids such as 0.12345679 over two
+                flat = raw.ravel()
+                shown = np.array2string(flat[:8], separator=", ", max_line_width=sys.maxsize)
+                more = ", ...]" if flat.size > 8 else "]"
+                raise ValueError(f"ids: expected whole corner ids, got {shown[:-1]}{more}")
             if raw.size and not 0 <= raw.min() <= raw.max() < self.n_corners:
                 raise ValueError(
                     f"ids: expected corner ids from 0 to {self.n_corners - 1} (a "
