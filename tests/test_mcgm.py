@@ -1393,11 +1393,23 @@ def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> No
     assert len(mcgm.zncc_reference(left, right, max_disparity=8, pixels=[], **off)) == 0
 
 
-@pytest.mark.parametrize("sigma", [True, np.True_, "2", b"2", np.timedelta64(2, "ns")])
+@pytest.mark.parametrize(
+    "sigma",
+    [
+        True,
+        np.True_,
+        "2",
+        b"2",
+        np.timedelta64(2, "ns"),
+        np.array(True),
+        np.array(np.timedelta64(2, "ns")),
+    ],
+)
 def test_log_filter_refuses_a_bool_a_numeric_string_or_a_time_as_sigma(sigma: object) -> None:
     """log_filter's float() read True as sigma 1, "2" and b"2" as 2 and 2 ns as 2 (mcgm_match's
     sigmas refuse each, naming sigmas): each is a ValueError naming sigma; a Fraction, a Decimal
-    and a NumPy float are still their number."""
+    and a NumPy float are still their number. Given as a 0-d array (np.array(True), np.array of
+    2 ns) each still ran as 1 and 2: only a size-1 int or float array was read as its value."""
     from decimal import Decimal
     from fractions import Fraction
 

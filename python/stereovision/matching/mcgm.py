@@ -277,9 +277,10 @@ def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
     ValueError
         Bad image or sigma.
     """
-    if isinstance(sigma, np.ndarray) and sigma.size == 1 and sigma.dtype.kind in "iuf":
+    if isinstance(sigma, np.ndarray) and sigma.size == 1 and sigma.dtype.kind in "iufbm":
         # its number, as mcgm_match reads sigmas: float() of np.array([2.0]) was NumPy's bare
-        # TypeError "only 0-dimensional arrays can be converted"
+        # TypeError "only 0-dimensional arrays can be converted"; a bool or a time as its
+        # scalar, refused below (float() read np.array(True) as sigma 1)
         sigma = sigma.reshape(())[()]
     if isinstance(sigma, (*NOT_NUMBERS, str, bytes)):
         # float() read True as sigma 1, "2" and b"2" as 2, and 2 ns as 2 (mcgm_match's sigmas
