@@ -774,3 +774,24 @@ def test_a_count_beyond_64_bits_is_shown_as_given(value: object, shown: str) -> 
         hp.hopfield_match(left, left, max_disparity=8, k_cand=value)
     msg = str(exc.value)
     assert msg == f"k_cand: expected an integer of at most 64 bits, got {shown}"
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("A", np.array(True)),
+        ("A", np.array([True])),
+        ("A", np.array(np.timedelta64(3, "ns"))),
+        ("k_cand", np.array(True)),
+    ],
+    ids=["A=array(True)", "A=array([True])", "A=array(3 ns)", "k_cand=array(True)"],
+)
+def test_a_bool_or_a_time_in_a_size_1_array_is_no_number(name: str, value: object) -> None:
+    """refuse_not_numbers caught A=True and k_cand=3 ns, but not the same given as a size-1
+    array: A=np.array(True) ran as A=1 without a word (the kernel's float of it) and
+    k_cand=np.array(True) was its bare "TypeError: only integer scalar arrays can be converted
+    to a scalar index". Each is now named as its scalar is."""
+    left = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError) as exc:
+        hp.hopfield_match(left, left, max_disparity=8, **{name: value})
+    assert str(exc.value) == f"{name}: expected a number, got {value!r}"

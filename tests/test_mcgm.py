@@ -1458,3 +1458,12 @@ def test_a_count_beyond_64_bits_is_shown_as_given() -> None:
     with pytest.raises(ValueError) as exc:
         mcgm.mcgm_match(left, left, max_disparity=8, knn=1e300)
     assert str(exc.value) == "knn: expected an integer of at most 64 bits, got 1e+300"
+
+
+def test_a_bool_in_a_size_1_array_is_no_number() -> None:
+    """A=np.array(True) passed refuse_not_numbers (it caught A=True) and ran as A=1 without
+    a word. It is named as True itself is."""
+    left = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError) as exc:
+        mcgm.mcgm_match(left, left, max_disparity=8, A=np.array(True))
+    assert str(exc.value) == "A: expected a number, got array(True)"
