@@ -578,6 +578,29 @@ def test_batch_grid_is_a_number(data_dir: Path, tmp_path: Path) -> None:
     assert _summary(out)["pairs"]["a"]["options"]["grid"] == 0.25
 
 
+def test_batch_a_pair_failed_on_an_obstacle_is_done_once_it_is_gone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A file where pair a's output folder goes failed the pair with its fingerprint and
+    options recorded: once the file was moved away the rerun skipped a as 'failed before'
+    (exit 1, '--retry-failed redoes them'), though the code said a rerun meets the obstacle
+    again. Such a failure is the output folder's, not the inputs': the pair is tried again on
+    every run, as one whose image could not be read."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "a/left.png", "a/right.png")
+    out.mkdir()
+    (out / "a").write_text("notes")
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 1
+    assert _summary(out)["pairs"]["a"]["status"] == "failed"
+    (out / "a").unlink()
+    capsys.readouterr()
+    assert main(args) == 0, capsys.readouterr()
+    pair = _summary(out)["pairs"]["a"]
+    assert pair["status"] == "done" and pair["this_run"] == "processed"
+    assert (out / "a" / "disparity.pfm").is_file()
+
+
 def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Path) -> None:
     """A grid cell of 0.01 m and of 10 m, the bounds, pass the options' check (the missing input
     is the error); past them, and a calib_unit without calib, are refused by name."""

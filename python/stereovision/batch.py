@@ -2033,7 +2033,12 @@ def _run_jobs(
                     _commit_pair(out, job.name, res["files"], (previous or {}).get(job.name))
                 except (NotADirectoryError, IsADirectoryError) as err:
                     # a file where its folder goes, a folder where one of its files goes: this
-                    # pair alone fails (a rerun meets it again; the pairs to come can be written)
+                    # pair alone fails (the pairs to come can be written), and a rerun meets it
+                    # again: the output folder's failure, not its inputs', so it is recorded
+                    # without them, as an unreadable image's (with them, once the obstacle was
+                    # moved away, the rerun skipped the pair as failed before)
+                    for key in ("options", "fingerprint"):
+                        summary.pairs[job.name].pop(key, None)
                     record_failure(job, err)
                     fut.release()
                     while len(futures) < limit and submit_next():
