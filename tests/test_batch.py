@@ -578,6 +578,31 @@ def test_batch_grid_is_a_number(data_dir: Path, tmp_path: Path) -> None:
     assert _summary(out)["pairs"]["a"]["options"]["grid"] == 0.25
 
 
+def test_batch_a_range_or_cell_too_large_for_a_float_is_refused_by_name(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """grid=10**400 passed the number check and failed in float() with Python's bare
+    "OverflowError: int too large to convert to float"; max_disparity=10**400 passed as
+    positive, and every pair failed alike in the workers with depth_map's refusal ("expected a
+    finite number"), a cluster started and an output folder made. Both are refused by name,
+    before the input is searched, max_disparity in depth_map's words."""
+    from stereovision.batch import run_batch
+
+    root, out = tmp_path / "in", tmp_path / "o"
+    _tiny(root, data_dir, "a_left.png", "a_right.png")
+    with pytest.raises(
+        ValueError,
+        match=r"^grid: expected a cell side from 0\.01 to 10 m, got an integer of 401 digits",
+    ):
+        run_batch(root, out, workers=1, ground=True, grid=10**400, progress=False)
+    with pytest.raises(
+        ValueError,
+        match=r"^max_disparity: expected a finite number, got an integer of 401 digits",
+    ):
+        run_batch(root, out, workers=1, max_disparity=10**400, progress=False)
+    assert not out.exists()
+
+
 def test_batch_a_pair_failed_on_an_obstacle_is_done_once_it_is_gone(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1475,7 +1475,12 @@ def run_batch(
         raise ValueError(f"words: expected 'api' or 'cli', got {words!r}")
     import numpy as np
 
-    from stereovision._validate import number_shown, real_number, too_large_for_float
+    from stereovision._validate import (
+        finite_number,
+        number_shown,
+        real_number,
+        too_large_for_float,
+    )
     from stereovision.depth import METHODS
 
     if grid is not None:
@@ -1483,6 +1488,10 @@ def run_batch(
         # summary's first write (no JSON)
         if not real_number(grid):
             raise TypeError(f"grid: expected a cell side in metres, got {grid!r}")
+        if too_large_for_float(grid):  # 10**400: float() raised a bare OverflowError
+            raise ValueError(
+                f"grid: expected a cell side from 0.01 to 10 m, got {number_shown(grid)}"
+            )
         grid = float(grid)
     if grid is not None and not ground:
         raise ValueError("grid: the occupancy grid lies on the floor; it needs ground=True")
@@ -1496,13 +1505,11 @@ def run_batch(
             raise TypeError(f"max_disparity: expected a number of pixels, got {max_disparity!r}")
         if isinstance(max_disparity, np.generic):  # a NumPy number is no JSON for the summary
             max_disparity = max_disparity.item()
-        # an int too large for a float (isfinite's OverflowError): compared as it is; a
-        # positive one is each pair's to refuse, as wider than its images
+        # an int too large for a float (10**400): depth_map's finite_number refuses it, so
+        # every pair failed alike in the workers; refused here in its words
         if too_large_for_float(max_disparity):
-            positive = max_disparity > 0
-        else:
-            positive = math.isfinite(max_disparity) and max_disparity > 0
-        if not positive:
+            finite_number(max_disparity, "max_disparity")
+        if not (math.isfinite(max_disparity) and max_disparity > 0):
             given = number_shown(max_disparity)
             raise ValueError(f"max_disparity: expected a positive number, got {given}")
     if method is not None and method not in METHODS:
