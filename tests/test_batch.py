@@ -603,6 +603,25 @@ def test_batch_a_range_or_cell_too_large_for_a_float_is_refused_by_name(
     assert not out.exists()
 
 
+def test_batch_switches_are_true_or_false(tmp_path: Path) -> None:
+    """run_batch(ground="no") went by truthiness (a floor asked for, every pair failing without a
+    calibration) and retry_failed="no" redid the failed pairs; the CLI gives them as True or
+    False (store_true). Anything else is refused by name, before the input is searched, as
+    depth_map refuses such a switch."""
+    from stereovision.batch import run_batch
+
+    missing = tmp_path / "missing"
+    for name in ("ground", "retry_failed"):
+        for bad in ("no", 1, None):
+            with pytest.raises(TypeError) as info:
+                run_batch(missing, tmp_path / "o", **{name: bad})  # type: ignore[arg-type]
+            assert str(info.value) == f"{name}: expected True or False, got {bad!r}"
+        # NumPy's bools are taken (the missing input is the error)
+        with pytest.raises(FileNotFoundError, match=r"^input folder not found: "):
+            run_batch(missing, tmp_path / "o", **{name: np.True_})  # type: ignore[arg-type]
+    assert not (tmp_path / "o").exists()
+
+
 def test_batch_a_pair_failed_on_an_obstacle_is_done_once_it_is_gone(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

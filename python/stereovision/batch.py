@@ -1454,8 +1454,8 @@ def run_batch(
         made from other images (they would be replaced), or one that another run is writing
         into.
     TypeError
-        A ``fill`` that is not True, False or None, a ``max_disparity`` or ``grid`` that is not
-        a number.
+        A ``fill`` that is not True, False or None, a ``ground`` or ``retry_failed`` that is
+        not True or False, a ``max_disparity`` or ``grid`` that is not a number.
     PermissionError
         If the output folder cannot be written.
     OSError
@@ -1482,6 +1482,13 @@ def run_batch(
         too_large_for_float,
     )
     from stereovision.depth import METHODS
+
+    # True or False, as the CLI gives them (store_true) and depth_map takes a switch: "no"
+    # was true (a floor asked for, every pair failing without a calibration; failed pairs redone)
+    for name, flag in (("ground", ground), ("retry_failed", retry_failed)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"{name}: expected True or False, got {flag!r}")
+    ground, retry_failed = bool(ground), bool(retry_failed)
 
     if grid is not None:
         # "0.2" failed in isfinite ("must be real number, not str"), a NumPy float32 at the
