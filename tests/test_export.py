@@ -1076,6 +1076,22 @@ def test_export_result_formats_given_once_through_are_all_written(result, tmp_pa
     assert not (tmp_path / "bad").exists()
 
 
+def test_export_result_names_formats_that_are_no_names(result, tmp_path):
+    """A format that is no name was Python's own error, naming no argument: a list among them
+    (``[["ply"]]``) "unhashable type: 'list'", two unknown ones of different types
+    (``("x", 3)``) "'<' not supported between instances of 'int' and 'str'" from the sort of
+    the error's own list. Each is an unknown format, named, and nothing is written."""
+    expected = f"expected {list(export.EXPORT_FORMATS)}"
+    for bad, shown in (([["ply"]], "[['ply']]"), (("ply", "x", 3, "x"), "['x', 3]")):
+        with pytest.raises(ValueError) as info:
+            export.export_result(result, tmp_path / "bad", bad)
+        assert str(info.value) == f"unknown export format(s) {shown}: {expected}"
+    with pytest.raises(ValueError) as info:  # as before for names alone
+        export.export_result(result, tmp_path / "bad", ("PLY", "npz", "Ply"))
+    assert str(info.value) == f"unknown export format(s) ['PLY', 'Ply']: {expected}"
+    assert not (tmp_path / "bad").exists()
+
+
 def test_pcd_without_the_comment_line_and_with_signed_colours(tmp_path):
     """A PCD may start at VERSION (the comment line is optional); a ``TYPE I`` colour holds
     the bits as a signed integer (opaque red 0xFFFF0000 is -65536)."""

@@ -42,6 +42,7 @@ from stereovision._validate import (
     not_a_result,
     number_shown,
     renamed_keyword,
+    text_shown,
 )
 from stereovision._validate import require as _require_type
 
@@ -1096,10 +1097,14 @@ def export_result(
         raise TypeError(
             f"formats: expected a tuple of format names, got {formats!r} (e.g. ('ply', 'npz'))"
         ) from None
-    unknown = set(formats) - set(EXPORT_FORMATS)
+    # each shown once, by its repr: a list among them failed in set() ("unhashable type"),
+    # an int beside an unknown name in the sort of this list, naming no argument
+    unknown = sorted(
+        {text_shown(f) for f in formats if not (isinstance(f, str) and f in EXPORT_FORMATS)}
+    )
     if unknown:
         raise ValueError(
-            f"unknown export format(s) {sorted(unknown)}: expected {list(EXPORT_FORMATS)}"
+            f"unknown export format(s) [{', '.join(unknown)}]: expected {list(EXPORT_FORMATS)}"
         )
     _require_type(result, "DepthResult", "result")
     # Refused before any file is written: found at its turn, after the formats before it were
