@@ -2270,6 +2270,41 @@ def test_an_image_that_cannot_be_read_when_sent_is_tried_again(
     assert _summary(out)["pairs"]["a"]["status"] == "done"
 
 
+def test_a_calibration_that_cannot_be_read_for_its_hash_fails_its_pair_alone(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A pair's calibration file read for its sha256 after its task was made (permission
+    denied, an I/O error, a share gone between the two reads) raised out of the run: it
+    stopped ("PermissionError ...; 0 of 2 pairs finished this run"), the pairs to come undone,
+    where an unreadable file is a failed pair. It is one now, tried again on the next run."""
+    from stereovision import batch
+
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    cam = "[100 0 48; 0 100 32; 0 0 1]"
+    for name in ("a", "b"):
+        (src / name / "calib.txt").write_text(
+            f"cam0={cam}\ncam1={cam}\ndoffs=0\nbaseline=100\nwidth=96\nheight=64\nndisp=16\n"
+        )
+    denied = src / "a/calib.txt"
+    real_sha256 = batch._sha256
+
+    def sha256(path: Path) -> str:
+        if path == denied:
+            raise PermissionError(13, "Permission denied", str(path))
+        return real_sha256(path)
+
+    monkeypatch.setattr(batch, "_sha256", sha256)
+    first = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
+    assert (first.processed, first.failed) == (["b"], ["a"])
+    entry = _summary(out)["pairs"]["a"]
+    assert entry["error"] == f"PermissionError: [Errno 13] Permission denied: '{denied}'"
+    assert "fingerprint" not in entry and "options" not in entry
+    monkeypatch.setattr(batch, "_sha256", real_sha256)
+    again = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
+    assert (again.processed, again.skipped, again.failed_before) == (["a"], ["b"], [])
+
+
 def test_calib_unit_reaches_the_workers(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

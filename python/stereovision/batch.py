@@ -2000,6 +2000,9 @@ def _run_jobs(
                 return False
             try:
                 task = _task(job, opts, payloads)
+                # read from the bytes shipped: a copy of these files without their times is
+                # known; its calibration files read again (an OSError there stopped the run)
+                hashes = _hashes(job, task)
             except (OSError, ValueError) as exc:  # unreadable input or calibration (a scene's
                 # Q.dat is read here): a failed pair, not a failed run
                 if isinstance(exc, OSError):
@@ -2011,8 +2014,7 @@ def _run_jobs(
                         summary.pairs[job.name].pop(key, None)
                 record_failure(job, exc)
                 return True
-            # read from the bytes shipped: a copy of these files without their times is known
-            summary.pairs[job.name]["hashes"] = _hashes(job, task)
+            summary.pairs[job.name]["hashes"] = hashes
             fut = client.submit(process_pair, task, key=f"stereovision-{uuid.uuid4().hex}")
             futures[fut] = job
             ac.add(fut)
