@@ -1239,6 +1239,41 @@ def test_batch_skipped_pairs_record_where_their_images_are_now(
     assert _tree(out) == before and _summary(out)["input"] == str(moved)
 
 
+def test_batch_a_skip_through_a_link_keeps_the_images_it_recorded(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A drive run as it is, then through a link to it (its pairs skipped): the skip rewrote
+    the records to name the images through the link, so once the link was pointed at another
+    drive its other images passed for the pairs' own (_same_file resolves the link) and
+    replaced the first drive's outputs without a word (exit 0, 1 processed), where before
+    caa148b, and for any other folder, they are refused as 'made from other images'. A skip
+    now keeps a recorded path that still names the pair's image; one gone (the input moved)
+    is replaced as before."""
+    one, two, out = tmp_path / "drive1", tmp_path / "drive2", tmp_path / "out"
+    _tiny(one, data_dir, "a/left.png", "a/right.png")
+    _tiny(two, data_dir, "a/left.png", "a/right.png")
+    _change(two / "a/left.png")
+    link = tmp_path / "current"
+    link.symlink_to(one)
+    args = ["--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(one), "-o", str(out), *args]) == 0
+    assert main(["batch", str(link), "-o", str(out), *args]) == 0
+    assert _summary(out)["run"]["skipped"] == 1
+    assert _summary(out)["pairs"]["a"]["left"] == str(one / "a/left.png")
+    link.unlink()
+    link.symlink_to(two)
+    before = _tree(out)
+    capsys.readouterr()
+    assert main(["batch", str(link), "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        f"stereovision: error: output folder {out} holds the outputs of 1 pair(s) of the same "
+        f"names made from other images (e.g. a from {one / 'a/left.png'}); give another output "
+        "folder, or remove those pairs' folders to replace them"
+    ]
+    assert _tree(out) == before
+
+
 def test_batch_refuses_to_replace_a_file_it_did_not_write(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1611,13 +1611,13 @@ def run_batch(
                 assert entry is not None
                 # its images where they are now: an input moved with its times named the old
                 # place, and a new drive made there passed for these images (not refused as
-                # made from other images, its outputs replacing these)
-                entry.update(
-                    left=_recorded(job.left),
-                    right=_recorded(job.right),
-                    calib=None if job.calib is None else _recorded(job.calib),
-                    this_run="skipped",
-                )
+                # made from other images, its outputs replacing these). A path that still names
+                # the image is kept: rewritten to one through a link, the link pointed at
+                # another drive passed for these images just so
+                for key, path in (("left", job.left), ("right", job.right), ("calib", job.calib)):
+                    if path is None or not _same_file(entry.get(key), path):
+                        entry[key] = None if path is None else _recorded(path)
+                entry["this_run"] = "skipped"
                 (skipped if entry["status"] == "done" else failed_before).append(job.name)
                 continue
             if (
