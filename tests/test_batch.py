@@ -3221,3 +3221,65 @@ def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
     assert err.startswith(f"stereovision: error: --scheduler: {says}") and err.count("\n") == 1
     assert "s3cret" not in err
     assert (out / "summary.json").read_bytes() == summary
+
+
+def _camera_pair(root: Path, data_dir: Path, number: str) -> None:
+    for side in ("left", "right"):
+        (root / side).mkdir(parents=True, exist_ok=True)
+        img = cv2.imread(str(data_dir / "middlebury2001" / "tsukuba" / f"{side}.png"))
+        small = cv2.resize(img, None, fx=SCALE, fy=SCALE, interpolation=cv2.INTER_AREA)
+        cv2.imwrite(str(root / side / f"{number}.png"), small)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
+def test_a_fifo_named_as_an_image_fails_its_pair_and_does_not_hang(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    root = tmp_path / "in"
+    _camera_pair(root, data_dir, "0002")
+    shutil.copy(root / "right" / "0002.png", root / "right" / "0001.png")
+    os.mkfifo(root / "left" / "0001.png")  # read_bytes waited for a writer: the run hung
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "stereovision",
+            "batch",
+            str(root),
+            "-o",
+            str(tmp_path / "out"),
+            "--workers",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=240,
+    )
+    assert proc.returncode == 1, proc.stderr
+    left = root / "left" / "0001.png"
+    assert (
+        f"failed 0001: ValueError: image file is not a regular file: {left} (a FIFO)\n"
+        in proc.stderr
+    )
+    summary = json.loads((tmp_path / "out" / SUMMARY_NAME).read_text())
+    assert summary["pairs"]["0001"]["status"] == "failed"
+    assert summary["pairs"]["0002"]["status"] == "done"
+
+
+def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    root = tmp_path / "in"
+    _camera_pair(root, data_dir, "0001")
+    (root / "s\nx").mkdir()
+    (root / "s\nx" / "a_left.png").write_bytes(b"not an image")
+    (root / "s\nx" / "a_right.png").write_bytes(b"not an image")
+    lines: list[str] = []
+    from stereovision.batch import run_batch
+
+    run_batch(root, tmp_path / "out", workers=1, progress=False, log=lines.append)
+    failed = [line for line in lines if line.startswith("failed")]
+    assert len(failed) == 1 and "\n" not in failed[0]
+    assert failed[0].startswith("failed s\\nx/a: ")
+    assert "s\\nx/a_left.png" in failed[0], failed[0]

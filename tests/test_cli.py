@@ -3501,3 +3501,40 @@ def test_output_folder_dash_is_refused_not_made(
         "standard output: name a folder\n"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("name", "shown"),
+    [
+        ("a\nb.png", "a\\nb.png"),  # was cut at the newline: "image file not found: a"
+        ("a\tb.png", "a\\tb.png"),
+        ("a\x1b[2Jb.png", "a\\x1b[2Jb.png"),  # an ESC sequence that would clear the terminal
+        ("my scans/é 1.png", "my scans/é 1.png"),  # an ordinary path: as it is
+    ],
+)
+def test_a_path_with_a_control_character_is_shown_escaped_on_one_line(
+    tmp_path: Path, name: str, shown: str
+) -> None:
+    right = CONES / "right.png"
+    proc = subprocess.run(
+        [*SV, "depth", name, str(right), "-o", str(tmp_path / "d.png")],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr == f"stereovision: error: image file not found: {shown}\n"
+
+
+def test_a_folder_with_a_newline_is_shown_escaped_in_an_argparse_error(tmp_path: Path) -> None:
+    (tmp_path / "d\nx").mkdir()
+    proc = subprocess.run(
+        [*SV, "depth", "d\nx", "-o", str(tmp_path / "d.png")],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "; d\\nx is a folder with no pair" in proc.stderr

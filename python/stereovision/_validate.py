@@ -1150,7 +1150,7 @@ def refuse_unreachable_range(min_disparity: float, max_disparity: float, width: 
         raise err
 
 
-def first_line(exc: BaseException) -> str:
+def first_line(exc: BaseException, paths: Iterable[object] = ()) -> str:
     """What a one-line error message says of ``exc``: its message's first line with text (its
     type's name if none), as the CLI, the GUI and the stream print errors and warnings.
 
@@ -1158,6 +1158,9 @@ def first_line(exc: BaseException) -> str:
     ----------
     exc : BaseException
         The error.
+    paths : iterable, optional
+        Paths the message may name, shown :func:`escaped` where they hold a control character
+        (:func:`escape_paths`): one holding a newline is not cut.
 
     Returns
     -------
@@ -1174,8 +1177,82 @@ def first_line(exc: BaseException) -> str:
     'the pair differs in size'
     """
     # the first line with text: a message opening with a line break said nothing
-    text = [line for line in str(exc).splitlines() if line.strip()]
-    return text[0] if text else type(exc).__name__
+    text = [line for line in escape_paths(str(exc), paths).splitlines() if line.strip()]
+    # a control character left (a tab, an ESC sequence in a file name found in a folder) would
+    # be obeyed by the terminal: shown escaped
+    return _CONTROL.sub(_escape_one, text[0]) if text else type(exc).__name__
+
+
+#: The characters a one-line message does not show as they are: C0 and C1 controls (a
+#: newline, a tab, ESC that starts a sequence rewriting the terminal) and the line and
+#: paragraph separators ``str.splitlines`` also cuts at.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+
+
+def _escape_one(m: re.Match[str]) -> str:
+    return repr(m.group())[1:-1]  # "\n", "\t", "\x1b", "\u2028"
+
+
+def escaped(text: str) -> str:
+    """``text`` as a one-line message shows a path: as it is, unless it holds a control
+    character (:data:`_CONTROL`), then with those escaped as Python writes them and its
+    backslashes doubled (so that ``a\\nb`` is not read as ``a``, newline, ``b``).
+
+    Parameters
+    ----------
+    text : str
+        A path or a part of one.
+
+    Returns
+    -------
+    str
+        One line.
+
+    Examples
+    --------
+    >>> escaped("my scans/é.png")
+    'my scans/é.png'
+    >>> print(escaped("a\\nb.png"), escaped("\\x1b[2Jx.png"))
+    a\\nb.png \\x1b[2Jx.png
+    """
+    if not _CONTROL.search(text):
+        return text
+    return _CONTROL.sub(_escape_one, text.replace("\\", "\\\\"))
+
+
+def escape_paths(message: str, paths: Iterable[object] = ()) -> str:
+    """``message`` with each part of ``paths`` that holds a control character shown
+    :func:`escaped`, wherever it is in the message (the path as given, made absolute or joined
+    to a file name under it): a path holding a newline cut a one-line message in two, its
+    first line naming another file (``image file not found: a`` for ``a\\nb.png``).
+
+    Parameters
+    ----------
+    message : str
+        An error message, which may name the paths.
+    paths : iterable
+        The paths the message may name (str or os.PathLike; others are passed over).
+
+    Returns
+    -------
+    str
+        ``message``, the paths in it escaped; its own line breaks kept.
+
+    Examples
+    --------
+    >>> print(escape_paths("image file not found: /tmp/a\\nb.png", ["a\\nb.png"]))
+    image file not found: /tmp/a\\nb.png
+    """
+    parts: set[str] = set()
+    for p in paths:
+        if isinstance(p, str | os.PathLike):
+            text = os.fspath(p)
+            if isinstance(text, str) and _CONTROL.search(text):
+                # by its parts: the message may name it absolute, or a file under it
+                parts |= {x for x in re.split(r"[/\\]", text) if _CONTROL.search(x)}
+    for part in sorted(parts, key=len, reverse=True):
+        message = message.replace(part, escaped(part))
+    return message
 
 
 #: RuntimeError's subclasses that are a bug of ours, never a failure to say as it is: a

@@ -33,6 +33,7 @@ import re
 import shutil
 import signal
 import socket
+import stat
 import sys
 import tempfile
 import threading
@@ -150,7 +151,10 @@ class _Unpaired:
 
     @property
     def error(self) -> str:
-        return f"unpaired image: {self.what}"
+        from stereovision._validate import escaped
+
+        # a newline in a file's name cut the summary's one line there
+        return f"unpaired image: {escaped(self.what)}"
 
     @property
     def what(self) -> str:
@@ -364,6 +368,8 @@ def _calib_size(cal: Path | None, jobs: list[PairJob]) -> tuple[int, int] | None
     if cal is None or not _sizeless(cal):
         return None
     for job in jobs:
+        if not job.left.is_file():  # a FIFO's read waits for a writer: the run hung
+            continue
         with contextlib.suppress(OSError, ValueError):
             img = _decode(str(job.left), job.left.read_bytes())
             return int(img.shape[1]), int(img.shape[0])
@@ -767,9 +773,29 @@ def _inputs(job: PairJob) -> dict[str, Path]:
 
 
 def _fingerprint(job: PairJob) -> dict[str, Any]:
+    """The size and time of each of the pair's input files (:func:`_inputs`).
+
+    Raises
+    ------
+    ValueError
+        If its left or right image is no regular file (a FIFO, a socket, a link to /dev/zero
+        named ``left/0001.png``): reading it waited for a writer, or without end, and the run
+        hung; the pair fails instead.
+    """
     fp: dict[str, Any] = {}
     for key, p in _inputs(job).items():
         st = p.stat()
+        if key in ("left", "right") and not stat.S_ISREG(st.st_mode):
+            kind = (
+                "a FIFO"
+                if stat.S_ISFIFO(st.st_mode)
+                else "a socket"
+                if stat.S_ISSOCK(st.st_mode)
+                else "a folder"
+                if stat.S_ISDIR(st.st_mode)
+                else "a device"
+            )
+            raise ValueError(f"image file is not a regular file: {p} ({kind})")
         fp[key] = [st.st_size, st.st_mtime_ns]
     return fp
 
@@ -950,10 +976,15 @@ def _remove_partials(out: Path, names: list[str]) -> None:
                 shutil.rmtree(e.path, ignore_errors=True)
 
 
-def _error_line(exc: BaseException, words: str = "api") -> str:
+def _error_line(exc: BaseException, words: str = "api", job: PairJob | None = None) -> str:
     """``exc`` as a summary line, ``Type: first line``, its advice in ``words`` ("api" as
-    raised, or "cli": :func:`stereovision._validate.advice_for`)."""
-    msg = str(exc).splitlines()[0] if str(exc) else ""
+    raised, or "cli": :func:`stereovision._validate.advice_for`). The files of ``job`` that
+    hold a control character are shown escaped (:func:`stereovision._validate.escape_paths`):
+    one with a newline in its name cut the line there, naming another file."""
+    from stereovision._validate import first_line
+
+    paths = () if job is None else (job.left, job.right, job.calib)
+    msg = first_line(exc, paths) if str(exc).strip() else ""
     if words != "api":
         from stereovision._validate import advice_for
 
@@ -1476,6 +1507,7 @@ def run_batch(
     import numpy as np
 
     from stereovision._validate import (
+        escaped,
         finite_number,
         number_shown,
         real_number,
@@ -1587,8 +1619,9 @@ def run_batch(
         for job in checking.over(jobs):
             try:
                 fp = _fingerprint(job)
-            except OSError as exc:  # a broken link, an unmounted drive: this pair alone fails
-                unreadable.append((job, _error_line(exc, words)))
+            # a broken link, an unmounted drive, a FIFO named as an image: this pair alone fails
+            except (OSError, ValueError) as exc:
+                unreadable.append((job, _error_line(exc, words, job)))
                 continue
             entry = summary.pairs.get(job.name)
             # new times: the files are read again (a copy of a large dataset took minutes with
@@ -1715,7 +1748,7 @@ def run_batch(
                 summary.pairs[name]["outputs"] = earlier["outputs"]
             failed.append(name)
             if log is not None:
-                log(f"failed {name}: {error}")
+                log(f"failed {escaped(name)}: {error}")
 
         for u in unpaired:  # a failed pair, every run until the missing image is there
             left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
@@ -1779,7 +1812,7 @@ def run_batch(
                 run.update(
                     finished=_now(),
                     seconds=round(time.perf_counter() - t0, 3),
-                    error=_error_line(exc, words),
+                    error=_error_line(exc, words, job),
                 )
                 unsaved = ""
                 try:
@@ -2021,10 +2054,12 @@ def _run_jobs(
             return True
 
         def record_failure(job: PairJob, exc: BaseException) -> None:
+            from stereovision._validate import escaped
+
             entry = summary.pairs[job.name]
             entry.update(
                 status="failed",
-                error=_error_line(exc, words),
+                error=_error_line(exc, words, job),
                 finished=_now(),
                 this_run="failed",
             )
@@ -2033,7 +2068,7 @@ def _run_jobs(
             summary.record()
             bar.update(failed=True)
             if log is not None:
-                log(f"failed {job.name}: {entry['error']}")
+                log(f"failed {escaped(job.name)}: {entry['error']}")
 
         while len(futures) < limit and submit_next():
             pass

@@ -2172,7 +2172,8 @@ class _Parser(argparse.ArgumentParser):
         missing = "the following arguments are required: right"
         if message == missing or message.startswith(f"{missing}, "):
             message = self._folder_for_a_pair(message, message[len(missing) + 2 :])
-        message = _with_unit_hint(message)
+        # a path typed with a newline in it (or a tab, an ESC) is shown escaped, on the one line
+        message = first_line(ValueError(_with_unit_hint(message)), self.typed)
         sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
         sys.exit(EXIT_ERROR)
 
@@ -2602,6 +2603,16 @@ def _main(argv: Sequence[str] | None) -> int:
             signal.signal(signal.SIGTERM, kept)
 
 
+def _given_texts(args: argparse.Namespace) -> list[object]:
+    """The paths (and other text) given on the command line, for :func:`first_line` to show
+    those holding a control character escaped wherever its message names them: a path with a
+    newline was cut there (``image file not found: a`` for ``a\\nb.png``)."""
+    given: list[object] = []
+    for value in vars(args).values():
+        given += value if isinstance(value, list | tuple) else [value]
+    return given
+
+
 def _run(args: argparse.Namespace) -> int:
     try:
         status = int(args.func(args))
@@ -2622,7 +2633,8 @@ def _run(args: argparse.Namespace) -> int:
         return EXIT_ERROR
     # ImportError: an optional package missing (trame, rosbags, dask), said with its pip line
     except (CliError, ValueError, OSError, RuntimeError, MemoryError, ImportError) as exc:
-        print(f"stereovision: error: {advice_for(first_line(exc), 'cli')}", file=sys.stderr)
+        line = first_line(exc, _given_texts(args))
+        print(f"stereovision: error: {advice_for(line, 'cli')}", file=sys.stderr)
         return EXIT_ERROR
     except Exception as exc:  # a bug of ours: still one line, never a traceback
         print(internal_error(exc), file=sys.stderr)
