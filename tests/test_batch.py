@@ -3283,3 +3283,19 @@ def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
     assert len(failed) == 1 and "\n" not in failed[0]
     assert failed[0].startswith("failed s\\nx/a: ")
     assert "s\\nx/a_left.png" in failed[0], failed[0]
+
+
+@pytest.mark.parametrize(("left", "right"), [("left.jpg", "right.jpg"), ("LEFT.PNG", "RIGHT.PNG")])
+def test_a_scene_of_left_and_right_of_another_suffix_reads_its_calib(
+    data_dir: Path, tmp_path: Path, left: str, right: str
+) -> None:
+    scene = tmp_path / "in" / "terrace"
+    scene.mkdir(parents=True)
+    src = data_dir / "eth3d" / "terrace"
+    for name, side in ((left, "left"), (right, "right")):
+        cv2.imwrite(str(scene / name), cv2.imread(str(src / f"{side}.png")))
+    shutil.copy(src / "calib.txt", scene / "calib.txt")
+    # its calib.txt was passed over: no depth came out, unsaid
+    assert find_pairs(tmp_path / "in") == [
+        PairJob("terrace", scene / left, scene / right, scene / "calib.txt")
+    ]

@@ -172,6 +172,25 @@ def _stem_without(stem: str, m: re.Match[str]) -> str:
     return "_".join(x for x in (before, after) if x)
 
 
+def _is_right(stem: str) -> bool:
+    """``right`` (in any case) alone, the stem of a scene's right image."""
+    m = _last(_RIGHT_RE, stem)
+    return m is not None and not _stem_without(stem, m)
+
+
+def _scene_calib(folder: Path, names: set[str]) -> Path | None:
+    """The calibration of a scene ``folder`` holding the files ``names``, as
+    :func:`~stereovision.io.load_scene` reads it: its ``calib.txt``, else its ``Q.dat`` when
+    the image that sizes it is there (:func:`~stereovision.calibration._sizing_images`)."""
+    from stereovision.calibration import _sizing_images
+
+    if "calib.txt" in names:
+        return folder / "calib.txt"
+    if "Q.dat" in names and _sizing_images(folder / "Q.dat"):
+        return folder / "Q.dat"
+    return None
+
+
 def _pair_name(p: Path, m: re.Match[str], rel: str, root: Path) -> str:
     """``seq/0001`` for ``seq/left_0001.png``: the folder and the stem without the word ``m``
     (and separators around it); the folder alone for ``left.jpg``, like a scene."""
@@ -189,7 +208,9 @@ def find_pairs(
 
     * A folder holding ``left.png`` and ``right.png`` (evaluation.md's scene layout) is one pair,
       named by its path relative to ``root`` (``root``'s own name when ``root`` is the scene);
-      its ``calib.txt`` is used when present, else its ``Q.dat``.
+      its ``calib.txt`` is used when present, else its ``Q.dat``. So is one holding ``left`` +
+      ``right`` of another suffix or case (``left.jpg`` + ``right.jpg``, ``LEFT.PNG`` +
+      ``RIGHT.PNG``), its ``Q.dat`` when a ``left.png`` or ``left.jpg`` sizes it.
     * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
       saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
       in its place; the pair is named by its folder and the file name without ``left`` (and
@@ -293,7 +314,13 @@ def _scan(
             if rp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, rp, "left"))
                 continue
-            found.append(PairJob(_pair_name(p, m, rel, r), p, rp, cal))
+            named_cal = None
+            if cal is None and not _stem_without(p.stem, m) and _is_right(rp.stem):
+                # left.jpg + right.jpg (or LEFT.PNG ...) is a scene too: its calib.txt was
+                # passed over and no depth came out, unsaid. Its Q.dat is read when the image
+                # that sizes it (left.png, left.jpg) is there.
+                named_cal = _scene_calib(here, names)
+            found.append(PairJob(_pair_name(p, m, rel, r), p, rp, named_cal or cal))
             paired |= {f, rp.name}
         for f in images:
             p = here / f
