@@ -1240,8 +1240,8 @@ def escape_paths(message: str, paths: Iterable[object] = ()) -> str:
 
     Examples
     --------
-    >>> print(escape_paths("image file not found: /tmp/a\\nb.png", ["a\\nb.png"]))
-    image file not found: /tmp/a\\nb.png
+    >>> print(escape_paths("image file not found: scans/a\\nb.png", ["a\\nb.png"]))
+    image file not found: scans/a\\nb.png
     """
     parts: set[str] = set()
     for p in paths:
