@@ -822,3 +822,26 @@ def test_table1_report_shows_a_numpy_string_unit_as_its_text() -> None:
     ones = np.ones((2, 2))
     with pytest.raises(ValueError, match=r"got 'parsec'$"):
         table1_report(ones, ones, unit=np.str_("parsec"))  # type: ignore[arg-type]
+
+
+def test_depth_metrics_rmse_pct_is_of_the_mean_gt_depth() -> None:
+    # GT depths 1, 1, 10: mean 4, median 1 (the hand-computed test's 10, 10, 20, 20 has both 15,
+    # so it could not tell them apart)
+    gt = np.array([[1.0, 1.0, 10.0]])
+    est = np.array([[1.1, 1.0, 10.0]])
+    m = depth_metrics(est, gt)
+    rmse = math.sqrt((0.1**2 + 0.0 + 0.0) / 3)  # 0.0577...
+    assert m.rmse == pytest.approx(rmse)
+    assert m.rmse_pct == pytest.approx(100 * rmse / 4.0)  # 1.443 %, not 5.77 % (median 1)
+
+
+def test_sparse_metrics_measures_the_disparity_at_the_unrounded_column() -> None:
+    # The GT is looked up at the rounded (xl, yl), but the match's disparity is xl - xr with
+    # xl as given: 10.4 - 9.0 = 1.4 against GT 1.7 (err 0.3), 3.6 - 3.0 = 0.6 against GT 0.4
+    # (err 0.2). With the rounded columns they would be 1.0 and 1.0: errors 0.7 and 0.6.
+    gt = np.full((2, 12), NAN)
+    gt[0, 10] = 1.7
+    gt[1, 4] = 0.4
+    m = sparse_metrics([10.4, 3.6], [0.0, 1.0], [9.0, 3.0], gt)
+    assert m.count == 2
+    assert m.precision[0.5] == pytest.approx(100.0)
