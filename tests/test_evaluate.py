@@ -845,3 +845,19 @@ def test_sparse_metrics_measures_the_disparity_at_the_unrounded_column() -> None
     m = sparse_metrics([10.4, 3.6], [0.0, 1.0], [9.0, 3.0], gt)
     assert m.count == 2
     assert m.precision[0.5] == pytest.approx(100.0)
+
+
+def test_count_at_precision_measures_the_disparity_at_the_unrounded_column() -> None:
+    # as sparse_metrics: 10.4 - 9.0 = 1.4 against GT 1.7 (err 0.3 <= 0.5 px); the rounded
+    # column's 1.0 would be 0.7 off and no prefix would hold 100 %
+    gt = np.full((1, 12), NAN)
+    gt[0, 10] = 1.7
+    assert count_at_precision([10.4], [0.0], [9.0], [1.0], gt, 100.0, tolerance=0.5) == 1
+
+
+def test_sparse_metrics_dict_gives_the_coverage_not_the_count() -> None:
+    # three matches with GT, two in cell (0, 0) of the 4x4 grid over an 8x8 map, one in (3, 3):
+    # count 3, coverage 2
+    gt = np.full((8, 8), 2.0)
+    s = sparse_metrics([0.0, 1.0, 7.0], [0.0, 1.0, 7.0], [-2.0, -1.0, 5.0], gt).as_dict()
+    assert (s["count"], s["coverage"], s["precision@1.0"]) == (3, 2, 100.0)
