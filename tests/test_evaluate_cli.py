@@ -269,7 +269,7 @@ def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> No
     raw map as filled, swapped the depth maps or dropped a threshold survived every test)."""
     from stereovision._jsonout import json_ready
     from stereovision._validate import as_gray_float
-    from stereovision.baselines import row_fill
+    from stereovision.baselines import opencv_sgbm, row_fill
     from stereovision.cli import _eval_scene
     from stereovision.depth import depth_map
     from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth, table1_report
@@ -288,6 +288,11 @@ def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> No
     assert row["ours+fill"]["density"] > row["ours"]["density"]  # the fill filled holes
     zgt = gt_depth(scene.gt, calib)
     assert row["table1"] == json_ready(table1_report(res.depth, zgt, n_points=10, seed=0).as_dict())
+    # the headline depth figures: ours and SGBM-3WAY's depth against the GT depth, relative to
+    # the GT (depth_metrics(zgt, res.depth) divided by our depth and survived)
+    assert row["depth"] == json_ready(depth_metrics(res.depth, zgt).as_dict())
+    sgbm_z = calib.depth_from_disparity(opencv_sgbm(scene.left, scene.right, md))
+    assert row["sgbm_depth"] == json_ready(depth_metrics(sgbm_z, zgt).as_dict())
     gl, gr = as_gray_float(scene.left, "left"), as_gray_float(scene.right, "right")
     z_members = calib.depth_from_disparity(fuse_pair(gl, gr, max_disparity=md).dispx)
     assert row["members_depth"] == json_ready(depth_metrics(z_members, zgt).as_dict())
@@ -433,3 +438,31 @@ def test_eval_mean_line_says_why_stereobm_has_no_mean(data_dir: Path, tmp_path: 
     ]
     assert names == ["ours", "ours+fill", "SGBM-3WAY", "SGBM+fill"], mean
     assert mean.endswith("; StereoBM: no mean (no figures for 1 of 2 scenes)"), mean
+
+
+def test_eval_table_shows_each_blocks_bad_2_bad_1_and_density(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The text row gives, under bad-2, bad-1 and dens, the --json line's figures of each block
+    (a table that showed bad-2 under bad-1 too survived every test)."""
+    import cv2
+
+    from stereovision.io import read_pfm, write_pfm
+
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    scene = tmp_path / "crop"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        img = cv2.imread(str(tsukuba / name))
+        assert cv2.imwrite(str(scene / name), img[100:196, 100:228])
+    write_pfm(scene / "gt_disp.pfm", read_pfm(tsukuba / "gt_disp.pfm")[100:196, 100:228])
+    argv = ["eval", "--no-opencv", "--method", "census", str(scene)]
+    assert main([*argv, "--json"]) == 0
+    (row,) = _rows(capsys.readouterr().out)
+    assert main(argv) == 0
+    text = capsys.readouterr().out.splitlines()[2]
+    cells = [c.split() for c in text.split(" | ")[1:3]]
+    for block, cell in zip(("ours", "ours+fill"), cells, strict=True):
+        want = [f"{row[block][k]:.1f}" for k in ("bad_2.0", "bad_1.0", "density")]
+        assert want[0] != want[1]  # bad-2 and bad-1 differ here: the test tells them apart
+        assert cell == want, (block, text)
