@@ -1046,6 +1046,17 @@ def test_read_pfm_refuses_a_zero_scale(tmp_path: Path) -> None:
         read_pfm(tmp_path / "zero.pfm")
 
 
+def test_read_pfm_scale_sets_the_byte_order_not_the_values(tmp_path: Path) -> None:
+    # evaluation.md: the scale's sign is the byte order; a GT disparity of 1.5 px stored under
+    # a scale of -2.5 (or 4.0, big-endian) is 1.5 px, not scaled by it (every shared GT has a
+    # scale of -1.0, so a reader multiplying by |scale| passed every other test)
+    vals = [1.5, 0.25]
+    (tmp_path / "le.pfm").write_bytes(b"Pf\n2 1\n-2.5\n" + struct.pack("<2f", *vals))
+    (tmp_path / "be.pfm").write_bytes(b"Pf\n2 1\n4.0\n" + struct.pack(">2f", *vals))
+    for name in ("le.pfm", "be.pfm"):
+        np.testing.assert_array_equal(read_pfm(tmp_path / name), [vals])
+
+
 def test_find_scenes_needs_both_images(tmp_path: Path) -> None:
     for name in ("a/pair", "a/left_only"):
         (tmp_path / name).mkdir(parents=True)
