@@ -1403,13 +1403,20 @@ def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> No
         np.timedelta64(2, "ns"),
         np.array(True),
         np.array(np.timedelta64(2, "ns")),
+        np.array("2"),
+        np.array(b"2"),
+        np.array("2", dtype=object),
+        np.array(True, dtype=object),
+        np.array(np.datetime64(2, "ns")),
+        np.datetime64(2, "ns"),
     ],
 )
 def test_log_filter_refuses_a_bool_a_numeric_string_or_a_time_as_sigma(sigma: object) -> None:
     """log_filter's float() read True as sigma 1, "2" and b"2" as 2 and 2 ns as 2 (mcgm_match's
     sigmas refuse each, naming sigmas): each is a ValueError naming sigma; a Fraction, a Decimal
     and a NumPy float are still their number. Given as a 0-d array (np.array(True), np.array of
-    2 ns) each still ran as 1 and 2: only a size-1 int or float array was read as its value."""
+    2 ns) each still ran as 1 and 2: only a size-1 int or float array was read as its value;
+    then a 0-d array of "2", b"2", a datetime or an object "2" or True ran as 2 or 1."""
     from decimal import Decimal
     from fractions import Fraction
 

@@ -277,12 +277,14 @@ def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
     ValueError
         Bad image or sigma.
     """
-    if isinstance(sigma, np.ndarray) and sigma.size == 1 and sigma.dtype.kind in "iufbm":
+    if isinstance(sigma, np.ndarray) and sigma.size == 1 and sigma.dtype.kind != "O":
         # its number, as mcgm_match reads sigmas: float() of np.array([2.0]) was NumPy's bare
-        # TypeError "only 0-dimensional arrays can be converted"; a bool or a time as its
-        # scalar, refused below (float() read np.array(True) as sigma 1)
+        # TypeError "only 0-dimensional arrays can be converted"; any other as its scalar,
+        # refused below: float() read np.array(True) as sigma 1, and a 0-d array of "2", b"2"
+        # or 2 ns since the epoch as 2
         sigma = sigma.reshape(())[()]
-    if isinstance(sigma, (*NOT_NUMBERS, str, bytes)):
+    no_number = isinstance(sigma, np.ndarray) and sigma.dtype.kind == "O"  # a 0-d "2": 2
+    if no_number or isinstance(sigma, (*NOT_NUMBERS, str, bytes, np.datetime64)):
         # float() read True as sigma 1, "2" and b"2" as 2, and 2 ns as 2 (mcgm_match's sigmas
         # refuse them all); a Fraction or a Decimal is still its number
         raise ValueError(f"sigma: expected a number of pixels, got {reprlib.repr(sigma)}")
