@@ -783,14 +783,30 @@ def test_a_count_beyond_64_bits_is_shown_as_given(value: object, shown: str) -> 
         ("A", np.array([True])),
         ("A", np.array(np.timedelta64(3, "ns"))),
         ("k_cand", np.array(True)),
+        ("A", np.array("3")),
+        ("A", np.array("3", dtype=object)),
+        ("A", np.array([b"3"])),
+        ("A", np.array(np.datetime64(3, "ns"))),
+        ("k_cand", np.array(["3"])),
     ],
-    ids=["A=array(True)", "A=array([True])", "A=array(3 ns)", "k_cand=array(True)"],
+    ids=[
+        "A=array(True)",
+        "A=array([True])",
+        "A=array(3 ns)",
+        "k_cand=array(True)",
+        "A=array('3')",
+        "A=array('3', object)",
+        "A=array([b'3'])",
+        "A=array(datetime)",
+        "k_cand=array(['3'])",
+    ],
 )
 def test_a_bool_or_a_time_in_a_size_1_array_is_no_number(name: str, value: object) -> None:
     """refuse_not_numbers caught A=True and k_cand=3 ns, but not the same given as a size-1
     array: A=np.array(True) ran as A=1 without a word (the kernel's float of it) and
     k_cand=np.array(True) was its bare "TypeError: only integer scalar arrays can be converted
-    to a scalar index". Each is now named as its scalar is."""
+    to a scalar index". Each is now named as its scalar is. Then A=np.array('3') (and the
+    same of dtype object, or 3 ns since the epoch) still ran as A=3 though A='3' is refused."""
     left = np.random.default_rng(0).random((20, 30), dtype=np.float32)
     with pytest.raises(ValueError) as exc:
         hp.hopfield_match(left, left, max_disparity=8, **{name: value})

@@ -798,12 +798,16 @@ def refuse_not_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> None
     """A ``ValueError`` naming the first of ``params`` whose default is a number (not a switch)
     and whose value is one of :data:`NOT_NUMBERS`: a matcher's kernel read True as 1 and 3 ns
     as 3 (``A=True``, ``k_cand=np.timedelta64(3)``). A switch's True is its own. A size-1 array
-    is judged by its value, as :func:`read_numbers` reads one: ``A=np.array(True)`` ran as 1."""
+    is judged by its value, as :func:`read_numbers` reads one: ``A=np.array(True)`` ran as 1,
+    and one of a string or a datetime (``np.array('3')``, of dtype object too) as 3, though
+    ``A='3'`` is refused."""
     for name, v in params.items():
         d = defaults.get(name)
-        scalar = v.reshape(())[()] if isinstance(v, np.ndarray) and v.size == 1 else v
+        array = isinstance(v, np.ndarray) and v.size == 1
+        scalar = v.reshape(())[()] if array else v
         number = isinstance(d, (int, float)) and not isinstance(d, bool)
-        if number and isinstance(scalar, NOT_NUMBERS):
+        text = array and isinstance(scalar, (str, bytes, np.datetime64))
+        if number and (isinstance(scalar, NOT_NUMBERS) or text):
             raise ValueError(f"{name}: expected a number, got {v!r}")
 
 
