@@ -3408,7 +3408,23 @@ def test_a_bad_fourcc_is_refused_in_the_options_name(
     )
 
 
-@pytest.mark.parametrize("host", ["", " ", "127.0.0.1\n", "local host", "127.0.0.1\t"])
+@pytest.mark.parametrize(
+    "host",
+    [
+        "",
+        " ",
+        "127.0.0.1\n",
+        "local host",
+        "127.0.0.1\t",
+        "[::1",
+        "::1]",
+        "[]",
+        "[127.0.0.1]",
+        "[[::1]]",
+        "[::1]:8080",
+        "[localhost]",
+    ],
+)
 @pytest.mark.parametrize("command", ["stream", "gui"])
 def test_an_empty_host_is_refused_in_the_options_name(
     capsys: pytest.CaptureFixture[str], command: str, host: str
@@ -3418,7 +3434,9 @@ def test_an_empty_host_is_refused_in_the_options_name(
     alone, and said it as ``http://:8765/``; it is refused by argparse now, before any camera
     opens: one line, exit 2. So is an address holding a space or a control character
     (``127.0.0.1\\n`` read from a file): it reached the bind, after the cameras opened, and
-    the error was cut at its newline ('cannot serve the view on 127.0.0.1')."""
+    the error was cut at its newline ('cannot serve the view on 127.0.0.1'). So is a bracket
+    around no IPv6 address ('[::1', '[]', '[127.0.0.1]', '[::1]:8080'): no name holds one,
+    and each was bound after the cameras opened ('Name or service not known')."""
     with pytest.raises(SystemExit) as exit_:
         main([command, "--left", "0", "--right", "1", "--host", host])
     assert exit_.value.code == 2
@@ -3443,6 +3461,8 @@ def test_a_bracketed_ipv6_host_is_the_address_inside(command: str) -> None:
     for given, taken in [
         ("[::1]", "::1"),
         ("[::]", "::"),
+        ("[fe80::1%lo]", "fe80::1%lo"),
+        ("[::ffff:127.0.0.1]", "::ffff:127.0.0.1"),
         ("::1", "::1"),
         ("::ffff:127.0.0.1", "::ffff:127.0.0.1"),
         ("0.0.0.0", "0.0.0.0"),

@@ -2733,8 +2733,9 @@ def test_the_view_listens_on_the_loopback_by_default() -> None:
     finally:
         srv.close()
     # an empty host (a bind's "every interface") is refused, not served on 0.0.0.0; a host
-    # with a newline (read from a file) reached the bind, its error cut at the newline
-    for host in ("", " ", "127.0.0.1\n", "local host"):
+    # with a newline (read from a file) reached the bind, its error cut at the newline; so
+    # did a bracket around no IPv6 address ("Name or service not known")
+    for host in ("", " ", "127.0.0.1\n", "local host", "[::1", "[]", "[127.0.0.1]"):
         with pytest.raises(
             ValueError, match=rf"^host: expected an address .*got {re.escape(repr(host))}$"
         ):

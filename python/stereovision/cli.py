@@ -2139,10 +2139,18 @@ def check_listen_address(host: str, name: str = "--host") -> str:
         or any(c.isspace() or not c.isprintable() for c in host)
     ):
         raise ValueError(f"{name}: {_listen_address_words(host)}")
-    if host.startswith("[") and host.endswith("]") and ":" in host:
+    if "[" in host or "]" in host:
         # "[::1]" as a URL writes it was bound as a host name (not found) and said
-        # "[[::1]]:8765"; the address is inside
-        return host[1:-1]
+        # "[[::1]]:8765"; the address is inside. No name holds a bracket, so anything else
+        # ("[::1", "[]", "[127.0.0.1]", "[::1]:8080") was bound, after the cameras opened
+        import ipaddress
+
+        inner = host[1:-1] if host.startswith("[") and host.endswith("]") else ""
+        try:
+            ipaddress.IPv6Address(inner)  # a scope too: fe80::1%eth0
+        except ValueError:
+            raise ValueError(f"{name}: {_listen_address_words(host)}") from None
+        return inner
     return host
 
 
