@@ -761,14 +761,18 @@ def test_counts_and_reals_are_read_as_the_librarys_numbers() -> None:
         (np.array([1e300]), "array([1.e+300])"),
         (10**400, "an integer of 401 digits"),
         (10**5000, "an integer of 5001 digits"),
+        (Decimal("1e5000"), "Decimal('1E+5000')"),
+        (Decimal("-1.5e9999"), "Decimal('-1.5E+9999')"),
     ],
-    ids=["1e300", "-1e300", "Decimal", "array", "10**400", "10**5000"],
+    ids=["1e300", "-1e300", "Decimal", "array", "10**400", "10**5000", "Dec5000", "Dec-9999"],
 )
 def test_a_count_beyond_64_bits_is_shown_as_given(value: object, shown: str) -> None:
     """read_numbers turned a whole count into its int before the kernel named it, so
     k_cand=1e300 was "... got 1000000000000000052504760255204420248704468581108159..." (301
     digits: not what was given), Decimal('1e4000') 4001 digits, and an int of over 4300 digits
-    "got ?". A count past any 64-bit integer is now named as given, on one short line."""
+    "got ?". A count past any 64-bit integer is now named as given, on one short line; a
+    Decimal of over 4300 digits (no whole_value) was then the kernel's bare "TypeError:
+    'decimal.Decimal' object cannot be interpreted as an integer"."""
     left = np.random.default_rng(0).random((20, 30), dtype=np.float32)
     with pytest.raises(ValueError) as exc:
         hp.hopfield_match(left, left, max_disparity=8, k_cand=value)

@@ -838,7 +838,10 @@ def read_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> dict[str, 
             continue  # a switch, a choice, a list: the kernel's own
         if isinstance(d, int):
             whole = whole_value(v)
-            if whole is not None and not -(2**63) <= whole < 2**64:
+            # a Decimal of over 4300 digits is no whole_value (its int takes minutes) and went
+            # to the kernel as given: "TypeError: 'decimal.Decimal' object cannot be interpreted"
+            huge = isinstance(v, decimal.Decimal) and v.is_finite() and v.adjusted() >= 64
+            if huge or (whole is not None and not -(2**63) <= whole < 2**64):
                 shown = too_large_for_float(v, why=False) or reprlib.repr(v)
                 raise ValueError(f"{name}: expected an integer of at most 64 bits, got {shown}")
             if whole is not None:
