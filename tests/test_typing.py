@@ -110,6 +110,31 @@ def test_mypy_strict_refuses_what_fails_at_run_time(tmp_path: Path, mypy_cache: 
     )
 
 
+def test_mypy_strict_refuses_a_name_the_package_does_not_have(
+    tmp_path: Path, mypy_cache: Path
+) -> None:
+    """The package's lazy imports (a module ``__getattr__``) made every attribute of it
+    ``Any`` to mypy: ``sv.depth_mapp(...)``, a typo that fails at run time, passed --strict."""
+    script = tmp_path / "typo.py"
+    script.write_text("import stereovision as sv\n\nsv.depth_mapp\nreveal_type(sv.io)\n")
+    run = _mypy_strict(script, tmp_path, mypy_cache)
+    assert run.returncode == 1
+    lines = run.stdout.splitlines()
+    assert lines[0].endswith(
+        'typo.py:3: error: Module has no attribute "depth_mapp"; maybe "depth_map"?  [attr-defined]'
+    ), run.stdout
+    assert lines[1].endswith('typo.py:4: note: Revealed type is "types.ModuleType"'), run.stdout
+    assert len(lines) == 2, run.stdout
+
+
+def test_a_name_that_is_no_identifier_is_no_attribute() -> None:
+    """``getattr(sv, "a.b")`` looked for the submodule ``stereovision.a`` and raised
+    ModuleNotFoundError, so ``hasattr`` raised where it says False."""
+    assert not hasattr(sv, "a.b")
+    with pytest.raises(AttributeError, match=r"has no attribute 'depth\.x'"):
+        getattr(sv, "depth.x")
+
+
 def test_the_readme_script_runs(data_dir: Path, tmp_path: Path) -> None:
     spec = importlib.util.spec_from_file_location("typed_user_script", SCRIPT)
     assert spec is not None and spec.loader is not None

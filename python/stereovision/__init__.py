@@ -60,16 +60,24 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    """A name of the API (or a submodule: ``stereovision.depth``), imported on first use."""
-    if name in _WHERE:
-        value = getattr(_importlib.import_module(_WHERE[name]), name)
-    elif not name.startswith("__") and _importlib_util.find_spec(f"{__name__}.{name}"):
-        value = _importlib.import_module(f"{__name__}.{name}")  # binds it here too
-    else:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    globals()[name] = value  # once: later uses do not come here
-    return value
+if not TYPE_CHECKING:
+    # hidden from type checkers: a module's __getattr__ makes every attribute of it Any to
+    # mypy, so a user's typo (sv.depth_mapp) passed --strict; the names above are their types
+
+    def __getattr__(name: str) -> Any:
+        """A name of the API (or a submodule: ``stereovision.depth``), imported on first use."""
+        if name in _WHERE:
+            value = getattr(_importlib.import_module(_WHERE[name]), name)
+        elif (
+            name.isidentifier()  # getattr(sv, "a.b") imported stereovision.a, or failed to
+            and not name.startswith("__")
+            and _importlib_util.find_spec(f"{__name__}.{name}")
+        ):
+            value = _importlib.import_module(f"{__name__}.{name}")  # binds it here too
+        else:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        globals()[name] = value  # once: later uses do not come here
+        return value
 
 
 def __dir__() -> list[str]:
