@@ -647,6 +647,38 @@ def test_the_disparity_picture_says_the_pixels_of_its_colours():
     assert app.state.disparity_caption.startswith("disparity: blue 0\xa0px … red ")
 
 
+def test_a_map_of_negative_disparities_is_captioned_by_its_colours_ends(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The page coloured the disparity from 0 px up to the 99th percentile, both ends given:
+    for a map below 0 px (a swapped pair's) the picture was one colour and its caption read
+    "blue 0 px … red -1.4 px". Its ends are now colorize's own (colour_range: the map's 1st
+    and 99th percentiles there), the caption saying them."""
+    import stereovision.depth
+    from stereovision.cli import colorize
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import _data_url, compute_view
+
+    real = stereovision.depth.depth_map
+
+    def below_zero(*args: Any, **kwargs: Any) -> Any:
+        res = real(*args, **kwargs)
+        res.disparity = -1.0 - res.disparity  # every finite value below 0 px
+        return res
+
+    monkeypatch.setattr(stereovision.depth, "depth_map", below_zero)
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    view = compute_view(left, right, None, "fast")
+    d = view.result.disparity
+    lo, hi = (float(np.percentile(d[np.isfinite(d)], q)) for q in (1, 99))
+    assert lo < hi < 0
+    assert view.disparity_caption == f"disparity: blue {lo:.1f}\xa0px … red {hi:.1f}\xa0px"
+    assert view.disparity_url == _data_url(colorize(d, lo=lo, hi=hi))
+    assert view.disparity_url == _data_url(colorize(d, lo=0.0))  # the file's colours
+    assert len(np.unique(colorize(d, lo=lo, hi=hi).reshape(-1, 3), axis=0)) > 50
+
+
 def test_a_number_and_its_unit_are_never_broken_apart():
     """On a narrow page the statistics line broke "median depth 3.50 m" as "3.50" at the end
     of a line and "m" alone on the next. The page's texts hold a non-breaking space between

@@ -875,6 +875,7 @@ def compute_view(
     from stereovision.baselines import BM_BLOCK_SIZE, bm_widest_range, round_up16
     from stereovision.cli import colorize
     from stereovision.depth import METHODS, depth_map, estimate_max_disparity
+    from stereovision.overview import colour_range
     from stereovision.render import Intrinsics, surface_mesh
 
     def report(pct: int, text: str) -> None:
@@ -947,18 +948,21 @@ def compute_view(
         # were drawn on the raw pair, off the rows they were found on)
         shown_right = calib_s.rectify(left_s, right_s)[1]
     disparity_caption = DISPARITY_CAPTION
-    disp_known = result.disparity[np.isfinite(result.disparity)]
+    disp_lo: float | None = 0.0
     disp_hi = None
-    if disp_known.size:
-        # colorize's own top (99th percentile; the bottom is 0), said in pixels: the picture had
-        # no key, as the depth picture had none
-        disp_hi = float(np.percentile(disp_known, 99))
-        disparity_caption = f"disparity: blue 0 px … red {disp_hi:.1f} px"
+    ends = colour_range(result.disparity, 0.0)
+    if ends is not None:
+        # colorize's own ends (0 px to the 99th percentile; the 1st to the 99th for a map below
+        # 0 px, where 0 px up to its top was one colour, captioned "blue 0 px … red -1.4 px"),
+        # said in pixels: the picture had no key, as the depth picture had none
+        disp_lo, disp_hi = ends
+        blue = "0 px" if disp_lo == 0 else f"{disp_lo:.1f} px"
+        disparity_caption = f"disparity: blue {blue} … red {disp_hi:.1f} px"
     sparse = matches is not None
     if sparse:
-        disparity_url = _data_url(draw_sparse(shown_left, result.disparity, 0.0, disp_hi))
+        disparity_url = _data_url(draw_sparse(shown_left, result.disparity, disp_lo, disp_hi))
     else:
-        disparity_url = _data_url(colorize(result.disparity, lo=0.0, hi=disp_hi))
+        disparity_url = _data_url(colorize(result.disparity, lo=disp_lo, hi=disp_hi))
     depth_img = np.zeros_like(shown_left)
     depth_caption = DEPTH_CAPTION if result.depth is not None else NO_DEPTH_CAPTION
     depth_ends = None
@@ -980,7 +984,7 @@ def compute_view(
     matches_url = ""
     if method in SPARSE_METHODS or result.density < SPARSE_DENSITY:
         matches_url = _data_url(
-            draw_matches(shown_left, shown_right, result.disparity, lo=0.0, hi=disp_hi),
+            draw_matches(shown_left, shown_right, result.disparity, lo=disp_lo, hi=disp_hi),
             2 * DISPLAY_WIDTH,
         )
     mesh = None
