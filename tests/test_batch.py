@@ -3299,3 +3299,20 @@ def test_a_scene_of_left_and_right_of_another_suffix_reads_its_calib(
     assert find_pairs(tmp_path / "in") == [
         PairJob("terrace", scene / left, scene / right, scene / "calib.txt")
     ]
+
+
+@pytest.mark.parametrize("address", ["ucx://10.0.0.1:13337", "inproc://10.0.0.1/123/1"])
+def test_a_scheduler_address_dask_reads_no_port_of_is_left_to_dask(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str
+) -> None:
+    """The check read every address as a host and a port, which the UCX and in-process
+    transports' addresses have none of to Dask before it connects: a UCX scheduler was refused
+    ("--scheduler: don't know how to extract host and port for address 'ucx://...'"), where
+    Dask takes it. A rerun with every pair done exits 0 with it, as before the check."""
+    pytest.importorskip("distributed")
+    _noise_pair(tmp_path / "in" / "scene")
+    out = tmp_path / "out"
+    argv = ["batch", str(tmp_path / "in"), "-o", str(out)]
+    assert main([*argv, "--workers", "1"]) == 0
+    capsys.readouterr()
+    assert main([*argv, "--scheduler", address]) == 0, capsys.readouterr().err

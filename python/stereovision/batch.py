@@ -2179,13 +2179,20 @@ def _check_scheduler_address(address: str) -> None:
         Dask's reason after ``--scheduler:``, a password in the address said as ``***``.
     """
     try:
-        from distributed.comm.addressing import get_address_host_port
+        from distributed.comm.addressing import parse_address
+        from distributed.comm.registry import get_backend
     except ImportError:  # run_batch names the extra to install once it needs Dask
         return
     from stereovision.capture import _mask_secrets_of
 
     try:
-        get_address_host_port(address)
+        scheme, location = parse_address(address)
+        try:
+            get_backend(scheme).get_address_host_port(location)
+        except NotImplementedError:
+            # ucx://, inproc://: their backends read no host and port before they connect
+            # (Dask's get_address_host_port refused them: "don't know how to extract...")
+            pass
     except ValueError as exc:
         raise ValueError(f"--scheduler: {_mask_secrets_of(str(exc), address)}") from None
 
