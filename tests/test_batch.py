@@ -3202,6 +3202,11 @@ def test_camera_folders_pair_a_side_of_one_image_at_the_other_sides_number(
         ("bogus", "missing port number in address 'bogus'"),
         ("foo://a:1", "unknown address scheme 'foo'"),
         ("tcp://admin:s3cret@127.0.0.1:1", "invalid address 'admin:***@127.0.0.1:1'"),
+        # Dask named a piece of these its own way, the password in it
+        ("tcp://admin:s3cret@127.0.0.1", "invalid address 'admin:***@127.0.0.1': a sched"),
+        ("tls://admin:s3cret@host", "invalid address 'admin:***@host': a scheduler's"),
+        ("admin:s3cret@127.0.0.1:1", "invalid address 'admin:***@127.0.0.1:1': a sch"),
+        ("tcp://127.0.0.1:1?token=s3cret", "invalid address '127.0.0.1:1?token=***'"),
     ],
 )
 def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(

@@ -2183,7 +2183,7 @@ def _check_scheduler_address(address: str) -> None:
         from distributed.comm.registry import get_backend
     except ImportError:  # run_batch names the extra to install once it needs Dask
         return
-    from stereovision.capture import _mask_secrets_of
+    from stereovision.capture import _mask_secrets_of, mask_url_secrets
 
     try:
         scheme, location = parse_address(address)
@@ -2194,7 +2194,17 @@ def _check_scheduler_address(address: str) -> None:
             # (Dask's get_address_host_port refused them: "don't know how to extract...")
             pass
     except ValueError as exc:
-        raise ValueError(f"--scheduler: {_mask_secrets_of(str(exc), address)}") from None
+        reason = _mask_secrets_of(str(exc), address)
+        # Dask reads an address without a scheme as tcp://, and names a piece of it its own way
+        # ("invalid literal for int() with base 10: 's3cret@h'" for tcp://admin:s3cret@h), which
+        # the masking does not recognise: an address holding a secret is said masked, whole
+        url = address if "://" in address else f"tcp://{address}"
+        if mask_url_secrets(url) != url:
+            reason = (
+                f"invalid address {mask_url_secrets(url).split('://', 1)[-1]!r}: a scheduler's "
+                "address is [scheme://]host:port, with no user, password or query"
+            )
+        raise ValueError(f"--scheduler: {reason}") from None
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
