@@ -3558,3 +3558,39 @@ def test_a_folder_with_a_newline_is_shown_escaped_in_an_argparse_error(tmp_path:
     )
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "; d\\nx is a folder with no pair" in proc.stderr
+
+
+@pytest.mark.parametrize("command", ["depth", "batch", "rectify"])
+def test_output_folder_dot_slash_dash_is_a_folder(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    command: str,
+) -> None:
+    """``-o ./-`` names a folder "-" as a path; the check took Path("./-"), which is
+    Path("-"), for ``-o -`` and refused it (depth, rectify; batch's run its own way)."""
+    monkeypatch.chdir(tmp_path)
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    inputs = (
+        [str(scene)] if command == "batch" else [str(scene / n) for n in ("left.png", "right.png")]
+    )
+    options = {"depth": ["--method", "fast"], "batch": ["--method", "fast", "--workers", "1"]}
+    code = main([command, *inputs, "-o", "./-", *options.get(command, [])])
+    err = capsys.readouterr().err
+    assert "standard output" not in err
+    assert code == 0, err
+    made = tmp_path / "-" / ("tsukuba" if command == "batch" else "")
+    assert (made / ("left_rect.png" if command == "rectify" else "disparity.png")).is_file()
+
+
+def test_a_file_in_a_folder_named_dash_is_no_standard_output(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``check --plot=-/plot.png``'s folder is Path("-"), which the ``-o -`` check refused:
+    "--plot -/plot.png: its folder -: ... not a stream for standard output"."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "-").mkdir()
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    main(["check", str(scene / "left.png"), str(scene / "right.png"), "--plot=-/plot.png"])
+    assert (tmp_path / "-" / "plot.png").is_file()

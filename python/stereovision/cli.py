@@ -800,6 +800,9 @@ def cmd_depth(args: argparse.Namespace) -> int:
     counts: dict[str, int] = {}
     removed: list[Path] = []
     unfiltered: list[Any] = []
+    from stereovision.io import check_output_folder
+
+    check_output_folder(args.output, "-o")  # the text: depth_outputs is given a Path
     res, written = depth_outputs(
         left,
         right,
@@ -1198,8 +1201,9 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     from stereovision.io import check_output_folder
 
     # a file above it, or a folder that cannot be written, said before the pair is matched
-    # (as depth and demo say it), not once the homographies were fitted
-    check_output_folder(out, "-o")
+    # (as depth and demo say it), not once the homographies were fitted; the text: `-o ./-`
+    # names a folder where Path("./-") is Path("-")
+    check_output_folder(args.output, "-o")
     inputs = {"the left image": args.left, "the right image": args.right,
               "the calibration": args.calib}  # fmt: skip
     for name in RECTIFY_OUTPUTS:
@@ -1478,7 +1482,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
     # before the work: a file named as -o was said after the scene was matched and evaluated
     out_dir = Path(args.output)
-    check_output_folder(out_dir, "-o")
+    check_output_folder(args.output, "-o")  # the text: `-o ./-` names a folder
     names = planned_depth_outputs(calib=True)
     # A file under an output name that no earlier run listed (the user's, or a demo folder of a
     # version before the manifest: `make demo` after an update) is copied aside, not refused:

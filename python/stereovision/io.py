@@ -250,14 +250,15 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
     Raises
     ------
     ValueError
-        If ``folder`` is ``-`` (standard output, to many tools: a folder of files cannot go
-        there), or it or a folder above it is a file (or a FIFO: "not a folder") or a link to
-        nothing (or in a loop).
+        If ``folder`` is the text ``-`` (standard output, to many tools: a folder of files
+        cannot go there; ``./-`` or ``Path("-")`` is a folder), or it or a folder above it is
+        a file (or a FIFO: "not a folder") or a link to nothing (or in a loop).
     PermissionError
         If the nearest existing folder above it is not writable.
     """
-    if os.fspath(folder) == "-":
-        # `-o -` made a folder named "-" and said "-/disparity.png", where the user meant stdout
+    if isinstance(folder, str) and folder == "-":
+        # `-o -` made a folder named "-" and said "-/disparity.png", where the user meant stdout.
+        # The text as typed only: Path("./-") is Path("-"), and `-o ./-` names a folder
         raise ValueError(
             f"{flag} -: the outputs are files in a folder, not a stream for standard output: "
             "name a folder"
