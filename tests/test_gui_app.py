@@ -267,6 +267,48 @@ def test_a_program_calling_the_gui_gets_its_signal_handlers_back(signum: int) ->
     assert (code, out) == (0, f"{status} [True, True] -1 [2, 15]\n"), err
 
 
+_CALLER_OF_THE_GUI_TWICE = """
+import os, signal, threading
+import stereovision.gui as gui
+
+real = gui.url_for
+sent = []
+def url_for(*args):
+    if len(sent) < runs[0]:  # once a run: the address is said when the server listens
+        sent.append(1)
+        threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT)).start()
+    return real(*args)
+gui.url_for = url_for
+runs, statuses = [0], []
+for _ in range(2):
+    runs[0] += 1
+    statuses.append(gui.main(["--no-browser", "--port", "0"]))
+print(statuses, flush=True)
+"""
+
+
+def test_a_program_calling_the_gui_twice_runs_the_second_alone() -> None:
+    """trame's server is one per process and keeps its hooks: a second ``gui.main`` in the
+    same program ran the first's ready hook too, its address said twice and a Ctrl+C maybe
+    heard by the first's handler (the second then exits 0). Each run says its address once
+    and is stopped by its Ctrl+C: 130 twice."""
+    pytest.importorskip("trame")
+    done = subprocess.run(
+        [sys.executable, "-c", _CALLER_OF_THE_GUI_TWICE],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    lines = done.stdout.splitlines()
+    assert [line.startswith("stereovision gui on http://127.0.0.1:") for line in lines] == [
+        True,
+        True,
+        False,
+    ], done.stdout + done.stderr
+    assert lines[2] == "[130, 130]", done.stderr
+    assert done.stderr == "stereovision: interrupted\n" * 2
+
+
 _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS = _CALLER_OF_THE_GUI.replace(
     "status = gui.main(",
     "from stereovision.gui.app import StereoApp\n"
@@ -332,8 +374,13 @@ def test_add_cli_registers_gui():
 
 
 class _Ready(list):
+    """trame's function set, as cmd_gui uses it: its hook added, then discarded."""
+
     def add(self, fn: Any) -> None:
         self.append(fn)
+
+    def discard(self, fn: Any) -> None:
+        self.discarded = [*getattr(self, "discarded", []), fn]
 
 
 class _Source:

@@ -270,6 +270,10 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise err from exc
     finally:
         sys.argv = argv
+        # trame's server is one per process ("stereovision-gui"), its hooks kept: a program's
+        # second gui.main ran the first's too (its address said twice, a Ctrl+C maybe heard
+        # by the first's handler, its stop unseen: exit 0)
+        app.ctrl.on_server_ready.discard(ready)
         try:
             app.stop_work()  # the computation under way is not waited for (a Save is)
             if app.source is not None:
