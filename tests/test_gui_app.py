@@ -459,6 +459,31 @@ def test_cmd_gui_starts_the_server_as_asked_and_closes_the_cameras(monkeypatch, 
         assert err == note
 
 
+def test_the_public_host_note_is_not_said_of_a_loopback_host(monkeypatch, capsys):
+    """Any 127.0.0.0/8 address, ``::ffff:127.0.0.1`` and ``localhost.`` are this machine
+    alone: ``--host 127.0.0.2`` printed "anyone who can reach this address sees the cameras"
+    (only 127.0.0.1, localhost and ::1 were known). Another address or name still gets it."""
+    import stereovision.gui as gui
+
+    note = "note: listening on {}: anyone who can reach this address sees the cameras\n"
+    for host, public in (
+        ("127.0.0.2", False),
+        ("127.255.255.254", False),
+        ("::ffff:127.0.0.1", False),
+        ("localhost.", False),
+        ("LocalHost", False),
+        ("::1", False),
+        ("192.168.1.5", True),
+        ("::", True),
+        ("::ffff:10.0.0.1", True),
+        ("localhost.example.com", True),
+        ("127.0.0.1.example.com", True),
+    ):
+        monkeypatch.setattr(gui, "build_app", lambda _args: _App())
+        assert gui.cmd_gui(_gui_args("--no-browser", "--host", host)) == 0
+        assert capsys.readouterr().err == (note.format(host) if public else ""), host
+
+
 def test_cmd_gui_says_why_the_server_cannot_listen(monkeypatch, capsys):
     """A bind that fails: one message naming the port and host (errno kept), nothing announced,
     the cameras closed; a failure after the bind is raised as it came."""

@@ -30,7 +30,33 @@ __all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "add_cli", "build_app", "cmd_gui", "m
 #: Loopback only by default: exposing the robot's cameras is an explicit decision (--host).
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8080
-LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
+#: The names of this machine alone (its loopback); any other name may resolve to a public
+#: address. Compared case-insensitively, as a resolver does.
+LOOPBACK_NAMES = frozenset({"localhost", "localhost."})
+
+
+def is_loopback_host(host: str) -> bool:
+    """Whether listening on ``host`` keeps the page to this machine: a loopback address (any
+    of 127.0.0.0/8, ``::1``, ``::ffff:127.0.0.1``) or ``localhost`` (``localhost.``).
+
+    Examples
+    --------
+    >>> [is_loopback_host(h) for h in ("127.0.0.2", "::ffff:127.0.0.1", "localhost.")]
+    [True, True, True]
+    >>> [is_loopback_host(h) for h in ("0.0.0.0", "192.168.1.5", "localhost.example.com")]
+    [False, False, False]
+    """
+    import ipaddress
+
+    if host.lower() in LOOPBACK_NAMES:
+        return True
+    try:
+        addr = ipaddress.ip_address(host)
+    except ValueError:  # a name other than localhost: it may resolve anywhere
+        return False
+    # Python 3.11's is_loopback is False for an IPv4-mapped one (::ffff:127.0.0.1)
+    mapped = getattr(addr, "ipv4_mapped", None)
+    return addr.is_loopback or (mapped is not None and mapped.is_loopback)
 
 
 def bundled_data_dir() -> Path:
@@ -205,7 +231,8 @@ def cmd_gui(args: argparse.Namespace) -> int:
         bound.append(app.server.port)
         url = url_for(args.host, app.server.port)
         print(f"stereovision gui on {url} (Ctrl+C to stop)", flush=True)
-        if args.host not in LOOPBACK_HOSTS:
+        # 127.0.0.2 (all of 127/8 is loopback) and "localhost." got the note too
+        if not is_loopback_host(args.host):
             print(
                 f"note: listening on {args.host}: anyone who can reach this address sees the "
                 "cameras",
