@@ -3547,6 +3547,22 @@ def test_a_path_with_a_control_character_is_shown_escaped_on_one_line(
     assert proc.stderr == f"stereovision: error: image file not found: {shown}\n"
 
 
+def test_a_path_with_a_newline_is_shown_escaped_in_a_warning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The warning line cut its message at the first newline: ``check a\\nb.png c\\nd.png``
+    of one image twice warned ``stereovision: warning: a``, another file's name. The command
+    line's paths are shown escaped, as in an error line, and the line is whole."""
+    for name in ("a\nb.png", "c\nd.png"):
+        (tmp_path / name).write_bytes((CONES / "left.png").read_bytes())
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", "a\nb.png", "c\nd.png"]) == 0
+    assert capsys.readouterr().err == (
+        "stereovision: warning: a\\nb.png and c\\nd.png are the same image: every disparity "
+        "comes out 0 (two views of the scene are needed)\n"
+    )
+
+
 def test_a_folder_with_a_newline_is_shown_escaped_in_an_argparse_error(tmp_path: Path) -> None:
     (tmp_path / "d\nx").mkdir()
     proc = subprocess.run(

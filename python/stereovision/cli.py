@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import functools
 import json
 import math
 import os
@@ -2525,12 +2526,15 @@ def _one_line_warning(
     lineno: int,
     file: Any = None,
     line: str | None = None,
+    paths: Sequence[object] = (),
 ) -> None:
     """Warnings as one line, like the errors (not Python's file:line and source echo): the
     message's first line with text; one with none (``warnings.warn(SomeWarning())``) is named
-    by its category."""
+    by its category. The ``paths`` given on the command line (:func:`_given_texts`) are shown
+    escaped where they hold a control character, as in an error (:func:`first_line`)."""
     warning = message if isinstance(message, Warning) else category(message)
-    print(f"stereovision: warning: {advice_for(first_line(warning), 'cli')}", file=sys.stderr)
+    text = first_line(warning, paths)
+    print(f"stereovision: warning: {advice_for(text, 'cli')}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -2605,7 +2609,8 @@ def _main(argv: Sequence[str] | None) -> int:
         # collector, which warns "unclosed file": Python's own default hides that (a developer's
         # warning), and "default" above had made it a line after the interrupt's
         warnings.simplefilter("ignore", ResourceWarning)
-        warnings.showwarning = _one_line_warning
+        # a path with a newline cut the warning there, naming another file ("warning: a")
+        warnings.showwarning = functools.partial(_one_line_warning, paths=_given_texts(args))
         if threading.current_thread() is not threading.main_thread():
             return _run(args)
         kept = signal.signal(signal.SIGTERM, raise_terminated)
