@@ -1058,6 +1058,24 @@ def test_export_result_formats_as_one_string_is_named(result, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_export_result_formats_as_bytes_are_named(result, tmp_path):
+    """``formats=b"ply"`` was taken byte by byte: "unknown export format(s) [108, 112, 121]".
+    Bytes are refused as one string is, named, with the tuple to give when they spell a
+    format; nothing is written."""
+    for bad, hint in (
+        (b"ply", "give ('ply',)"),
+        (bytearray(b"npz"), "give ('npz',)"),
+        (b"xyz", "e.g. ('ply', 'npz')"),
+        (b"\xff", "e.g. ('ply', 'npz')"),
+    ):
+        with pytest.raises(TypeError) as info:
+            export.export_result(result, tmp_path / "out", bad)
+        assert str(info.value) == (
+            f"formats: expected a tuple of format names, got the bytes {bytes(bad)!r} ({hint})"
+        )
+    assert not (tmp_path / "out").exists()
+
+
 def test_export_result_formats_given_once_through_are_all_written(result, tmp_path):
     """Formats given as a generator (or any iterator) were used up by the check of their names,
     so nothing was written and ``{}`` returned, the folder made empty, without a word; they

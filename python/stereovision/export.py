@@ -1068,8 +1068,9 @@ def export_result(
     Raises
     ------
     TypeError
-        If ``formats`` is one string (``"ply"``), not a tuple of them, or no collection of
-        names at all (None). Any iterable of names is taken (a list, a generator).
+        If ``formats`` is one string (``"ply"``) or bytes (``b"ply"``), not a tuple of
+        names, or no collection of names at all (None). Any iterable of names is taken (a
+        list, a generator).
     ValueError
         Unknown format, or PLY / PCD / depth PNG asked for a result without calibration.
     IsADirectoryError
@@ -1088,6 +1089,13 @@ def export_result(
         raise TypeError(
             f"formats: expected a tuple of format names, got the string {formats!r} "
             f"(give ({formats!r},))"
+        )
+    if isinstance(formats, bytes | bytearray | memoryview):
+        # iterated, b"ply" is its byte values: "unknown export format(s) [108, 112, 121]"
+        name = bytes(formats).decode("ascii", "replace")
+        hint = f"give ({name!r},)" if name in EXPORT_FORMATS else "e.g. ('ply', 'npz')"
+        raise TypeError(
+            f"formats: expected a tuple of format names, got the bytes {bytes(formats)!r} ({hint})"
         )
     try:
         # once, as a tuple: a generator was used up by the check of its names below, and
