@@ -736,6 +736,28 @@ def test_a_frame_rate_asked_of_a_file_is_not_said(tmp_path: Path) -> None:
             assert cam.delivered_fps == {"left": 10.0, "right": 10.0}
 
 
+def test_a_frame_rate_asked_of_an_http_url_is_not_said(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An ``http(s)://`` URL may name a video file (a live stream ends only for the other
+    schemes, 20c7f0a): ``--fps 30`` of one warned "a rate this camera does not give". It is
+    read as it is, as a file; an ``rtsp://`` camera's other rate is still said."""
+    from stereovision import capture as capmod
+
+    class _UrlCap(_RateCap):  # a URL's capture reports its backend, as OpenCV's do
+        def getBackendName(self) -> str:
+            return "FFMPEG"
+
+    monkeypatch.setattr(capmod, "_open_path", lambda path, first: _UrlCap(path, (25.0,)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        StereoCamera("http://host/l.mp4", "HTTPS://host/r.mp4", fps=30).close()
+    with pytest.warns(UserWarning) as rec:
+        StereoCamera("https://host/l.mp4", "rtsp://cam/0", fps=30).close()
+    assert [str(w.message) for w in rec] == [
+        "right source 'rtsp://cam/0' reports 25 fps, not the 30 fps asked (a rate this camera "
+        "does not give at this size and format?)"
+    ]
+
+
 def test_fourcc_codes() -> None:
     assert parse_fourcc(None) is None and parse_fourcc("Y800") == "Y800"
     for bad in ("MJPEG", "YUV", "", "MJ\tG", 1196444237):

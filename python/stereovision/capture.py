@@ -1527,7 +1527,8 @@ class StereoCamera(PairSource):
     fps : float, optional
         Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
         :attr:`delivered_fps`. A camera or stream that reports another rate (more than 1 %
-        off; 0 is none reported) gets one :class:`UserWarning`; a file is read as it is.
+        off; 0 is none reported) gets one :class:`UserWarning`; a file, or an ``http(s)://``
+        URL (which may name one), is read as it is.
     fourcc : str, optional
         Pixel format asked of the sources before the size and rate (``CAP_PROP_FOURCC``; with
         V4L2 the format decides which sizes and rates a webcam offers): ``"YUYV"`` for
@@ -1719,8 +1720,11 @@ class StereoCamera(PairSource):
         rate = self.delivered_fps.get(side, 0.0)
         # a camera's or stream's (a file is read as it is): --fps 60 of a webcam that gives 30
         # at that size streamed at 30 without a word; 0 is no rate reported, nothing to compare
+        # An http(s) URL may name a video file (as _LIVE_SCHEMES has it): --fps 30 of
+        # http://host/clip.mp4 warned "a rate this camera does not give"
         live = not isinstance(src, (str, os.PathLike)) or (
-            "://" in os.fspath(src) or _camera_device(os.fspath(src)) is not None
+            ("://" in os.fspath(src) and not _http_url(os.fspath(src)))
+            or _camera_device(os.fspath(src)) is not None
         )
         if fps is not None and live and rate > 0 and abs(rate - fps) > 0.01 * fps:
             try:
@@ -2324,6 +2328,11 @@ def _live_stream(src: object) -> bool:
         return False
     m = re.match(r"\s*([A-Za-z][A-Za-z0-9+.-]*)://", src)
     return m is not None and m.group(1).lower() in _LIVE_SCHEMES
+
+
+def _http_url(src: object) -> bool:
+    """Whether ``src`` is an ``http://`` or ``https://`` URL, which may name a video file."""
+    return isinstance(src, str) and re.match(r"\s*https?://", src, re.IGNORECASE) is not None
 
 
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
