@@ -827,6 +827,24 @@ def test_depth_map_reports_the_census_checked_members(data_dir: Path) -> None:
     assert m.stats["members_before_census"] > len(m)
 
 
+def test_depth_map_reports_only_the_members_in_the_range(data_dir: Path) -> None:
+    """A member's sub-pixel average can leave the range searched (cones at 37 px: 84 members
+    up to 37.79 px); ``match(method="fused")`` drops them, and so does ``depth_map``'s report,
+    its rasters with them."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    r = sv_depth_map(sc.left, sc.right, method="fused", max_disparity=37, return_channels=True)
+    assert r.channels is not None
+    members = r.channels["members"]
+    m = sv_match(sc.left, sc.right, method="fused", max_disparity=37)
+    assert m.stats["n_out_of_range"] > 50
+    np.testing.assert_array_equal(members.matches.to_array(), m.to_array())
+    np.testing.assert_array_equal(members.count, m.stats["count"])
+    np.testing.assert_array_equal(members.sources, m.stats["sources"])
+    assert np.nanmax(members.dispx) <= 37
+    assert np.count_nonzero(np.isfinite(members.dispx)) == len(m)
+    assert np.count_nonzero(members.count_map) == len(m)
+
+
 def test_no_depth_within_its_sigma_on_playground(data_dir: Path) -> None:
     """ETH3D playground's sky and far gaps, matched at 0-1 px: such a depth's one-sigma interval
     reaches infinity, so the fused depth_map reports no depth there (the disparity stays)."""

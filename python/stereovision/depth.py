@@ -540,7 +540,7 @@ class DepthChannels(ChannelOutputs, total=False):
         The graph-matching and Hopfield channels' matches (``"fused"``).
     members : FusionResult
         The valid members with their ``count`` and ``sources``, checked against the census map
-        as ``match(method="fused")`` gives them (``"fused"``).
+        and within the range searched, as ``match(method="fused")`` gives them (``"fused"``).
     sgm : numpy.ndarray
         ``(H, W)`` float32: the census semi-global disparity map (``"fused"``, ``"census"``,
         ``"fast"``; NaN = none).
@@ -1138,6 +1138,12 @@ def _run_matcher(
             # the checked ones, as ``match(method="fused")`` gives them.
             sgm = fr.channel_outputs.get("sgm")
             members = fusion.census_clear(fr, sgm) if sgm is not None else fr
+            # and, as match() keeps them, in the range searched: a member's sub-pixel average
+            # can leave it (cones at max_disparity=37: 84 members up to 37.79 px)
+            d = members.matches.xl - members.matches.xr
+            inside = (d >= d_min) & (d <= d_max)
+            if not inside.all():
+                members = fusion._members_where(members, inside)
             channels.update({**fr.channel_outputs, "members": members})
         return disp, conf, only_second
     if method in ("census", "fast"):
