@@ -840,6 +840,7 @@ def test_depth_map_reports_only_the_members_in_the_range(data_dir: Path) -> None
     np.testing.assert_array_equal(members.matches.to_array(), m.to_array())
     np.testing.assert_array_equal(members.count, m.stats["count"])
     np.testing.assert_array_equal(members.sources, m.stats["sources"])
+    assert m.stats["members"] == members.matches.stats["members"] == len(m)
     assert np.nanmax(members.dispx) <= 37
     assert np.count_nonzero(np.isfinite(members.dispx)) == len(m)
     assert np.count_nonzero(members.count_map) == len(m)

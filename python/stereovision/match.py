@@ -156,7 +156,9 @@ def match(
         m = _keep(res.matches, keep)
         # per member, as the matches: a member dropped out of range takes its entries along
         # (they were left whole, longer than the matches)
-        m.stats.update(count=res.count[keep], sources=res.sources[keep])
+        # (and its count: "members" still said those before the range, 5509 for 5425 on cones
+        # at 37 px)
+        m.stats.update(count=res.count[keep], sources=res.sources[keep], members=len(m))
         return m
     elif method == "gabor":
         m = _gabor_matches(gl, gr, max_disparity, params)
