@@ -540,7 +540,10 @@ class DepthChannels(ChannelOutputs, total=False):
         The graph-matching and Hopfield channels' matches (``"fused"``).
     members : FusionResult
         The valid members with their ``count`` and ``sources``, checked against the census map
-        and within the range searched, as ``match(method="fused")`` gives them (``"fused"``).
+        and within the range searched, as ``match(method="fused")`` gives them (``"fused"``;
+        with ``semi_global=False`` there is no census map to check them against, as
+        ``match(..., census_members=False)``, and with ``refine=False`` they are voted on the
+        Gabor map as measured, as ``match(..., remeasure_gabor=False)``).
     sgm : numpy.ndarray
         ``(H, W)`` float32: the census semi-global disparity map (``"fused"``, ``"census"``,
         ``"fast"``; NaN = none).
