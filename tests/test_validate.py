@@ -3,6 +3,7 @@ ValueError and never another exception type)."""
 
 from __future__ import annotations
 
+import os
 import re
 from decimal import Decimal
 from fractions import Fraction
@@ -1264,3 +1265,42 @@ def test_mutation_audit_refuse_not_numbers_names_the_first_and_spares_switches()
         refuse_not_numbers({"flag": True, "A": True, "k_cand": np.timedelta64(3)}, defaults)
     assert str(exc.value) == "A: expected a number, got True"
     refuse_not_numbers({"flag": True, "A": 2.0, "k_cand": 3}, defaults)
+
+
+@pytest.mark.skipif(os.sep != "/", reason="a backslash is a path separator on this system")
+def test_first_line_doubles_the_backslashes_of_a_path_it_escapes() -> None:
+    """A name holding a backslash and a control character (``x\\ny<TAB>z.png``, a literal
+    backslash-n) was split at the backslash, so its backslash was not doubled and it read as
+    ``x``, newline, ``y``: the escape was ambiguous. A path with no control character (a
+    Windows-style name) is shown as it is."""
+    from stereovision._validate import first_line
+
+    name = "scans/x\\ny\tz.png"
+    assert first_line(ValueError(f"image file not found: {name}"), [name]) == (
+        "image file not found: scans/x\\\\ny\\tz.png"
+    )
+    win = "C:\\new\\test.png"
+    assert first_line(ValueError(f"{win} not found\nmore"), [win]) == f"{win} not found"
+
+
+def test_first_line_keeps_the_message_own_line_breaks_beside_an_escaped_path() -> None:
+    """A path part ending (or starting) with a control character, ``a\\n`` of a pasted
+    ``scans/a\\n``, was replaced wherever its text was: ``data\\nhint`` holds ``a\\n``, so the
+    message's own line break was escaped and its second line shown on the first."""
+    from stereovision._validate import first_line
+
+    assert first_line(ValueError("cannot read data\nhint: give another"), ["scans/a\n"]) == (
+        "cannot read data"
+    )
+    assert first_line(ValueError("cannot read x\n\nmore"), ["d/\n/e.png"]) == "cannot read x"
+    assert first_line(ValueError("no\tway\nmore"), ["\tway"]) == "no\\tway"
+    # where the path is, it is still escaped
+    assert first_line(ValueError("not found: scans/a\n\nhint"), ["scans/a\n"]) == (
+        "not found: scans/a\\n"
+    )
+    assert first_line(ValueError("not found: d/\n/e.png"), ["d/\n/e.png"]) == (
+        "not found: d/\\n/e.png"
+    )
+    assert first_line(ValueError("not found: /abs/a\nb_depth.png"), ["a\nb"]) == (
+        "not found: /abs/a\\nb_depth.png"
+    )

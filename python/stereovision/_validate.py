@@ -1250,16 +1250,34 @@ def escape_paths(message: str, paths: Iterable[object] = ()) -> str:
     >>> print(escape_paths("image file not found: scans/a\\nb.png", ["a\\nb.png"]))
     image file not found: scans/a\\nb.png
     """
+    # by the system's separators alone: a POSIX name's backslash is its own, to be doubled
+    seps = "".join(re.escape(s) for s in (os.sep, os.altsep) if s)
     parts: set[str] = set()
     for p in paths:
         if isinstance(p, str | os.PathLike):
             text = os.fspath(p)
             if isinstance(text, str) and _CONTROL.search(text):
                 # by its parts: the message may name it absolute, or a file under it
-                parts |= {x for x in re.split(r"[/\\]", text) if _CONTROL.search(x)}
+                parts |= {x for x in re.split(f"[{seps}]", text) if _CONTROL.search(x)}
+    if not parts:
+        return message
+    # A part that opens (ends) with a control character matches only after (before) what
+    # bounds a name: "a\n" of "scans/a\n" is also in "data\nhint", the message's own break.
+    alternatives = []
     for part in sorted(parts, key=len, reverse=True):
-        message = message.replace(part, escaped(part))
-    return message
+        pattern = re.escape(part)
+        if _CONTROL.match(part):
+            pattern = _NAME_BEFORE + pattern
+        if _CONTROL.match(part[-1]):
+            pattern += _NAME_AFTER
+        alternatives.append(pattern)
+    return re.sub("|".join(alternatives), lambda m: escaped(m.group()), message)
+
+
+#: What may stand before (after) a name in a message: its start (end), a separator, a space,
+#: a quote or a bracket, punctuation after it.
+_NAME_BEFORE = r"""(?<![^ /\\'"`(\[{<:=,])"""
+_NAME_AFTER = r"""(?![^\s/\\'"`)\]}>:;,.!?\x00-\x1f\x7f-\x9f\u2028\u2029])"""
 
 
 #: RuntimeError's subclasses that are a bug of ours, never a failure to say as it is: a
