@@ -3116,6 +3116,31 @@ def test_save_all_or_nothing_says_a_failure_in_one_line_with_the_folders_path(tm
     assert list(written) == ["disparity.png", "depth.png", "overview.png"]  # SAVE_WRITE_ORDER's
 
 
+@pytest.mark.parametrize(
+    ("name", "shown"), [("my\tsaved", "my\\tsaved"), ("my\nsaved", "my\\nsaved")]
+)
+def test_save_all_or_nothing_names_a_folder_with_a_control_character_not_its_staging_one(
+    tmp_path, name, shown
+):
+    """The failure is said with the folder's path, escaped on the one line: first_line
+    (e005247) escaped the tab in the message before the staging path in it was replaced by the
+    folder's, so the replace missed and the hidden ``.stereovision-partial-...`` folder was
+    named; a newline cut the line at the folder's name."""
+    pytest.importorskip("trame")
+    from stereovision.gui.app import SaveFailed, save_all_or_nothing
+
+    folder = tmp_path / name
+
+    def failing(into: Path) -> None:
+        raise OSError(f"cannot write {into / 'depth.png'}\nsecond line of the reason")
+
+    with pytest.raises(SaveFailed) as info:
+        save_all_or_nothing(failing, folder)
+    assert str(info.value) == (
+        f"disparity.png could not be written (cannot write {tmp_path}/{shown}/depth.png)"
+    )
+
+
 def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     tmp_path, monkeypatch
 ):

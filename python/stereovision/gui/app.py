@@ -403,7 +403,10 @@ def save_all_or_nothing(
             # of the files this Save writes: a pair without depth that failed at disparity.pfm
             # said "depth.png could not be written", a file it never writes
             failed = next((n for n in files if n not in done), "a file")
-            why = first_line(exc).replace(str(inner), str(folder))  # its path as it would be
+            # its path as it would be, replaced before first_line escapes a tab in it (the
+            # staging path was named then) and shown escaped (a newline cut the line there)
+            said = str(exc).replace(str(inner), str(folder))
+            why = first_line(ValueError(said), [folder]) if said.strip() else first_line(exc)
             raise SaveFailed(f"{failed} could not be written ({why})") from exc
         names = [n for n in SAVE_WRITE_ORDER if (inner / n).is_file()]
         moved = False
