@@ -3423,6 +3423,8 @@ def test_a_bad_fourcc_is_refused_in_the_options_name(
         "[[::1]]",
         "[::1]:8080",
         "[localhost]",
+        "[fe80::1%]]",
+        "[fe80::1%[lo]",
     ],
 )
 @pytest.mark.parametrize("command", ["stream", "gui"])
@@ -3436,7 +3438,8 @@ def test_an_empty_host_is_refused_in_the_options_name(
     (``127.0.0.1\\n`` read from a file): it reached the bind, after the cameras opened, and
     the error was cut at its newline ('cannot serve the view on 127.0.0.1'). So is a bracket
     around no IPv6 address ('[::1', '[]', '[127.0.0.1]', '[::1]:8080'): no name holds one,
-    and each was bound after the cameras opened ('Name or service not known')."""
+    and each was bound after the cameras opened ('Name or service not known'); nor does an
+    IPv6 address's scope (ipaddress took '[fe80::1%]]' as fe80::1 scoped ']')."""
     with pytest.raises(SystemExit) as exit_:
         main([command, "--left", "0", "--right", "1", "--host", host])
     assert exit_.value.code == 2

@@ -2153,6 +2153,8 @@ def check_listen_address(host: str, name: str = "--host") -> str:
         inner = host[1:-1] if host.startswith("[") and host.endswith("]") else ""
         try:
             ipaddress.IPv6Address(inner)  # a scope too: fe80::1%eth0
+            if "[" in inner or "]" in inner:  # ipaddress takes any scope: "fe80::1%]"
+                raise ValueError(inner)
         except ValueError:
             raise ValueError(f"{name}: {_listen_address_words(host)}") from None
         return inner
