@@ -309,6 +309,58 @@ def test_a_program_calling_the_gui_twice_runs_the_second_alone() -> None:
     assert done.stderr == "stereovision: interrupted\n" * 2
 
 
+_CALLER_OF_THE_GUI_TWICE_WATCHING_ITS_APPS = (
+    _CALLER_OF_THE_GUI_TWICE.replace(
+        "runs, statuses = [0], []",
+        "from stereovision.gui.app import StereoApp\n"
+        "apps, heard = [], []\n"
+        "init, on_ready = StereoApp.__init__, StereoApp._on_ready\n"
+        "on_method = StereoApp._on_method\n"
+        "def __init__(self, *a, **k):\n"
+        "    apps.append(self)\n"
+        "    init(self, *a, **k)\n"
+        "def _on_ready(self, **k):\n"
+        "    heard.append(('ready', apps.index(self)))\n"
+        "    return on_ready(self, **k)\n"
+        "def _on_method(self, **k):\n"
+        "    if probing:\n"
+        "        heard.append(('method', apps.index(self)))\n"
+        "        return None\n"
+        "    return on_method(self, **k)\n"
+        "StereoApp.__init__, StereoApp._on_ready, StereoApp._on_method = (\n"
+        "    __init__, _on_ready, _on_method)\n"
+        "probing = False\n"
+        "runs, statuses = [0], []",
+    )
+    .replace(
+        '    statuses.append(gui.main(["--no-browser", "--port", "0"]))\n',
+        '    statuses.append(gui.main(["--no-browser", "--port", "0"]))\n'
+        "    probing = True  # a change once the run is over: its app no longer hears it\n"
+        "    apps[-1].state.method = 'sgm' if apps[-1].state.method != 'sgm' else 'mcgm'\n"
+        "    apps[-1].state.flush()\n"
+        "    probing = False\n",
+    )
+    .replace("print(statuses, flush=True)", "print(statuses, heard, flush=True)")
+)
+
+
+def test_a_second_gui_in_one_program_is_served_by_its_own_app_alone() -> None:
+    """93b9cff took cmd_gui's own hook off trame's one server, but the first app's were kept
+    there: its ready hook ran again in the second run (it loaded and matched the demo scene
+    into the page the second app shows; with cameras, it read from the closed ones), and its
+    handlers heard the page's changes after its run (a method chosen: it recomputed). Each
+    app's hooks are taken off when its run ends."""
+    pytest.importorskip("trame")
+    done = subprocess.run(
+        [sys.executable, "-c", _CALLER_OF_THE_GUI_TWICE_WATCHING_ITS_APPS],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    last = done.stdout.splitlines()[-1]
+    assert last == "[130, 130] [('ready', 0), ('ready', 1)]", done.stderr
+
+
 _CALLER_OF_A_GUI_WHOSE_CLOSE_FAILS = _CALLER_OF_THE_GUI.replace(
     "status = gui.main(",
     "from stereovision.gui.app import StereoApp\n"
@@ -415,6 +467,9 @@ class _App:
 
     def stop_work(self) -> None:
         self.stopped += 1
+
+    def detach(self) -> None:
+        self.detached = getattr(self, "detached", 0) + 1
 
 
 def _gui_args(*argv: str) -> argparse.Namespace:

@@ -301,6 +301,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         # second gui.main ran the first's too (its address said twice, a Ctrl+C maybe heard
         # by the first's handler, its stop unseen: exit 0)
         app.ctrl.on_server_ready.discard(ready)
+        app.detach()  # the app's own hooks too: its ready hook, its state handlers
         try:
             app.stop_work()  # the computation under way is not waited for (a Save is)
             if app.source is not None:

@@ -2949,6 +2949,17 @@ class StereoApp:
                 raise SaveFailed("the server is stopping: nothing was written")
             return save_all_or_nothing(write, folder, files)
 
+    def detach(self) -> None:
+        """Take this app's hooks off its server, which trame keeps one per process
+        (``get_server("stereovision-gui")``): a program's second ``gui.main`` ran this app's
+        ready hook again (the demo scene matched into the page the new app shows; with
+        cameras, a read of the closed ones) and its handlers heard the new page's changes."""
+        self.ctrl.on_server_ready.discard(self._on_ready)
+        # trame has no call that removes a change handler: they are kept in this dict
+        callbacks = getattr(self.state, "_change_callbacks", None) or {}
+        for handlers in callbacks.values():
+            handlers[:] = [h for h in handlers if getattr(h[0], "__self__", None) is not self]
+
     def stop_work(self) -> None:
         """The server has stopped: the computations and checks queued are dropped, and the one
         running is left to the process's end (``gui.main`` ends the process past it,
