@@ -142,7 +142,8 @@ def _signal_the_serving_gui(argv: list[str], signum: int) -> tuple[int, str, str
     return proc.returncode, out, err
 
 
-@pytest.mark.parametrize(
+#: Each entry point with each stop signal: its exit status and the one line it says.
+_EACH_ENTRY_AND_SIGNAL = pytest.mark.parametrize(
     ("entry", "signum", "status", "said"),
     [
         ("stereovision", signal.SIGINT, 130, "interrupted"),
@@ -151,6 +152,9 @@ def _signal_the_serving_gui(argv: list[str], signum: int) -> tuple[int, str, str
         ("stereovision.gui", signal.SIGTERM, 143, "terminated (SIGTERM)"),
     ],
 )
+
+
+@_EACH_ENTRY_AND_SIGNAL
 def test_gui_stopped_by_ctrl_c_exits_130_as_the_cli(
     entry: str, signum: int, status: int, said: str
 ) -> None:
@@ -177,15 +181,7 @@ sys.exit(main([{argv}"--no-browser", "--port", "0"]))
 """
 
 
-@pytest.mark.parametrize(
-    ("entry", "signum", "status", "said"),
-    [
-        ("stereovision", signal.SIGINT, 130, "interrupted"),
-        ("stereovision", signal.SIGTERM, 143, "terminated (SIGTERM)"),
-        ("stereovision.gui", signal.SIGINT, 130, "interrupted"),
-        ("stereovision.gui", signal.SIGTERM, 143, "terminated (SIGTERM)"),
-    ],
-)
+@_EACH_ENTRY_AND_SIGNAL
 def test_a_signal_while_the_server_is_set_up_is_not_exit_0(
     entry: str, signum: int, status: int, said: str
 ) -> None:
