@@ -24,8 +24,10 @@ from stereovision._validate import (
     as_gray_float,
     as_gray_uint8,
     check_pair,
+    finite_number,
     int_in_range,
     positive_finite,
+    positive_whole,
 )
 
 SIDES = {"min_side": 1, "max_side": 6}
@@ -1304,3 +1306,34 @@ def test_first_line_keeps_the_message_own_line_breaks_beside_an_escaped_path() -
     assert first_line(ValueError("not found: /abs/a\nb_depth.png"), ["a\nb"]) == (
         "not found: /abs/a\\nb_depth.png"
     )
+
+
+@pytest.mark.parametrize(
+    ("value", "shown"),
+    [
+        (np.arange(16.0).reshape(4, 4), "array of shape (4, 4) dtype float64"),
+        (np.zeros((2, 2), np.uint8), "array of shape (2, 2) dtype uint8"),
+        ("7" * 500, "'777777777777...7777777777777'"),
+        ([1.0] * 50, "[1.0, 1.0, 1.0, 1.0, 1.0, 1.0, ...]"),
+    ],
+)
+def test_a_number_check_shows_an_array_or_a_long_value_in_one_short_line(
+    value: object, shown: str
+) -> None:
+    # the repr of a (4, 4) array is 4 lines: the message was cut by the CLI's first line, and
+    # a camera frame given as a count filled the screen
+    for check, words in [
+        (lambda v: finite_number(v, "blur"), "blur: expected a finite number, got "),
+        (lambda v: int_in_range(v, "blur", 0, 9), "blur: expected an integer from 0 to 9, got "),
+        (lambda v: positive_whole(v, "blur"), "blur: expected a positive integer, got "),
+    ]:
+        with pytest.raises(ValueError) as err:
+            check(value)
+        assert str(err.value) == words + shown
+    with pytest.raises(ValueError) as err:
+        positive_finite(value, "blur")
+    kind = "" if isinstance(value, np.ndarray) else type(value).__name__ + " "
+    assert str(err.value) == "blur: expected a positive finite number, got " + kind + shown
+    # a short value is shown as it is, on one line
+    with pytest.raises(ValueError, match=r"got array\(\[1, 2\]\)$"):
+        finite_number(np.array([1, 2]), "blur")

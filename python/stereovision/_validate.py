@@ -891,7 +891,12 @@ def positive_finite(value: object, name: str) -> float:
         out = _real_scalar(value)
     except TypeError:
         raise ValueError(
-            f"{name}: expected a positive finite number, got {type(value).__name__} {value!r}"
+            f"{name}: expected a positive finite number, got "
+            + (
+                _shown(value)
+                if isinstance(value, np.ndarray)
+                else f"{type(value).__name__} {_shown(value)}"
+            )
         ) from None
     if not math.isfinite(out) or out <= 0.0:
         raise ValueError(f"{name}: expected a positive finite number, got {out!r}")
@@ -966,17 +971,30 @@ def float_sized(value: _T, name: str) -> _T:
     return value
 
 
+#: The longest repr :func:`_shown` gives as it is: a message is one short line.
+_SHOWN_MAX = 80
+
+
 def _shown(value: object) -> str:
     """``repr(value)``, or for an int beyond a float its size (10**5000 has no repr), in
     :func:`too_large_for_float`'s words (one wording for every message); another value with
-    such an int inside (``Fraction(10**5000)``, a count to :func:`whole_value`) by its type."""
+    such an int inside (``Fraction(10**5000)``, a count to :func:`whole_value`) by its type.
+
+    A repr of several lines or over :data:`_SHOWN_MAX` characters is shortened to one line: an
+    array by its shape and dtype (a ``(4, 4)`` array as a count was its 4 lines of values, a
+    camera frame's hundreds), anything else as :mod:`reprlib` cuts it (a 500-character str)."""
     big = too_large_for_float(value, why=False)
     if big:
         return big
     try:
-        return repr(value)
+        text = repr(value)
     except ValueError:  # Python's limit of an int's str: its message named no parameter
         return f"a {type(value).__name__} of over 4300 digits"
+    if "\n" not in text and len(text) <= _SHOWN_MAX:
+        return text
+    if isinstance(value, np.ndarray):
+        return f"array of shape {value.shape} dtype {value.dtype}"  # as io says one
+    return " ".join(reprlib.repr(value).split())
 
 
 def too_large_for_float(value: object, *, why: bool = True) -> str | None:
