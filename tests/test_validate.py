@@ -1337,3 +1337,25 @@ def test_a_number_check_shows_an_array_or_a_long_value_in_one_short_line(
     # a short value is shown as it is, on one line
     with pytest.raises(ValueError, match=r"got array\(\[1, 2\]\)$"):
         finite_number(np.array([1, 2]), "blur")
+
+
+def test_an_encoded_files_bytes_are_no_path_and_are_said_in_one_short_line() -> None:
+    # a PNG's bytes (requests.get(url).content) were "got the path '\udc89PNG\r\n...'": every
+    # byte escaped, a message of 3.5 times the file's size; a NUL is in no file name
+    from stereovision._validate import path_given, require
+
+    png = cv2.imencode(".png", np.zeros((40, 60), np.uint8))[1].tobytes()
+    assert path_given(png) is None and path_given(np.bytes_(png)) is None
+    assert path_given("a\x00b.png") is None and path_given(b"left.png") == "left.png"
+    with pytest.raises(ValueError) as err:
+        as_gray_float(png, "left")
+    assert str(err.value) == (
+        f"left: got {len(png)} bytes, not an image: decode an encoded file first "
+        "(cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED))"
+    )
+    with pytest.raises(TypeError) as terr:
+        require(png, "Calibration", "calib")
+    assert str(terr.value) == "calib: expected a stereovision.Calibration, got bytes"
+    # a file name is said as before
+    with pytest.raises(ValueError, match=r"^left: got the path 'left\.png', not an image"):
+        as_gray_float(b"left.png", "left")

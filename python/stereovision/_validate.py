@@ -81,13 +81,17 @@ def path_given(obj: object) -> str | None:
     Returns
     -------
     str or None
-        The path (``np.str_('left.png')`` said as ``'left.png'``), or None.
+        The path (``np.str_('left.png')`` said as ``'left.png'``), or None; None too for text
+        holding a NUL, which no file name holds: an encoded file's bytes (``requests.get(url)
+        .content``, ``open(f, 'rb').read()``) were "got the path" with all their bytes, a
+        message of a megabyte.
     """
     if isinstance(obj, np.ndarray) and obj.ndim == 0 and obj.dtype.kind in "US":
         obj = obj.item()
     if isinstance(obj, (str, bytes, os.PathLike)):
         path = os.fspath(obj)
-        return os.fsdecode(path) if isinstance(path, bytes) else str(path)
+        text = os.fsdecode(path) if isinstance(path, bytes) else str(path)
+        return None if "\x00" in text else text
     return None
 
 
@@ -177,6 +181,11 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
         raise ValueError(
             f"{name}: got the path {path!r}, not an image: read it first "
             "(cv2.imread(path) or stereovision.io.imread(path))"
+        )
+    if isinstance(img, bytes):  # no path (path_given): most often an encoded file's bytes
+        raise ValueError(
+            f"{name}: got {len(img)} bytes, not an image: decode an encoded file first "
+            "(cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED))"
         )
     try:
         arr = np.asarray(img)
