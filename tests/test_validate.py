@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
@@ -1359,3 +1360,19 @@ def test_an_encoded_files_bytes_are_no_path_and_are_said_in_one_short_line() -> 
     # a file name is said as before
     with pytest.raises(ValueError, match=r"^left: got the path 'left\.png', not an image"):
         as_gray_float(b"left.png", "left")
+
+
+def test_the_low_uint16_warning_reads_the_colours_of_a_bgra_image_not_its_alpha() -> None:
+    # an opaque 16-bit alpha is 65535: 12-bit colours beside it were scaled to 1/16 of the
+    # range (grey 0.0625 at most) without the warning their BGR image gets
+    img = np.full((4, 5, 4), 4095, np.uint16)
+    img[:, :, 3] = 65535
+    for convert in (as_gray_float, as_bgr_uint8, as_gray_uint8):
+        with pytest.warns(UserWarning, match=r"^left: uint16 image whose largest value is 4095 "):
+            convert(img, "left")
+    img[:, :, 0] = 4096  # a colour at 4096 or above: no 12-bit data, no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert float(as_gray_float(img, "left").max()) == pytest.approx(
+            (0.114 * 4096 + 0.886 * 4095) / 65535, rel=1e-6
+        )

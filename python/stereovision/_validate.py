@@ -326,10 +326,12 @@ def _warn_low_uint16(arr: np.ndarray, name: str, effect: str | None = None) -> N
     8 bits), so its 8-bit copy (colours, the fill's colour segments) has 0-16 grey levels of a
     12-bit camera's image; the matchers read all its bits, the automatic range stretches it.
     ``effect``, with its leading separator, says what the scaling does to another reader
-    (refine's contrast floor) instead."""
+    (refine's contrast floor) instead. Alpha is no grey level: a BGRA image's is left out (an
+    opaque one is 65535, which hid 12-bit colours, scaled as dark as any other's)."""
     import warnings
 
-    top = int(arr.max())
+    colour = arr[:, :, :3] if arr.ndim == 3 and arr.shape[2] == 4 else arr
+    top = int(colour.max())
     if top < LOW_UINT16_MAX:
         if effect is None:
             effect = (
