@@ -1376,3 +1376,43 @@ def test_the_low_uint16_warning_reads_the_colours_of_a_bgra_image_not_its_alpha(
         assert float(as_gray_float(img, "left").max()) == pytest.approx(
             (0.114 * 4096 + 0.886 * 4095) / 65535, rel=1e-6
         )
+
+
+@pytest.mark.parametrize(
+    ("points", "says"),
+    [
+        ([["1", "2"]], r"^points: expected \(x, y\) pixels as numbers, got dtype <U1$"),
+        ([[None, 1]], r"^points: expected \(x, y\) pixels as numbers, got dtype object$"),
+        ([[True, False]], r"^points: expected \(x, y\) pixels as numbers, got dtype bool$"),
+        (
+            [[np.timedelta64(3), 1]],
+            r"^points: expected \(x, y\) pixels as numbers, got dtype timedelta64$",
+        ),
+        ([[1 + 2j, 3]], r"^points: expected \(x, y\) pixels as numbers, got dtype complex128$"),
+        ([[1, 2], [3]], r"^points: expected an \(N, 2\) array of \(x, y\), got list that NumPy"),
+    ],
+)
+def test_xy_points_refuses_what_holds_no_numbers_naming_the_points(
+    points: object, says: str
+) -> None:
+    # the float64 cast read '1' as 1, None as NaN, True as 1 and 3 ns as 3; a complex or a
+    # ragged list was NumPy's TypeError or ValueError, naming no argument
+    from stereovision._validate import xy_points
+
+    with pytest.raises(ValueError, match=says):
+        xy_points(points)
+
+
+def test_xy_points_reads_every_real_number_as_before() -> None:
+    from stereovision._validate import xy_points
+
+    want = [[1.5, 2.0], [3.0, 4.0]]
+    for points in (
+        want,
+        np.array(want, np.float32),
+        [[Fraction(3, 2), 2], [3, np.int8(4)]],
+        [[Decimal("1.5"), 2], [3, 4]],
+        np.array([[1.5, 2], [3, 4]], dtype=object),
+    ):
+        got = xy_points(points)
+        assert got.dtype == np.float64 and got.tolist() == want

@@ -1439,7 +1439,9 @@ def xy_points(points: object, name: str = "points") -> npt.NDArray[np.float64]:
 
     A ``(2, N)`` array (Bouguet's layout) or homogeneous ``(N, 3)`` points are a ``ValueError``
     naming the shape (and the transpose for the first), not points reshaped and mapped as
-    others.
+    others; so is what holds no real numbers (:data:`NOT_NUMBERS`, text, None, complex) or
+    what NumPy cannot read as an array (a ragged list): the float64 cast read ``'1'`` as 1,
+    None as NaN, True as 1 and 3 ns as 3, and said the rest in NumPy's words naming nothing.
 
     Examples
     --------
@@ -1450,7 +1452,23 @@ def xy_points(points: object, name: str = "points") -> npt.NDArray[np.float64]:
     ...
     ValueError: points: expected shape (N, 2) of (x, y), got (2, 5) (transpose a (2, N) array)
     """
-    pts = np.asarray(points, np.float64)
+    try:
+        raw = np.asarray(points)
+    except (ValueError, TypeError):  # ragged nested lists
+        raise ValueError(
+            f"{name}: expected an (N, 2) array of (x, y), got {type(points).__name__} that "
+            "NumPy cannot read as an array"
+        ) from None
+    real = raw.dtype.kind in "iuf" or (
+        raw.dtype == object
+        and all(
+            isinstance(v, (numbers.Real, decimal.Decimal)) and not isinstance(v, NOT_NUMBERS)
+            for v in raw.flat
+        )
+    )
+    if not real:
+        raise ValueError(f"{name}: expected (x, y) pixels as numbers, got dtype {raw.dtype}")
+    pts = raw.astype(np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
         hint = (
             " (transpose a (2, N) array)"
