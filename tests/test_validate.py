@@ -1416,3 +1416,16 @@ def test_xy_points_reads_every_real_number_as_before() -> None:
     ):
         got = xy_points(points)
         assert got.dtype == np.float64 and got.tolist() == want
+
+
+@pytest.mark.parametrize(
+    "exc", [KeyError(10**5000), ValueError(10**5000), RuntimeError(-(10**4400))]
+)
+def test_an_error_whose_message_has_no_str_is_said_by_its_type(exc: BaseException) -> None:
+    # str() of an error holding an int of over 4300 digits raises ValueError itself: the one
+    # line the CLI prints of any error (first_line, internal_error) was a traceback instead
+    from stereovision._validate import first_line, internal_error
+
+    name = type(exc).__name__
+    assert first_line(exc) == name
+    assert internal_error(exc) == f"stereovision: error: internal {name} (please report this)"

@@ -1213,10 +1213,20 @@ def first_line(exc: BaseException, paths: Iterable[object] = ()) -> str:
     'the pair differs in size'
     """
     # the first line with text: a message opening with a line break said nothing
-    text = [line for line in escape_paths(str(exc), paths).splitlines() if line.strip()]
+    text = [line for line in escape_paths(_message(exc), paths).splitlines() if line.strip()]
     # a control character left (a tab, an ESC sequence in a file name found in a folder) would
     # be obeyed by the terminal: shown escaped
     return _CONTROL.sub(_escape_one, text[0]) if text else type(exc).__name__
+
+
+def _message(exc: BaseException) -> str:
+    """``str(exc)``, or "" for an error that cannot say its message: the str of one holding an
+    int of over 4300 digits (``KeyError(10**5000)``) is itself a ValueError, which the CLI's
+    last handler then let out as a traceback."""
+    try:
+        return str(exc)
+    except Exception:
+        return ""
 
 
 #: The characters a one-line message does not show as they are: C0 and C1 controls (a
@@ -1336,7 +1346,7 @@ def internal_error(exc: BaseException) -> str:
     "stereovision: error: internal KeyError: 'k' (please report this)"
     """
     # without a message (a bare assert) the type alone: "AssertionError:  (" said nothing twice
-    what = type(exc).__name__ + (f": {first_line(exc)}" if str(exc).strip() else "")
+    what = type(exc).__name__ + (f": {first_line(exc)}" if _message(exc).strip() else "")
     return f"stereovision: error: internal {what} (please report this)"
 
 
