@@ -1429,3 +1429,20 @@ def test_an_error_whose_message_has_no_str_is_said_by_its_type(exc: BaseExceptio
     name = type(exc).__name__
     assert first_line(exc) == name
     assert internal_error(exc) == f"stereovision: error: internal {name} (please report this)"
+
+
+@pytest.mark.parametrize("given", [Decimal("1e400"), Decimal("-1e400"), Fraction(10**400)])
+def test_a_finite_real_past_a_floats_range_is_named_as_given_not_as_inf(given: object) -> None:
+    # float(Decimal('1e400')) is inf, not the OverflowError of a Fraction's: the fusion's
+    # options refused a finite number as "got inf"
+    from stereovision._validate import _plain_option, _plain_real
+    from stereovision.matching.fusion import fused_dense
+
+    assert _plain_real(given) is given and _plain_option(given) is given
+    d = np.full((6, 8), np.nan, np.float32)
+    with pytest.raises(ValueError) as err:
+        fused_dense(d, d, d, fill_confidence=given)  # type: ignore[arg-type]
+    assert str(err.value).startswith("fill_confidence: expected a finite number, got ")
+    assert "inf" not in str(err.value)
+    # a Decimal infinity is one, and a Decimal within the range its float, as before
+    assert _plain_real(Decimal("-Infinity")) == -np.inf and _plain_real(Decimal("1e300")) == 1e300

@@ -728,9 +728,14 @@ def _plain_real(value: Any) -> Any:
     real = isinstance(value, (numbers.Real, decimal.Decimal))
     if real and not isinstance(value, (int, float, np.generic)):
         try:
-            return float(value)
+            out = float(value)
         except (OverflowError, ValueError):
             return value
+        # a finite Decimal past a float's range is no OverflowError, as a Fraction's is, but
+        # an infinity: Decimal('1e400') was refused as "got inf"
+        if math.isinf(out) and isinstance(value, decimal.Decimal) and value.is_finite():
+            return value
+        return out
     return value
 
 
