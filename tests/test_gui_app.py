@@ -513,7 +513,8 @@ def test_cmd_gui_starts_the_server_as_asked_and_closes_the_cameras(monkeypatch, 
 def test_the_public_host_note_is_not_said_of_a_loopback_host(monkeypatch, capsys):
     """Any 127.0.0.0/8 address, ``::ffff:127.0.0.1`` and ``localhost.`` are this machine
     alone: ``--host 127.0.0.2`` printed "anyone who can reach this address sees the cameras"
-    (only 127.0.0.1, localhost and ::1 were known). Another address or name still gets it."""
+    (only 127.0.0.1, localhost and ::1 were known), and so did ``127.1``, which the server
+    binds as 127.0.0.1. Another address or name still gets it."""
     import stereovision.gui as gui
 
     note = "note: listening on {}: anyone who can reach this address sees the cameras\n"
@@ -524,7 +525,12 @@ def test_the_public_host_note_is_not_said_of_a_loopback_host(monkeypatch, capsys
         ("localhost.", False),
         ("LocalHost", False),
         ("::1", False),
+        # inet_aton's forms of 127.0.0.1, as the bind reads them (getaddrinfo)
+        ("127.1", False),
+        ("0x7f.1", False),
+        ("2130706433", False),
         ("192.168.1.5", True),
+        ("10.1", True),
         ("::", True),
         ("::ffff:10.0.0.1", True),
         ("localhost.example.com", True),

@@ -37,26 +37,42 @@ LOOPBACK_NAMES = frozenset({"localhost", "localhost."})
 
 def is_loopback_host(host: str) -> bool:
     """Whether listening on ``host`` keeps the page to this machine: a loopback address (any
-    of 127.0.0.0/8, ``::1``, ``::ffff:127.0.0.1``) or ``localhost`` (``localhost.``).
+    of 127.0.0.0/8, ``::1``, ``::ffff:127.0.0.1``, in any form the bind reads: ``127.1``) or
+    ``localhost`` (``localhost.``).
 
     Examples
     --------
-    >>> [is_loopback_host(h) for h in ("127.0.0.2", "::ffff:127.0.0.1", "localhost.")]
-    [True, True, True]
+    >>> [is_loopback_host(h) for h in ("127.0.0.2", "::ffff:127.0.0.1", "localhost.", "127.1")]
+    [True, True, True, True]
     >>> [is_loopback_host(h) for h in ("0.0.0.0", "192.168.1.5", "localhost.example.com")]
     [False, False, False]
     """
     import ipaddress
+    import socket
 
     if host.lower() in LOOPBACK_NAMES:
         return True
     try:
-        addr = ipaddress.ip_address(host)
-    except ValueError:  # a name other than localhost: it may resolve anywhere
-        return False
+        addrs = [ipaddress.ip_address(host)]
+    except ValueError:
+        # The bind reads the host as getaddrinfo does, inet_aton's short forms too: 127.1,
+        # 0x7f.1 and 2130706433 are 127.0.0.1 (they got the note). Numeric only: a name other
+        # than localhost may resolve anywhere.
+        try:
+            found = socket.getaddrinfo(host, None, flags=socket.AI_NUMERICHOST)
+            addrs = [ipaddress.ip_address(info[4][0]) for info in found]
+        except (OSError, UnicodeError, ValueError):
+            return False
     # Python 3.11's is_loopback is False for an IPv4-mapped one (::ffff:127.0.0.1)
-    mapped = getattr(addr, "ipv4_mapped", None)
-    return addr.is_loopback or (mapped is not None and mapped.is_loopback)
+    return bool(addrs) and all(
+        a.is_loopback
+        or (
+            isinstance(a, ipaddress.IPv6Address)
+            and a.ipv4_mapped is not None
+            and a.ipv4_mapped.is_loopback
+        )
+        for a in addrs
+    )
 
 
 def bundled_data_dir() -> Path:
