@@ -1141,12 +1141,8 @@ def _run_matcher(
             # the checked ones, as ``match(method="fused")`` gives them.
             sgm = fr.channel_outputs.get("sgm")
             members = fusion.census_clear(fr, sgm) if sgm is not None else fr
-            # and, as match() keeps them, in the range searched: a member's sub-pixel average
-            # can leave it (cones at max_disparity=37: 84 members up to 37.79 px)
-            d = members.matches.xl - members.matches.xr
-            inside = (d >= d_min) & (d <= d_max)
-            if not inside.all():
-                members = fusion._members_where(members, inside)
+            # and, as match() keeps them, in the range searched
+            members = fusion._members_in_range(members, d_min, d_max)
             channels.update({**fr.channel_outputs, "members": members})
         return disp, conf, only_second
     if method in ("census", "fast"):

@@ -776,6 +776,15 @@ def census_clear(
     return out
 
 
+def _members_in_range(res: FusionResult, lo: float, hi: float) -> FusionResult:
+    """``res`` with only the members whose disparity ``xl - xr`` is in ``[lo, hi]``, as
+    ``match(method="fused")`` keeps them: a member's sub-pixel average can leave the range
+    searched (cones at max_disparity=37: 84 members up to 37.79 px)."""
+    d = res.matches.xl - res.matches.xr
+    inside = (d >= lo) & (d <= hi)
+    return res if inside.all() else _members_where(res, inside)
+
+
 def _members_where(res: FusionResult, keep: npt.NDArray[np.bool_]) -> FusionResult:
     """``res`` with only the members where ``keep`` (matches, per-member arrays, rasters)."""
     m = res.matches
