@@ -1446,3 +1446,21 @@ def test_a_finite_real_past_a_floats_range_is_named_as_given_not_as_inf(given: o
     assert "inf" not in str(err.value)
     # a Decimal infinity is one, and a Decimal within the range its float, as before
     assert _plain_real(Decimal("-Infinity")) == -np.inf and _plain_real(Decimal("1e300")) == 1e300
+
+
+def test_first_line_matches_a_part_with_a_control_character_at_an_end_as_a_whole_name() -> None:
+    """A part ending with a control character was bounded only after it, one opening with one
+    only before it: ``a\\n`` of ``scans/a\\n`` still matched in ``data\\n\\nhint`` (a blank line)
+    and ``\\nb`` of ``scans/\\nb`` in ``cannot read:\\nbad format``, so the message's own break
+    was shown escaped and its next line on the first."""
+    from stereovision._validate import first_line
+
+    assert first_line(ValueError("cannot read data\n\nhint"), ["scans/a\n"]) == "cannot read data"
+    assert first_line(ValueError("cannot read:\nbad format"), ["scans/\nb"]) == "cannot read:"
+    # where the name is whole, it is still escaped
+    assert first_line(ValueError("not found: scans/a\n\nhint"), ["scans/a\n"]) == (
+        "not found: scans/a\\n"
+    )
+    assert first_line(ValueError("not found: 'scans/\nb':\nhint"), ["scans/\nb"]) == (
+        "not found: 'scans/\\nb':"
+    )

@@ -1305,15 +1305,14 @@ def escape_paths(message: str, paths: Iterable[object] = ()) -> str:
                 parts |= {x for x in re.split(f"[{seps}]", text) if _CONTROL.search(x)}
     if not parts:
         return message
-    # A part that opens (ends) with a control character matches only after (before) what
-    # bounds a name: "a\n" of "scans/a\n" is also in "data\nhint", the message's own break.
+    # A part that opens or ends with a control character matches only as a whole name, what
+    # bounds a name before and after it: "a\n" of "scans/a\n" is also in "data\nhint" and
+    # "data\n\nhint", "\nb" of "scans/\nb" in "cannot read:\nbad", the message's own break.
     alternatives = []
     for part in sorted(parts, key=len, reverse=True):
         pattern = re.escape(part)
-        if _CONTROL.match(part):
-            pattern = _NAME_BEFORE + pattern
-        if _CONTROL.match(part[-1]):
-            pattern += _NAME_AFTER
+        if _CONTROL.match(part) or _CONTROL.match(part[-1]):
+            pattern = _NAME_BEFORE + pattern + _NAME_AFTER
         alternatives.append(pattern)
     return re.sub("|".join(alternatives), lambda m: escaped(m.group()), message)
 
