@@ -3290,6 +3290,27 @@ def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
     assert "s\\nx/a_left.png" in failed[0], failed[0]
 
 
+def test_a_pair_output_folder_with_a_newline_is_shown_escaped_when_it_fails(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """The pair's output folder (OUT/<name>/, its name from the images') was not among the
+    paths its error line escapes (its images' and calib's alone, whose part is ``a\\nb.png``):
+    a failure naming it was cut at the newline, ``failed a\\nb: NotADirectoryError: .../a``."""
+    root = tmp_path / "in"
+    _camera_pair(root, data_dir, "a\nb")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "a\nb").write_text("a file where the pair's folder goes")
+    lines: list[str] = []
+    from stereovision.batch import run_batch
+
+    run_batch(root, out, workers=1, progress=False, log=lines.append)
+    failed = [line for line in lines if line.startswith("failed")]
+    assert len(failed) == 1 and "\n" not in failed[0], failed
+    assert failed[0].startswith("failed a\\nb: NotADirectoryError: "), failed[0]
+    assert f"{out}/a\\nb is a file, where the pair's output folder" in failed[0], failed[0]
+
+
 @pytest.mark.parametrize(("left", "right"), [("left.jpg", "right.jpg"), ("LEFT.PNG", "RIGHT.PNG")])
 def test_a_scene_of_left_and_right_of_another_suffix_reads_its_calib(
     data_dir: Path, tmp_path: Path, left: str, right: str

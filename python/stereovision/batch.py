@@ -1005,12 +1005,14 @@ def _remove_partials(out: Path, names: list[str]) -> None:
 
 def _error_line(exc: BaseException, words: str = "api", job: PairJob | None = None) -> str:
     """``exc`` as a summary line, ``Type: first line``, its advice in ``words`` ("api" as
-    raised, or "cli": :func:`stereovision._validate.advice_for`). The files of ``job`` that
-    hold a control character are shown escaped (:func:`stereovision._validate.escape_paths`):
-    one with a newline in its name cut the line there, naming another file."""
+    raised, or "cli": :func:`stereovision._validate.advice_for`). The files of ``job`` and its
+    output folder's name that hold a control character are shown escaped
+    (:func:`stereovision._validate.escape_paths`): one with a newline in its name cut the line
+    there, naming another file."""
     from stereovision._validate import first_line
 
-    paths = () if job is None else (job.left, job.right, job.calib)
+    # the name too: OUT/<name>/, named by a failure to write there, is no part of the images'
+    paths = () if job is None else (job.left, job.right, job.calib, job.name)
     msg = first_line(exc, paths) if str(exc).strip() else ""
     if words != "api":
         from stereovision._validate import advice_for
