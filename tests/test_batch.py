@@ -2875,6 +2875,21 @@ def test_a_failed_pairs_error_is_the_first_line_of_its_message() -> None:
     assert _error_line(MemoryError()) == "MemoryError"
 
 
+class _NoStrError(Exception):
+    def __str__(self) -> str:
+        return 5  # type: ignore[return-value]  # a __str__ not returning a str: TypeError
+
+
+@pytest.mark.parametrize("exc", [KeyError(10**5000), _NoStrError(), ValueError(-(10**4400))])
+def test_a_failed_pairs_error_that_cannot_say_its_message_is_its_type(exc: Exception) -> None:
+    # _error_line took str(exc) before first_line, which ab716d7 taught such an error: a
+    # failed run's record (run["error"]) raised in its handler and was left without its end
+    from stereovision.batch import _error_line
+
+    assert _error_line(exc) == type(exc).__name__
+    assert _error_line(exc, "cli") == type(exc).__name__
+
+
 def test_a_run_killed_without_calib_does_not_own_the_depth_names(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1009,11 +1009,13 @@ def _error_line(exc: BaseException, words: str = "api", job: PairJob | None = No
     output folder's name that hold a control character are shown escaped
     (:func:`stereovision._validate.escape_paths`): one with a newline in its name cut the line
     there, naming another file."""
-    from stereovision._validate import first_line
+    from stereovision._validate import _message, first_line
 
     # the name too: OUT/<name>/, named by a failure to write there, is no part of the images'
     paths = () if job is None else (job.left, job.right, job.calib, job.name)
-    msg = first_line(exc, paths) if str(exc).strip() else ""
+    # _message, not str(exc): an error that cannot say its message (KeyError(10**5000)) raised
+    # here, in the handler closing a failed run's record
+    msg = first_line(exc, paths) if _message(exc).strip() else ""
     if words != "api":
         from stereovision._validate import advice_for
 
