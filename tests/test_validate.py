@@ -1418,6 +1418,15 @@ def test_xy_points_reads_every_real_number_as_before() -> None:
         assert got.dtype == np.float64 and got.tolist() == want
 
 
+def test_xy_points_names_the_points_for_an_int_past_a_floats_range() -> None:
+    # the float64 cast's bare OverflowError ("int too large to convert to float") named no
+    # argument, before and after c218122
+    from stereovision._validate import xy_points
+
+    with pytest.raises(ValueError, match=r"^points: .* integer too large for a float$"):
+        xy_points([[10**400, 1], [2, 3]])
+
+
 def test_xy_points_takes_a_float64_array_as_given_not_a_copy() -> None:
     # the real-number check cast every input with astype, which copies: a (1e6, 2) float64
     # array of points was copied once more (16 MB, +0.5 ms) where np.asarray had passed it

@@ -1482,7 +1482,12 @@ def xy_points(points: object, name: str = "points") -> npt.NDArray[np.float64]:
     )
     if not real:
         raise ValueError(f"{name}: expected (x, y) pixels as numbers, got dtype {raw.dtype}")
-    pts = raw.astype(np.float64, copy=False)  # a float64 array as given, not a copy: as before
+    try:
+        pts = raw.astype(np.float64, copy=False)  # a float64 array as given, not a copy: as before
+    except OverflowError:  # an int past a float's range (10**400): Python's words, naming nothing
+        raise ValueError(
+            f"{name}: expected (x, y) pixels as numbers, got an integer too large for a float"
+        ) from None
     if pts.ndim != 2 or pts.shape[1] != 2:
         hint = (
             " (transpose a (2, N) array)"
