@@ -6688,3 +6688,19 @@ def test_a_topic_without_a_bag_is_refused_before_the_server_starts(
         gui.build_app(_gui_args(*argv))
     assert gui.main([*argv, "--no-browser"]) == 2
     assert capsys.readouterr() == ("", f"stereovision: error: {said}\n")
+
+
+def test_fail_says_a_path_with_a_newline_escaped_on_its_one_line(tmp_path):
+    """_fail took the first line of the error before its path was shortened, and gave
+    first_line no path: a cloud file named with a newline cut the page's error line at it
+    (``not a PLY file: .../my``), its name lost."""
+    pytest.importorskip("trame")
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-fail-path-newline", [bundled_data_dir()])
+    path = tmp_path / "my\ncloud.ply"
+    app._fail(ValueError(f"not a PLY file: {path}\nsecond line"), path)
+    assert app.state.error == f"not a PLY file: {tmp_path}/my\\ncloud.ply"
+    plain = tmp_path / "cloud.ply"
+    app._fail(ValueError(f"not a PLY file: {plain}"), plain)
+    assert app.state.error == f"not a PLY file: {plain}"

@@ -43,6 +43,7 @@ import numpy.typing as npt
 from stereovision import release_memory
 from stereovision._validate import (
     BUG_ERRORS,
+    _message,
     advice_for,
     first_line,
     internal_error,
@@ -1754,9 +1755,10 @@ class StereoApp:
         said while a pair computes stays on the page after the computation's end."""
         if isinstance(exc, BUG_ERRORS):  # caught as a RuntimeError by the handlers: a bug
             exc = _as_said(exc, "an action")
-        msg = first_line(exc)
-        if path is not None:
-            msg = short_paths(msg, path)
+        said = short_paths(_message(exc), path) if path is not None else ""
+        # shortened before first_line escapes a control character in the path (the replace
+        # missed it then), and said with the path escaped: a newline in it cut the line there
+        msg = first_line(ValueError(said), [path]) if said.strip() else first_line(exc)
         log.info("gui error: %s", msg)
         with self.state:
             self.state.error = msg
