@@ -1011,7 +1011,11 @@ def test_filtered_limits_beyond_64_bits(key: str) -> None:
     want = 0 if key == "min_depth" else kept()  # nothing is that far; everything that close
     assert kept(**{key: 2**70}) == kept(**{key: 1e300}) == want
     assert kept() > 1000
-    with pytest.raises(ValueError, match=f"^{key}: expected a positive number, got 1000"):
+    with pytest.raises(
+        ValueError,
+        match=f"^{key}: expected a positive number, got an integer of 401 digits "
+        r"\(too large for a float\)$",
+    ):
         res.filtered(**{key: 10**400})
 
 
@@ -1706,3 +1710,29 @@ def test_the_12_bit_warning_points_at_the_callers_line() -> None:
             call()
         said = [w for w in seen if "uint16 image whose largest value" in str(w.message)]
         assert [w.filename for w in said] == [__file__, __file__], how
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        ("match", "max_disparity"),
+        ("match", "min_disparity"),
+        ("depth_map", "max_disparity"),
+        ("depth_map", "min_disparity"),
+        ("match", "method"),
+        ("depth_map", "method"),
+    ],
+)
+def test_a_bad_range_or_method_is_said_in_one_short_line(call, name):
+    """match's and depth_map's own refusals of max_disparity, min_disparity and method showed
+    an array's whole repr (4 lines for a (4, 4) array, cut at the first by the CLI), and an
+    array as the method failed in the test itself ("truth value ... is ambiguous"): one line
+    now, the array by its shape and dtype."""
+    img = np.zeros((20, 30), np.uint8)
+    bad = np.ones((4, 4))
+    with pytest.raises((ValueError, TypeError)) as info:
+        getattr(sv, call)(img, img, **{name: bad})
+    msg = str(info.value)
+    assert "\n" not in msg
+    assert "array of shape (4, 4) dtype float64" in msg
+    assert (name if name != "method" else "unknown method") in msg

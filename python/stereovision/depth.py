@@ -29,6 +29,7 @@ from stereovision._validate import (
     ADVICE,
     NO_DEPTH,
     _real_array,
+    _shown,
     as_bgr_uint8,
     as_gray_float,
     check_pair,
@@ -36,6 +37,7 @@ from stereovision._validate import (
     figure_shown,
     finite_number,
     known_unit,
+    number_shown,
     pair_shape_error,
     path_given,
     real_number,
@@ -121,7 +123,7 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
             flag = params.get(switch, True)
             if not isinstance(flag, (bool, np.bool_)):
                 # as the other switches: "no" ran the census map or the check, None skipped it
-                raise TypeError(f"{switch}: expected True or False, got {flag!r}")
+                raise TypeError(f"{switch}: expected True or False, got {_shown(flag)}")
         mode, *_, agree = fusion._fuse_options(
             **{**fusion.DEFAULTS, **_given(params, fusion.DEFAULTS)}
         )
@@ -160,7 +162,7 @@ def _check_fused_channels(channels: object) -> None:
     ):
         raise ValueError(
             "channels: depth_map(method='fused') needs 'gabor' (its dense map is the Gabor "
-            f"map's) and at least one of 'mcgm', 'hopfield', and no other, got {channels!r}"
+            f"map's) and at least one of 'mcgm', 'hopfield', and no other, got {_shown(channels)}"
         )
 
 
@@ -859,7 +861,7 @@ class DepthResult:
         """
         if not isinstance(filled, (bool, np.bool_)):
             # "no" (true) gave the filled pixels, None (false) left them out, without a word
-            raise TypeError(f"filled: expected True or False, got {filled!r}")
+            raise TypeError(f"filled: expected True or False, got {_shown(filled)}")
         if self.depth is None or self.calibration is None:
             raise ValueError(NO_DEPTH.format(what="3-D points"))
         cal = self.calibration
@@ -939,10 +941,10 @@ class DepthResult:
             if v is not None and not (
                 ok_number and _finite(v) and (v > 0 or (name == "min_depth" and v == 0))
             ):
-                raise ValueError(f"{name}: expected a positive number, got {v!r}")
+                raise ValueError(f"{name}: expected a positive number, got {number_shown(v)}")
         if min_depth is not None and max_depth is not None and min_depth > max_depth:
             raise ValueError(
-                f"min_depth, max_depth: an empty range, {min_depth!r} > {max_depth!r} m"
+                f"min_depth, max_depth: an empty range, {_shown(min_depth)} > {_shown(max_depth)} m"
             )
         z = self.depth
         keep = np.isfinite(z)
@@ -1509,8 +1511,9 @@ def depth_map(
         if progress is not None:
             progress(name)
 
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    # a str first: an array as the method failed in the test ("truth value ... ambiguous")
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
     if "calibration" in params:  # the result's field is .calibration; the argument is calib
         raise TypeError("depth_map: the calibration is the argument calib, not calibration")
     names = params.get("channels")
@@ -1523,22 +1526,22 @@ def depth_map(
     # a disparity of 1, and "32" failed in NumPy's isfinite.
     for name, flag in (("fill", fill), ("refine", refine)):
         if flag is not None and not isinstance(flag, (bool, np.bool_)):
-            raise TypeError(f"{name}: expected True, False or None, got {flag!r}")
+            raise TypeError(f"{name}: expected True, False or None, got {_shown(flag)}")
     # so too the output switches ("no" returned the channels, None dropped the cloud) and the
     # callback (3 failed after the rectification, "'int' object is not callable")
     for name, flag in (("return_channels", return_channels), ("cloud", cloud)):
         if not isinstance(flag, (bool, np.bool_)):
-            raise TypeError(f"{name}: expected True or False, got {flag!r}")
+            raise TypeError(f"{name}: expected True or False, got {_shown(flag)}")
     if progress is not None and not callable(progress):
         raise TypeError(
-            f"progress: expected a callable taking a stage name, or None, got {progress!r}"
+            f"progress: expected a callable taking a stage name, or None, got {_shown(progress)}"
         )
     for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if value is None and name == "max_disparity":
             continue  # estimated from the images below
         # real_number: a timedelta (an np.integer) passed here, refused later in other words
         if not real_number(value):
-            raise TypeError(f"{name}: expected a number of pixels, got {value!r}")
+            raise TypeError(f"{name}: expected a number of pixels, got {_shown(value)}")
     # NaN, inf or an int beyond 64 bits refused in its own words (finite_number, as below for
     # max_disparity), before the images' work as the refusal after it
     finite_number(min_disparity, "min_disparity")

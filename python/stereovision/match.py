@@ -9,6 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    _shown,
     as_bgr_uint8,
     check_pair,
     finite_number,
@@ -106,8 +107,9 @@ def match(
         no edges in a range it can match in still returns zero matches, not an error), a
         negative ``min_disparity`` with a method other than ``"gabor"`` (they search from 0 px).
     """
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    # a str first: an array as the method failed in the test ("truth value ... ambiguous")
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
     gl, gr = check_pair(left, right)
     # a negative min_disparity the method cannot search: said as depth_map says it (the
     # matchers' own words named neither the method nor the one that takes it), before the

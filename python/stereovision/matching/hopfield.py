@@ -24,6 +24,7 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    _shown,
     as_gray_float,
     check_pair,
     float_sized,
@@ -34,7 +35,6 @@ from stereovision._validate import (
     refuse_not_numbers,
     refuse_unknown,
     refuse_unreachable_range,
-    too_large_for_float,
     u8_pair,
 )
 from stereovision.matches import Matches
@@ -180,11 +180,6 @@ def moravec(image: npt.ArrayLike) -> npt.NDArray[np.float32]:
         ``(H, W)`` float32, ``min(S_h, S_v, S_d, S_a)`` at every pixel.
     """
     return interest_points(image).response
-
-
-def _shown(v: object) -> str:
-    """``repr(v)``, or the size of an int beyond a float (10**400: not its 401 digits)."""
-    return too_large_for_float(v, why=False) or repr(v)
 
 
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:

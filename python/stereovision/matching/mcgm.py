@@ -29,6 +29,7 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     NOT_NUMBERS,
+    _shown,
     as_gray_float,
     check_pair,
     float_sized,
@@ -37,7 +38,6 @@ from stereovision._validate import (
     refuse_not_numbers,
     refuse_unknown,
     refuse_unreachable_range,
-    too_large_for_float,
     xy_points,
 )
 from stereovision.matches import Matches
@@ -222,11 +222,6 @@ def _sigmas(sig: object) -> list[float]:
             f"before (as the default {DEFAULTS['sigmas']}), got {reprlib.repr(sig)}"
         )
     return out
-
-
-def _shown(v: object) -> str:
-    """``repr(v)``, or the size of an int beyond a float (10**400: not its 401 digits)."""
-    return too_large_for_float(v, why=False) or repr(v)
 
 
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
