@@ -3084,6 +3084,22 @@ def test_workers_with_a_scheduler_is_refused_before_any_work(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
 
 
+def test_run_batch_refuses_workers_with_a_scheduler_before_any_work(tmp_path: Path) -> None:
+    """run_batch(workers=2, scheduler=...) ran on the cluster's own workers, workers ignored
+    without a word, where the CLI refuses the pair of options: refused alike, in the
+    parameters' names, before the scheduler is asked or the output folder made."""
+    from stereovision.batch import run_batch
+
+    _noise_pair(tmp_path / "in" / "scene")
+    says = (
+        "^workers sizes the local cluster; scheduler's workers are the cluster's own: "
+        "give one of them$"
+    )
+    with pytest.raises(ValueError, match=says):
+        run_batch(tmp_path / "in", tmp_path / "out", workers=2, scheduler="tcp://127.0.0.1:1")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
+
+
 def _scan_tiny_images(tmp_path: Path, files: list[str]) -> tuple[list, list]:
     """Write an 8x8 image at each of ``files`` (relative to ``tmp_path``) and give back the
     pairs and unpaired images batch's scan finds there."""

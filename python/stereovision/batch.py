@@ -1462,7 +1462,7 @@ def run_batch(
         Input tree and output folder (created if missing).
     workers : int, optional
         Worker processes of the LocalCluster (default: the number of cores), at most one per
-        pair to do. Ignored with ``scheduler``.
+        pair to do. Not with ``scheduler`` (its cluster's workers are its own).
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:8786``).
     method : str, optional
@@ -1510,11 +1510,11 @@ def run_batch(
     FileNotFoundError, NotADirectoryError
         A missing input folder or calibration file.
     ValueError
-        ``workers`` not a whole number above 0, a bad ``max_disparity``, an unknown
-        ``method``, no pair under the input, an output folder that is a file (or below one), or
-        one holding the outputs of pairs of the same names that a run over another input folder
-        made from other images (they would be replaced), or one that another run is writing
-        into.
+        ``workers`` not a whole number above 0 or given with ``scheduler``, a bad
+        ``max_disparity``, an unknown ``method``, no pair under the input, an output folder
+        that is a file (or below one), or one holding the outputs of pairs of the same names
+        that a run over another input folder made from other images (they would be replaced),
+        or one that another run is writing into.
     TypeError
         A ``fill`` that is not True, False or None, a ``ground`` or ``retry_failed`` that is
         not True or False, a ``max_disparity`` or ``grid`` that is not a number.
@@ -1533,6 +1533,13 @@ def run_batch(
 
         # 1.5 failed in the LocalCluster's start, "2" in a comparison, True passed as 1
         workers = positive_whole(workers, "workers", "a whole number above 0")
+    if workers is not None and scheduler is not None:
+        # workers was ignored with a scheduler: workers=8 ran on the cluster's own workers
+        # without a word (the CLI refuses --workers with --scheduler alike)
+        raise ValueError(
+            "workers sizes the local cluster; scheduler's workers are the cluster's own: "
+            "give one of them"
+        )
     if words not in ("api", "cli"):
         raise ValueError(f"words: expected 'api' or 'cli', got {words!r}")
     import numpy as np
