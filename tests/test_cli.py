@@ -492,7 +492,10 @@ def test_depth_rectification_on_a_pair_too_small_says_only_that(
         # named as the option, not as run_stream's parameter ("frames: expected ...")
         (["stream", "--frames", "0"], "argument --frames: expected a whole number above 0"),
         (["stream", "--check-every", "0"], "argument --check-every: expected a whole number"),
-        (["stream", "--serve", "70000"], "argument --serve: expected a port 0 to 65535"),
+        (
+            ["stream", "--serve", "70000"],
+            "argument --serve: expected a port 1 to 65535, or 0 for a free one",
+        ),
         (["capture", "-o", "x", "--every", "0"], "argument --every: expected a whole number"),
         (["capture", "-o", "x", "--fps", "0"], "argument --fps: expected a frame rate above 0"),
         (["stream", "--fps", "nan"], "argument --fps: expected a frame rate above 0, got 'nan'"),
@@ -1822,7 +1825,9 @@ def test_port_number_refuses_what_is_no_port(text: str) -> None:
 
     from stereovision.cli import port_number
 
-    with pytest.raises(argparse.ArgumentTypeError, match="expected a port 0 to 65535"):
+    with pytest.raises(
+        argparse.ArgumentTypeError, match="expected a port 1 to 65535, or 0 for a free one"
+    ):
         port_number(text)
 
 
@@ -3632,3 +3637,19 @@ def test_eval_reports_the_same_members_whatever_the_method(data_dir: Path) -> No
     assert fused["members_depth"]["n"] > 1000
     assert census["members_depth"] == fused["members_depth"]
     assert census["members_table1"] == fused["members_table1"]
+
+
+def test_gui_port_and_stream_serve_refuse_a_port_in_the_same_words(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``gui --port 70000`` said "must be 1 to 65535, or 0 for a free one" and ``stream --serve
+    70000`` "expected a port 0 to 65535 (0: any free one)": one wording for both now."""
+    from stereovision import gui
+
+    words = "expected a port 1 to 65535, or 0 for a free one, got 70000\n"
+    assert gui.main(["--port", "70000"]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: --port: {words}"
+    with pytest.raises(SystemExit):
+        main(["stream", "--serve", "70000"])
+    err = capsys.readouterr().err
+    assert f"argument --serve: {words.rstrip()}" in err and len(err.splitlines()) == 1

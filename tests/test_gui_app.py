@@ -631,7 +631,8 @@ def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
         assert gui.main(argv) == 2
         err = capsys.readouterr().err
         assert err == (
-            f"stereovision: error: --port must be 1 to 65535, or 0 for a free one, got {argv[1]}\n"
+            "stereovision: error: --port: expected a port 1 to 65535, or 0 for a free one, "
+            f"got {argv[1]}\n"
         )
     monkeypatch.setitem(sys.modules, "trame.app", None)  # trame not installed
     assert gui.main([]) == 2

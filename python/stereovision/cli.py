@@ -2104,16 +2104,20 @@ def read_timeout_seconds(text: str) -> float:
     return value
 
 
+#: What a port option takes, as ``stream --serve`` and ``gui --port`` refuse another value.
+PORT_WORDS = "expected a port 1 to 65535, or 0 for a free one"
+
+
 def port_number(text: str) -> int:
     """argparse type of ``--serve``: a TCP port, 0 (any free one) to 65535."""
     try:
         value = int(text)
+        shown = str(value)
     except ValueError:
-        value = -1
+        value, shown = -1, repr(text)
     if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(
-            f"expected a port 0 to 65535 (0: any free one), got {text!r}"
-        )
+        # in gui --port's words (PORT_WORDS): one wording for both options
+        raise argparse.ArgumentTypeError(f"{PORT_WORDS}, got {shown}")
     return value
 
 

@@ -108,7 +108,9 @@ def build_app(args: argparse.Namespace) -> Any:
         raise ValueError("--left-topic and --right-topic are for --from-bag")
     if not 0 <= args.port <= 65535:
         # 0 is no port but "a free one": said, as --help does not say it
-        raise ValueError(f"--port must be 1 to 65535, or 0 for a free one, got {args.port}")
+        from stereovision.cli import PORT_WORDS
+
+        raise ValueError(f"--port: {PORT_WORDS}, got {args.port}")
     folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
     calib = None
     sizeless = None
