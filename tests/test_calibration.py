@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import re
 from pathlib import Path
 
@@ -2092,3 +2093,15 @@ def test_a_vertical_rig_is_refused_by_rectify_as_by_rectified_calibration(
     assert np.array_equal(rr, cv2.remap(img, m[2], m[3], cv2.INTER_LINEAR))
     p = side_by_side.rectify_points([[10.0, 20.0]], "right")
     assert p.shape == (1, 2) and np.all(np.isfinite(p))
+
+
+def test_from_file_refuses_a_bytes_path_naming_the_argument(tmp_path):
+    """Calibration.from_file(b'calib.txt') gave pathlib's TypeError ("argument should be a str
+    object or an os.PathLike object returning str, not <class 'bytes'>"), naming no argument;
+    the library's paths are str or os.PathLike: refused naming path, the name decoded."""
+    with pytest.raises(TypeError) as info:
+        Calibration.from_file(os.fsencode(tmp_path / "calib.txt"))
+    assert str(info.value) == (
+        f"path: expected a str or os.PathLike file name, got the bytes "
+        f"{str(tmp_path / 'calib.txt')!r}: decode it first (os.fsdecode(path))"
+    )

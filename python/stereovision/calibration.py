@@ -36,6 +36,7 @@ from stereovision._validate import (
     crop_or_pad_hint,
     known_unit,
     number_shown,
+    path_given,
     positive_finite,
     real_number,
     renamed_keyword,
@@ -1513,7 +1514,18 @@ class Calibration:
             If the format is not recognised or the content is invalid, if ``image_size`` or
             ``unit`` is missing where the format needs it, if ``unit`` is not a known unit, or
             if ``image_size`` or ``unit`` is given and the file states another.
+        TypeError
+            If ``path`` is bytes: the library's paths are str or os.PathLike, as io's are.
         """
+        if isinstance(path, bytes):
+            # pathlib's own "argument should be a str object or an os.PathLike object
+            # returning str, not <class 'bytes'>" named no argument; as path_given says a name
+            name = path_given(path)
+            said = f"the bytes {name!r}" if name is not None else f"{len(path)} bytes"
+            raise TypeError(
+                f"path: expected a str or os.PathLike file name, got {said}: "
+                "decode it first (os.fsdecode(path))"
+            )
         if unit is not None:
             unit = known_unit(unit, UNIT_TO_METRES)
         calib = cls._read_any(path, image_size, unit)
