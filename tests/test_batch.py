@@ -3373,3 +3373,25 @@ def test_a_scheduler_address_dask_reads_no_port_of_is_left_to_dask(
     assert main([*argv, "--workers", "1"]) == 0
     capsys.readouterr()
     assert main([*argv, "--scheduler", address]) == 0, capsys.readouterr().err
+
+
+def test_a_jpg_scene_with_a_kitti_calib_without_its_size_is_sized_by_its_left_jpg(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene of left.jpg + right.jpg with a KITTI calib.txt lacking S_rect_02 failed its pair
+    with "... pass image_size=(width, height)", Python advice a batch user cannot act on: the
+    KITTI file was sized by a left.png or image_2.png beside it, not a left.jpg (a Q.dat is).
+    It is sized by the scene's left.jpg now, as a Q.dat is."""
+    scene = tmp_path / "in" / "s"
+    scene.mkdir(parents=True)
+    img = np.random.default_rng(0).integers(0, 255, (32, 48, 3), np.uint8)
+    for side in ("left", "right"):
+        cv2.imwrite(str(scene / f"{side}.jpg"), img)
+    (scene / "calib.txt").write_text(
+        "P2: 100 0 24 0 0 100 16 0 0 0 1 0\nP3: 100 0 24 -50 0 100 16 0 0 0 1 0\n"
+    )
+    out = tmp_path / "out"
+    assert main(["batch", str(tmp_path / "in"), "-o", str(out), "--workers", "1"]) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 0 skipped (done before), 0 failed")
+    assert _summary(out)["pairs"]["s"]["status"] == "done"
+    assert Calibration.from_file(scene / "calib.txt").image_size == (48, 32)

@@ -1929,8 +1929,8 @@ class Calibration:
         its own (0.537 against 0.532 m on odometry sequence 00): ``cameras=(0, 1)`` reads it.
 
         The image size comes from ``S_rect_02`` (``S_rect_00`` ...: the left camera's), else
-        from ``image_size``, else from a ``left.png``/``image_2.png`` (``image_0.png`` ...) next
-        to the file.
+        from ``image_size``, else from a ``left.png``/``left.jpg``/``image_2.png``
+        (``image_0.png`` ...) next to the file.
 
         Parameters
         ----------
@@ -2033,7 +2033,8 @@ class Calibration:
         elif given is not None:
             size = given
         else:
-            for name in ("left.png", f"image_{a}.png"):
+            # left.jpg too, as a Q.dat is sized: a left.jpg + right.jpg scene was refused
+            for name in ("left.png", "left.jpg", f"image_{a}.png"):
                 img = p.parent / name
                 if img.is_file():
                     hdr = cv2.imread(str(img), cv2.IMREAD_UNCHANGED)
@@ -2809,9 +2810,9 @@ def _unsized_q(path: PathLike) -> bool:
 
 def _sizing_images(path: PathLike) -> tuple[Path, ...]:
     """The images beside a calibration that :meth:`Calibration.from_file` reads for its image
-    size when none is given: a ``Q.dat``'s ``left.png`` (else ``left.jpg``), the ``left.png``
-    and ``image_2.png`` beside a KITTI file without ``S_rect_02`` (a folder: those of the file
-    it reads); none for a calibration that holds its size."""
+    size when none is given: a ``Q.dat``'s ``left.png`` (else ``left.jpg``), the ``left.png``,
+    ``left.jpg`` and ``image_2.png`` beside a KITTI file without ``S_rect_02`` (a folder: those
+    of the file it reads); none for a calibration that holds its size."""
     p = Path(path)
     q = _q_file(p)
     if q is not None:
@@ -2822,7 +2823,8 @@ def _sizing_images(path: PathLike) -> tuple[Path, ...]:
         p = p / "calib.txt"
     if not _sizeless_kitti_text(p):
         return ()
-    return tuple(f for f in (p.parent / "left.png", p.parent / "image_2.png") if f.is_file())
+    kitti = ("left.png", "left.jpg", "image_2.png")
+    return tuple(p.parent / n for n in kitti if (p.parent / n).is_file())
 
 
 def _scene_image_size(q_file: Path) -> tuple[int, int]:
@@ -2896,7 +2898,7 @@ def _unsized_kitti(path: Path) -> bool:
     ``S_rect_02`` (the object/odometry ``calib`` files) and no image beside it to size it."""
     if not _sizeless_kitti_text(path):
         return False
-    return not any((path.parent / n).is_file() for n in ("left.png", "image_2.png"))
+    return not any((path.parent / n).is_file() for n in ("left.png", "left.jpg", "image_2.png"))
 
 
 def _sizeless(path: PathLike) -> bool:
