@@ -194,7 +194,6 @@ def test_eval_text_says_when_sgbm_or_the_members_have_no_gt_depth(
     """SGBM-3WAY without a pixel on GT (a textureless pair: all invalid) and validated matches
     none of which has a GT depth printed 'SGBM-3WAY over 0: nan %, nan %' and 'with GT depth:
     0, RMSE nan % ...; SGBM-3WAY's RMSE nan %'; each says it has none, as ours does (0d1ed26)."""
-    from types import SimpleNamespace
 
     from stereovision import baselines
     from stereovision.matching import fusion
@@ -205,8 +204,9 @@ def test_eval_text_says_when_sgbm_or_the_members_have_no_gt_depth(
     real_fuse = fusion.fuse_pair
 
     def no_members(*a: Any, **k: Any) -> Any:
+        # a whole FusionResult with no member (eval filters the members by range since 538eadb)
         fused = real_fuse(*a, **k)
-        return SimpleNamespace(dispx=np.full_like(fused.dispx, np.nan))
+        return fusion._members_where(fused, np.zeros(len(fused.matches.xl), bool))
 
     monkeypatch.setattr(baselines, "opencv_sgbm", no_sgbm)
     monkeypatch.setattr(fusion, "fuse_pair", no_members)
