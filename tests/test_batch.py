@@ -3259,20 +3259,12 @@ def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
     assert (out / "summary.json").read_bytes() == summary
 
 
-def _camera_pair(root: Path, data_dir: Path, number: str) -> None:
-    for side in ("left", "right"):
-        (root / side).mkdir(parents=True, exist_ok=True)
-        img = cv2.imread(str(data_dir / "middlebury2001" / "tsukuba" / f"{side}.png"))
-        small = cv2.resize(img, None, fx=SCALE, fy=SCALE, interpolation=cv2.INTER_AREA)
-        cv2.imwrite(str(root / side / f"{number}.png"), small)
-
-
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
 def test_a_fifo_named_as_an_image_fails_its_pair_and_does_not_hang(
     data_dir: Path, tmp_path: Path
 ) -> None:
     root = tmp_path / "in"
-    _camera_pair(root, data_dir, "0002")
+    _crops(root, data_dir, ["left/0002.png"], ["right/0002.png"])
     shutil.copy(root / "right" / "0002.png", root / "right" / "0001.png")
     os.mkfifo(root / "left" / "0001.png")  # read_bytes waited for a writer: the run hung
     proc = subprocess.run(
@@ -3307,7 +3299,7 @@ def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
     data_dir: Path, tmp_path: Path
 ) -> None:
     root = tmp_path / "in"
-    _camera_pair(root, data_dir, "0001")
+    _crops(root, data_dir, ["left/0001.png"], ["right/0001.png"])
     (root / "s\nx").mkdir()
     (root / "s\nx" / "a_left.png").write_bytes(b"not an image")
     (root / "s\nx" / "a_right.png").write_bytes(b"not an image")
@@ -3328,7 +3320,7 @@ def test_a_pair_output_folder_with_a_newline_is_shown_escaped_when_it_fails(
     paths its error line escapes (its images' and calib's alone, whose part is ``a\\nb.png``):
     a failure naming it was cut at the newline, ``failed a\\nb: NotADirectoryError: .../a``."""
     root = tmp_path / "in"
-    _camera_pair(root, data_dir, "a\nb")
+    _crops(root, data_dir, ["left/a\nb.png"], ["right/a\nb.png"])
     out = tmp_path / "out"
     out.mkdir()
     (out / "a\nb").write_text("a file where the pair's folder goes")
