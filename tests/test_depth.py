@@ -152,6 +152,15 @@ def test_disparity_sigma_refuses_what_is_no_confidence_map() -> None:
     assert float(sv.depth.disparity_sigma(0)) == pytest.approx(0.405)
 
 
+def test_disparity_sigma_refuses_a_refined_that_is_no_bool() -> None:
+    """``refined`` is a switch, as depth_map's: ``"no"`` (true) gave the refined line's 0.405
+    px at confidence 0, None (false) the raw one's 0.74, without a word."""
+    for bad in ("no", None, 0, 1):
+        with pytest.raises(TypeError, match=rf"^refined: expected True or False, got {bad!r}$"):
+            sv.depth.disparity_sigma(0.0, refined=bad)  # type: ignore[arg-type]
+    assert float(sv.depth.disparity_sigma(0.0, refined=np.False_)) == pytest.approx(0.74)
+
+
 @pytest.mark.parametrize("refine", [True, False])
 def test_depth_sigma_predicts_the_error(data_dir: Path, refine: bool) -> None:
     """The error in units of the predicted sigma is about standard normal in its core.

@@ -1072,7 +1072,12 @@ def disparity_sigma(
     ValueError
         If ``confidence`` is not real numbers (None, complex, text), or ``filled`` is not of
         its shape.
+    TypeError
+        If ``refined`` is not True or False.
     """
+    if not isinstance(refined, (bool, np.bool_)):
+        # as depth_map's switches: "no" (true) gave the refined line, None (false) the raw one
+        raise TypeError(f"refined: expected True or False, got {_shown(refined)}")
     s0, slope, s_min = _SIGMA_REFINED if refined else _SIGMA_RAW
     raw = _real_array(confidence)
     # None became a NaN sigma, a complex map lost its imaginary part with NumPy's warning only
