@@ -1141,6 +1141,30 @@ def test_min_disparity_above_the_automatic_range_names_the_estimate() -> None:
     assert res.disparity.shape == (32, 64)
 
 
+@pytest.mark.parametrize("method", ["hopfield", "best", "mcgm", "fused", "gabor"])
+def test_match_min_disparity_above_the_automatic_range_names_the_estimate(method: str) -> None:
+    """match(min_disparity=20) with no max_disparity was refused in the matchers' own words,
+    "max_disparity (16) must be >= min_disparity (20)" (hopfield, best, mcgm) or "empty
+    disparity range: max_disparity (16) must be larger than min_disparity (20)" (fused,
+    gabor), a max_disparity the caller never gave; it is now depth_map's error."""
+    rng = np.random.default_rng(5)
+    left = (rng.random((32, 64)) * 255).astype(np.uint8)
+    right = np.roll(left, -2, axis=1)
+    assert sv.estimate_max_disparity(left, right) == 16
+    with pytest.raises(ValueError) as err:
+        sv.match(left, right, method=method, min_disparity=20)
+    assert str(err.value) == (
+        "min_disparity (20) is not below the automatic max_disparity (16, estimated from the "
+        "pair): give a max_disparity above 20"
+    )
+    if method in ("gabor", "fused"):  # they search no single level: at the estimate too
+        with pytest.raises(ValueError, match=r"^min_disparity \(16\) is not below the auto"):
+            sv.match(left, right, method=method, min_disparity=16)
+    else:  # a one-level search at the estimate, as before
+        got = sv.match(left, right, method=method, min_disparity=16)
+        assert np.all(got.xl - got.xr == 16)
+
+
 @pytest.mark.parametrize("method", sv.depth.METHODS)
 @pytest.mark.parametrize(
     ("min_disparity", "max_disparity", "shown"),

@@ -347,6 +347,17 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
     return ValueError(f"{text}; {below} to match it")
 
 
+def _below_automatic(min_disparity: float, automatic_range: float) -> ValueError:
+    """The error of a ``min_disparity`` not below the ``max_disparity`` estimated for the pair
+    (:func:`estimate_max_disparity`; :func:`depth_map`'s and ``match``'s): the caller gave no
+    max_disparity, so the error names the estimate as such and asks for one."""
+    return ValueError(
+        f"min_disparity ({_px(min_disparity)}) is not below the automatic max_disparity "
+        f"({_px(automatic_range)}, estimated from the pair): give a max_disparity above "
+        f"{_px(min_disparity)}"
+    )
+
+
 def _range_too_wide(span: float, width: int, min_disparity: float = 0) -> ValueError:
     """The error of a disparity range the caller gave that is not below the pair's width: the
     width it needs, and the ``max_disparity`` that fits this pair (none for a 1 px wide one)."""
@@ -1604,11 +1615,7 @@ def depth_map(
         unreachable = unreachable_range(min_disparity, math.inf, gl.shape[1])
         if unreachable is not None:
             raise unreachable
-        raise ValueError(
-            f"min_disparity ({_px(min_disparity)}) is not below the automatic max_disparity "
-            f"({_px(max_disparity)}, estimated from the pair): give a max_disparity above "
-            f"{_px(min_disparity)}"
-        )
+        raise _below_automatic(min_disparity, max_disparity)
     if max_disparity <= min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"

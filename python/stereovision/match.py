@@ -19,6 +19,7 @@ from stereovision._validate import (
 )
 from stereovision.calibration import Calibration
 from stereovision.depth import (
+    _below_automatic,
     _from_zero,
     _rectify_grey,
     _rig_to_warp_by,
@@ -139,7 +140,9 @@ def match(
     automatic = max_disparity is None
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
-    _refuse_unreachable(params.get("min_disparity", 0), max_disparity, gl.shape[1], automatic)
+    _refuse_unreachable(
+        params.get("min_disparity", 0), max_disparity, gl.shape[1], automatic, method
+    )
     if from_zero:  # a range given: once it is known searchable
         raise _from_zero(method, lo, ("gabor",), params.get("channels"))
     if method == "mcgm":
@@ -171,7 +174,7 @@ def match(
 
 
 def _refuse_unreachable(
-    min_disparity: object, max_disparity: object, width: int, automatic: bool
+    min_disparity: object, max_disparity: object, width: int, automatic: bool, method: str
 ) -> None:
     """Refuse a range no pixel can match in (:func:`stereovision.depth_map`'s rule): a
     ``min_disparity`` at the width or above returned 0 matches without a word (or, beyond
@@ -182,7 +185,10 @@ def _refuse_unreachable(
     estimated one (``automatic``) below such a min_disparity is not the problem, the
     min_disparity is. An int beyond a float's range is compared as it is: a min_disparity of
     10**400 returned 0 matches without a word (hopfield, best, mcgm), a max_disparity of
-    10**400 searches the whole width."""
+    10**400 searches the whole width. An estimated one below a reachable min_disparity (at it,
+    for ``method`` ``"gabor"`` and ``"fused"``, which search no single level) is refused as
+    :func:`stereovision.depth_map` refuses it: the matchers' own words named a max_disparity
+    the caller never gave ("max_disparity (32) must be >= min_disparity (40)")."""
     try:
         lo = _bound(min_disparity, "min_disparity")
         hi = _bound(max_disparity, "max_disparity")
@@ -191,6 +197,8 @@ def _refuse_unreachable(
     if hi < lo and not automatic:
         return
     refuse_unreachable_range(lo, hi, width)
+    if automatic and (hi < lo or (hi == lo and method in ("gabor", "fused"))):
+        raise _below_automatic(lo, hi)
 
 
 def _bound(value: object, name: str) -> float:
