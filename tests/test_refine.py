@@ -253,6 +253,25 @@ def test_bad_parameters_raise(kwargs: dict, match: str) -> None:
         refine_disparity(a, a, a, max_disparity=8, **kwargs)
 
 
+def test_an_infinite_parameter_is_said_to_be_one() -> None:
+    """inf, or a value past float32 (1e39, inf in the kernel), was "invalid parameter
+    `base_sigma`: must be > 0, got inf", as if it were too small; fill_max_residual's inf is
+    still no test, and a sigma within float32 (1e20) still any box wider than the image."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    for kwargs, said in (
+        ({"base_sigma": float("inf")}, "base_sigma must be a finite number, got inf"),
+        ({"win_sigma": 1e39}, "win_sigma must be a finite number, got 1e+39"),
+        ({"step": 10**40}, "step must be a finite number, got 1e+40"),
+        ({"fills": ((float("inf"), 0.3),)}, "fill sigma must be a finite number, got inf"),
+    ):
+        with pytest.raises(ValueError) as err:
+            refine_disparity(a, a, a, max_disparity=8, **kwargs)  # type: ignore[arg-type]
+        assert str(err.value) == said
+    for kwargs in ({"fill_max_residual": float("inf")}, {"base_sigma": 1e20}):
+        res = refine_disparity(a, a, a, max_disparity=8, **kwargs)  # type: ignore[arg-type]
+        assert res.disparity.shape == (20, 30)
+
+
 def test_an_unknown_parameter_names_the_valid_ones() -> None:
     """A misspelt key was "unknown refinement parameter(s): ['win_sigmma']": neither the
     nearest spelling nor the valid keys, which the matchers' own errors give."""

@@ -206,6 +206,13 @@ def refine_disparity(
             f"fills must be a sequence of (sigma, min_score), got {fills_raw!r}"
         ) from exc
     f = {k: _number(kw[k], k) for k in _FLOAT_KEYS}
+    # The kernel's float32 reads an infinity, or a value past float32 (1e39), as inf: "invalid
+    # parameter `base_sigma`: must be > 0, got inf" told the caller to give a larger value.
+    # fill_max_residual's inf means no test; NaN is left to the kernel's words.
+    top = float(np.finfo(np.float32).max)
+    for k, v in [*f.items(), *(("fill sigma", s) for s, _ in fills)]:
+        if k != "fill_max_residual" and abs(v) > top:
+            raise ValueError(f"{k} must be a finite number, got {number_shown(v)}")
     i = {k: _number(kw[k], k, whole=True) for k in ("win_radius", "search", "fill_search")}
     # A switch, not a truth value: "no" or 0.5 went through bool() as True, None as False.
     if not isinstance(kw["fill_plane"], (bool, np.bool_)):
