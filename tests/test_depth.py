@@ -1650,6 +1650,38 @@ def test_depth_map_argument_edges_of_the_second_audit() -> None:
     assert type(res.min_disparity) is float and res.min_disparity == 2.0
 
 
+def test_min_disparity_above_the_rectifications_range_names_it() -> None:
+    """With an UncalibratedRectification and no max_disparity, a min_disparity above its search
+    range was "max_disparity (32) must be larger than min_disparity (40)" (match: "... must be
+    >= ..."), a max_disparity the caller never gave; the error names the rectification's."""
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    h, w = 64, 96
+    left = _texture(h, w, seed=3)
+    right = _shift(left, 4.0)
+    ident = np.eye(3)
+    homographies = UncalibratedRectification(
+        ident, ident, (w, h), (w, h), np.zeros((3, 3)), 100, 0.0, 0.0, (0.0, 20.0), 32,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    said = (
+        "min_disparity (40) is not below the automatic max_disparity (32, the rectification's "
+        "search range): give a max_disparity above 40"
+    )
+    runs = (
+        lambda: sv.depth_map(left, right, homographies, method="gabor", min_disparity=40),
+        lambda: sv.match(left, right, homographies, method="gabor", min_disparity=40),
+        lambda: sv.match(left, right, homographies, method="best", min_disparity=40),
+    )
+    for run in runs:
+        with pytest.raises(ValueError) as err:
+            run()
+        assert str(err.value) == said
+    # a max_disparity given is the caller's, said as before
+    with pytest.raises(ValueError, match=r"^max_disparity \(32\) must be larger than min"):
+        sv.depth_map(left, right, homographies, min_disparity=40, max_disparity=32)
+
+
 def test_stages_are_timed_apart_and_reported_in_order() -> None:
     """Each timing is its own stage's (they add up to at most the call), and progress hears the
     stages in the order they ran."""

@@ -347,14 +347,15 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
     return ValueError(f"{text}; {below} to match it")
 
 
-def _below_automatic(min_disparity: float, automatic_range: float) -> ValueError:
+def _below_automatic(min_disparity: float, automatic_range: float, rig: bool = False) -> ValueError:
     """The error of a ``min_disparity`` not below the ``max_disparity`` estimated for the pair
-    (:func:`estimate_max_disparity`; :func:`depth_map`'s and ``match``'s): the caller gave no
-    max_disparity, so the error names the estimate as such and asks for one."""
+    (:func:`estimate_max_disparity`; :func:`depth_map`'s and ``match``'s), or ``rig``: an
+    :class:`UncalibratedRectification`'s search range. The caller gave no max_disparity, so
+    the error names the automatic one as such and asks for one."""
+    whose = "the rectification's search range" if rig else "estimated from the pair"
     return ValueError(
         f"min_disparity ({_px(min_disparity)}) is not below the automatic max_disparity "
-        f"({_px(automatic_range)}, estimated from the pair): give a max_disparity above "
-        f"{_px(min_disparity)}"
+        f"({_px(automatic_range)}, {whose}): give a max_disparity above {_px(min_disparity)}"
     )
 
 
@@ -1587,6 +1588,8 @@ def depth_map(
     deep = np.asarray(left).dtype != np.uint8 or np.asarray(right).dtype != np.uint8
     grey: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]] | None = None
     h, w = left_bgr.shape[:2]
+    # the range an uncalibrated rectification suggests is no more the caller's than an estimate
+    rig_range = max_disparity is None and isinstance(calib, UncalibratedRectification)
     rig, calib, max_disparity = _rig_to_warp_by(calib, w, h, max_disparity)
     if rig is not None:
         if deep:
@@ -1608,14 +1611,14 @@ def depth_map(
     # a ValueError naming the argument for NaN, inf and ints beyond 64 bits (2**70 was NumPy's
     # TypeError "ufunc 'isfinite' not supported")
     finite_number(max_disparity, "max_disparity")
-    if max_disparity <= min_disparity and automatic:
+    if max_disparity <= min_disparity and (automatic or rig_range):
         # "max_disparity (16) must be larger than min_disparity (20)" named a value never given;
         # "give a max_disparity above 100" to a min_disparity no pixel reaches sent the caller
         # to the error below
         unreachable = unreachable_range(min_disparity, math.inf, gl.shape[1])
         if unreachable is not None:
             raise unreachable
-        raise _below_automatic(min_disparity, max_disparity)
+        raise _below_automatic(min_disparity, max_disparity, rig_range)
     if max_disparity <= min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"

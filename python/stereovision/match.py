@@ -129,6 +129,8 @@ def match(
         raise _from_zero(method, lo, ("gabor",), params.get("channels"))
     uint8 = np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8
     h, w = gl.shape
+    # the range an uncalibrated rectification suggests is no more the caller's than an estimate
+    rig_range = max_disparity is None and isinstance(calib, UncalibratedRectification)
     # a calibrated rig not yet rectified, or an uncalibrated one: as depth_map does
     rig, _, max_disparity = _rig_to_warp_by(calib, w, h, max_disparity, "match", METHODS)
     if rig is not None:
@@ -141,7 +143,12 @@ def match(
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
     _refuse_unreachable(
-        params.get("min_disparity", 0), max_disparity, gl.shape[1], automatic, method
+        params.get("min_disparity", 0),
+        max_disparity,
+        gl.shape[1],
+        automatic or rig_range,
+        method,
+        rig_range,
     )
     if from_zero:  # a range given: once it is known searchable
         raise _from_zero(method, lo, ("gabor",), params.get("channels"))
@@ -174,7 +181,12 @@ def match(
 
 
 def _refuse_unreachable(
-    min_disparity: object, max_disparity: object, width: int, automatic: bool, method: str
+    min_disparity: object,
+    max_disparity: object,
+    width: int,
+    automatic: bool,
+    method: str,
+    rig: bool = False,
 ) -> None:
     """Refuse a range no pixel can match in (:func:`stereovision.depth_map`'s rule): a
     ``min_disparity`` at the width or above returned 0 matches without a word (or, beyond
@@ -188,7 +200,8 @@ def _refuse_unreachable(
     10**400 searches the whole width. An estimated one below a reachable min_disparity (at it,
     for ``method`` ``"gabor"`` and ``"fused"``, which search no single level) is refused as
     :func:`stereovision.depth_map` refuses it: the matchers' own words named a max_disparity
-    the caller never gave ("max_disparity (32) must be >= min_disparity (40)")."""
+    the caller never gave ("max_disparity (32) must be >= min_disparity (40)"); ``rig``: the
+    automatic one is an uncalibrated rectification's."""
     try:
         lo = _bound(min_disparity, "min_disparity")
         hi = _bound(max_disparity, "max_disparity")
@@ -198,7 +211,7 @@ def _refuse_unreachable(
         return
     refuse_unreachable_range(lo, hi, width)
     if automatic and (hi < lo or (hi == lo and method in ("gabor", "fused"))):
-        raise _below_automatic(lo, hi)
+        raise _below_automatic(lo, hi, rig)
 
 
 def _bound(value: object, name: str) -> float:
