@@ -784,6 +784,26 @@ def test_matches_csv_text_and_bad_files(tmp_path: Path) -> None:
                 sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
 
 
+def test_matches_from_csv_refuses_an_image_shape_its_matches_lie_outside(tmp_path: Path) -> None:
+    """An image_shape given as (W, H), as cv2 and Calibration.image_size give sizes, read the
+    file and dropped every match past the height from dispx without a word."""
+    m = sv.Matches(
+        xl=[5.0, 70.0, np.nan], yl=[3.0, 20.0, 1.0], xr=[1.0, 66.0, 0.0], yr=[3.0, 20.0, 1.0],
+        score=[1.0, 0.5, 0.2], image_shape=(30, 80),
+    )  # fmt: skip
+    path = m.save_csv(tmp_path / "m.csv")
+    with pytest.raises(ValueError) as err:
+        sv.Matches.from_csv(path, (80, 30))
+    assert str(err.value) == (
+        f"{path}: 1 of the 3 matches lie outside image_shape (80, 30) (left positions up to "
+        "x 70, y 20); image_shape is the left image's (H, W): (30, 80)?"
+    )
+    with pytest.raises(ValueError, match=r"2 of the 3 matches .*\(H, W\)$"):
+        sv.Matches.from_csv(path, (10, 5))
+    back = sv.Matches.from_csv(path, (30, 80))  # a NaN position is no position: read as before
+    np.testing.assert_array_equal(back.to_array(), m.to_array())
+
+
 def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_path: Path) -> None:
     """An image given as the matches' CSV was a UnicodeDecodeError naming no file ("'utf-8'
     codec can't decode byte 0x89 in position 0"), a folder an IsADirectoryError: each now

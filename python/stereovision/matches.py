@@ -353,8 +353,9 @@ class Matches:
             If ``path`` does not exist.
         ValueError
             If ``path`` is a folder (or another file that is neither regular nor a pipe) or
-            not UTF-8 text (an image given by mistake), another header, or a row without five
-            numbers, naming the file (and the row's line).
+            not UTF-8 text (an image given by mistake), another header, a row without five
+            numbers, naming the file (and the row's line), or matches whose left position lies
+            outside ``image_shape`` (one given as ``(W, H)``).
         """
         from stereovision.io import _existing_file
 
@@ -397,4 +398,21 @@ class Matches:
         if a.ndim != 2 or a.shape[1] != 5:
             raise ValueError(f"{path}: expected 5 numbers per row")
         xl, yl, xr, yr, score = (a[:, i].astype(np.float32) for i in range(5))
-        return cls(xl=xl, yl=yl, xr=xr, yr=yr, score=score, image_shape=image_shape)
+        m = cls(xl=xl, yl=yl, xr=xr, yr=yr, score=score, image_shape=image_shape)
+        # The file does not hold the shape: one given as (W, H), as cv2 and image_size give it,
+        # left every match past the height out of dispx/dispy without a word (tsukuba's MCGM
+        # matches with (384, 288): 732 of 5,086 dropped). A position is where _raster puts it.
+        h, w = m.image_shape
+        rx, ry = np.rint(m.xl), np.rint(m.yl)
+        with np.errstate(invalid="ignore"):
+            out = np.isfinite(rx) & np.isfinite(ry) & ((rx < 0) | (rx >= w) | (ry < 0) | (ry >= h))
+        if out.any():
+            inside_swapped = not np.any(out & ((rx < 0) | (rx >= h) | (ry < 0) | (ry >= w)))
+            hint = f": ({w}, {h})?" if inside_swapped else ""
+            raise ValueError(
+                f"{path}: {int(out.sum())} of the {len(m)} matches lie outside image_shape "
+                f"{(h, w)} (left positions up to x {float(np.nanmax(m.xl[out])):g}, y "
+                f"{float(np.nanmax(m.yl[out])):g}); image_shape is the left image's (H, W)"
+                f"{hint}"
+            )
+        return m
