@@ -450,6 +450,14 @@ try:
                 call()
             except (ValueError, MemoryError) as e:
                 print(f"{{type(e).__name__}}: {{e}}")
+    elif case == "refine_before_copies":
+        # a 16 GiB float32 view of one value, with a right image of its shape, then another's
+        grey = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
+        for right in (grey, np.zeros((6, 8), np.float32)):
+            try:
+                _core.refine_disparity(grey, right, grey, grey, *{refine_args})
+            except (ValueError, MemoryError) as e:
+                print(f"{{type(e).__name__}}: {{e}}")
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -511,7 +519,7 @@ def test_hopfield_interest_refuses_a_row_past_int32_before_copying_it() -> None:
     out = _under_address_limit("interest_too_wide", 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     want = (
-        "ValueError: image of 2147483649x1 pixels is too large: the kernels index pixels "
+        "ValueError: img: image of 2147483649x1 pixels is too large: the kernels index pixels "
         "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
     assert want in out.stdout, out.stdout
@@ -526,14 +534,30 @@ def test_in_place_kernels_refuse_2_to_the_32_pixels_before_copying(case: str) ->
     """``plane_fill`` (no size check: its u32 pixel lists wrapped), ``gabor_remove_speckles``,
     ``quantised_regions`` and ``fill_planes`` (the kernel's check came after the copy) copied a
     65536 x 65536 (broadcast) map or image first: a 12-16 GiB MemoryError under ``ulimit -v``,
-    not the size's ValueError."""
+    not the size's ValueError. That error named no argument, and called a ``disp`` an image."""
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    # the argument and what it is, as the Python side's check_index_range says them
+    said = "disp: map" if case in ("plane_fill_too_large", "speckles_too_large") else "image: image"
     want = (
-        "ValueError: image of 65536x65536 pixels is too large: the kernels index pixels "
+        f"ValueError: {said} of 65536x65536 pixels is too large: the kernels index pixels "
         "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
     assert want in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_refine_disparity_refuses_a_huge_or_mismatched_pair_before_copying_it() -> None:
+    """``refine_disparity`` copied ``left`` (and ``right``) before the kernel refused a size past
+    its 32-bit warp columns, or a ``right`` of another shape: a broadcast 65536 x 65536 ``left``
+    was its 16 GiB copy's MemoryError under ``ulimit -v`` (the memory taken without one)."""
+    out = _under_address_limit("refine_before_copies", 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    assert out.stdout.splitlines() == [
+        "ValueError: left: image of 65536x65536 pixels is too large: the kernels index pixels "
+        "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)",
+        "ValueError: right: expected shape (65536, 65536) like left, got (6, 8)",
+    ], out.stdout
 
 
 @pytest.mark.parametrize("channels", [2, 5])
@@ -603,7 +627,7 @@ def test_graph_segments_refuses_a_huge_image_before_reading_it(case: str, messag
     [
         (
             "log_too_large",
-            "image of 65536x65536 pixels is too large: the kernels index pixels with 32-bit "
+            "img: image of 65536x65536 pixels is too large: the kernels index pixels with 32-bit "
             "integers (at most 4294967295 pixels, 2147483647 per side)",
         ),
         ("log_bad_sigma", "sigma must lie in [0.3, 64] px, got 0"),

@@ -17,6 +17,21 @@ pub fn to_pyerr(err: CoreError) -> PyErr {
     }
 }
 
+/// The core's 32-bit index check ([`check_index_range_within`]) of the argument `name`, a
+/// `w x h` `noun` ("image", or "map" for a disparity map), from its shape alone: before any
+/// copy. The core's words ("image of WxH pixels is too large") named no argument, and called
+/// `plane_fill`'s and `gabor_remove_speckles`' `disp` an image; these are the Python side's
+/// (`_validate.check_index_range`): "disp: map of 65536x65536 pixels is too large: ...".
+///
+/// [`check_index_range_within`]: stereovision_core::image::check_index_range_within
+pub fn check_size(w: usize, h: usize, max_pixels: usize, name: &str, noun: &str) -> PyResult<()> {
+    stereovision_core::image::check_index_range_within(w, h, max_pixels).map_err(|e| {
+        let text = e.to_string();
+        let rest = text.strip_prefix("image ").unwrap_or(&text);
+        PyValueError::new_err(format!("{name}: {noun} {rest}"))
+    })
+}
+
 /// `MemoryError` for a copy of `n` values of `T` the binding could not allocate.
 pub fn copy_oom<T>(n: usize, what: &str) -> PyErr {
     let bytes = n.saturating_mul(std::mem::size_of::<T>());

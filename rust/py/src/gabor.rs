@@ -300,7 +300,7 @@ pub fn gabor_remove_speckles<'py>(
     crate::params::non_negative("max_diff", max_diff)?;
     // The kernel's own check comes after the copy below: refused from the shape first.
     let (h, w) = disp.as_array().dim();
-    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
+    crate::errors::check_size(w, h, stereovision_core::image::MAX_PIXELS, "disp", "map")?;
     let kernel = |d: &mut [f32], w, h| {
         guard("gabor_remove_speckles", || {
             remove_speckles(d, w, h, min_size, max_diff)

@@ -139,7 +139,7 @@ pub fn hopfield_interest<'py>(
     // The points go out as int32 (a column past i32 wrapped): refused from the shape, before
     // the image is copied.
     let (h, w) = img.as_array().dim();
-    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
+    crate::errors::check_size(w, h, stereovision_core::image::MAX_PIXELS, "img", "image")?;
     let im = grey_from_numpy(&img, "img")?;
     let im = im.view();
     let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);

@@ -147,7 +147,8 @@ pub fn mcgm_log<'py>(
         )));
     }
     let (rows, cols) = img.as_array().dim();
-    stereovision_core::image::check_index_range(cols, rows).map_err(crate::errors::to_pyerr)?;
+    let max = stereovision_core::image::MAX_PIXELS;
+    crate::errors::check_size(cols, rows, max, "img", "image")?;
     let im = image_from_numpy(&img, "img")?;
     let (w, h) = im.size();
     let data = crate::workers::detach(py, || guard("mcgm_log", || log_filter(&im, sigma)))?;

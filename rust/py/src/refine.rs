@@ -1,7 +1,9 @@
 //! Binding of `stereovision_core::refine`.
 
 use numpy::{PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use stereovision_core::image::MAX_PIXELS;
 use stereovision_core::refine::{refine_disparity as core_refine, FillPass, RefineParams};
 use stereovision_core::Image;
 
@@ -45,6 +47,17 @@ pub fn refine_disparity<'py>(
     // shape was refused).
     let (h, w) = left.as_array().dim();
     check_map_shapes(&disp, &conf, (h, w), "left")?;
+    // So are `right`'s shape (the kernel's "left and right images differ in size" came after
+    // both copies) and the size the kernel's 32-bit warp columns reach: a broadcast 65536 x
+    // 65536 `left` was a 16 GiB copy (a MemoryError under a memory limit) before it was refused.
+    if right.as_array().dim() != (h, w) {
+        return Err(PyValueError::new_err(format!(
+            "right: expected shape {:?} like left, got {:?}",
+            (h, w),
+            right.as_array().dim()
+        )));
+    }
+    crate::errors::check_size(w, h, MAX_PIXELS, "left", "image")?;
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
     let (d, c) = map_and_confidence(&disp, &conf, (h, w), "left")?;

@@ -11,6 +11,7 @@ use stereovision_core::segment::{
 use crate::convert::{map_copy_in_place, row_major, vec_to_numpy};
 use crate::errors::guard;
 use crate::params::{non_negative, IntRange};
+use stereovision_core::image::MAX_PIXELS;
 
 /// Felzenszwalb-Huttenlocher segments of an `(H, W, C)` float32 image: `(H, W)` uint32 labels
 /// numbered in raster order of each segment's first pixel.
@@ -34,12 +35,13 @@ pub fn graph_segments<'py>(
     // Refused from the shape, then copied (a MemoryError for a huge one), then scanned: the
     // scan came first, over the view with the GIL held: a broadcast (1, 2**40, 3) image kept
     // the process reading 3.3e12 values, deaf to Ctrl-C, before the kernel's size check.
-    stereovision_core::image::check_index_range_within(
+    crate::errors::check_size(
         w,
         h,
         stereovision_core::segment::GRAPH_MAX_PIXELS,
-    )
-    .map_err(|e| PyValueError::new_err(format!("image: {e}")))?;
+        "image",
+        "image",
+    )?;
     let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         if img.iter().any(|v| !v.is_finite()) {
@@ -72,7 +74,7 @@ pub fn plane_fill<'py>(
     let (h, w) = a.dim();
     // The kernel lists pixels and counts them in u32, and has no check of its own: refused
     // from the shape, before the arrays are copied.
-    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
+    crate::errors::check_size(w, h, MAX_PIXELS, "disp", "map")?;
     if labels.as_array().dim() != (h, w) {
         return Err(PyValueError::new_err(format!(
             "labels: expected shape ({h}, {w}) like disp, got {:?}",
@@ -133,7 +135,7 @@ pub fn quantised_regions<'py>(
     // The kernel's size check came after the copy: a broadcast 65536 x 65536 image was a
     // 12 GiB MemoryError (a (1, 2**31 + 1) one 2 GiB copied in 7 s) before the size's
     // ValueError. Refused from the shape now, as `graph_segments` and `plane_fill` do.
-    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
+    crate::errors::check_size(w, h, MAX_PIXELS, "image", "image")?;
     let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         guard("quantised_regions", || {
@@ -167,7 +169,7 @@ pub fn fill_planes<'py>(
     non_negative("max_residual", max_residual)?;
     // The kernel (`quantised_regions`) refused the size only after the image and the map were
     // copied (a 12 GiB MemoryError for a broadcast 65536 x 65536 pair): from the shape now.
-    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
+    crate::errors::check_size(w, h, MAX_PIXELS, "image", "image")?;
     let img = row_major(&image, "image")?;
     let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("fill_planes", || {
