@@ -2105,3 +2105,18 @@ def test_from_file_refuses_a_bytes_path_naming_the_argument(tmp_path):
         f"path: expected a str or os.PathLike file name, got the bytes "
         f"{str(tmp_path / 'calib.txt')!r}: decode it first (os.fsdecode(path))"
     )
+
+
+def test_rectify_gives_a_one_channel_image_back_in_its_shape() -> None:
+    """An (H, W, 1) pair came back (H, W) from a raw rig's rectify (cv2.remap drops the channel
+    axis) but (H, W, 1) from a rectified rig's, though rectify says same shapes as the inputs:
+    it is (H, W, 1) both ways, the values those of the (H, W) pair's."""
+    c = raw_calib()
+    rng = np.random.default_rng(7)
+    left = rng.integers(0, 256, (SIZE[1], SIZE[0]), dtype=np.uint8)
+    right = rng.integers(0, 256, (SIZE[1], SIZE[0]), dtype=np.uint8)
+    flat = c.rectify(left, right)
+    for out, grey in zip(c.rectify(left[:, :, None], right[:, :, None]), flat, strict=True):
+        assert out.shape == (SIZE[1], SIZE[0], 1) and out.dtype == np.uint8
+        np.testing.assert_array_equal(out[:, :, 0], grey)
+    assert rect_calib().rectify(left[:, :, None], right)[0].shape == (SIZE[1], SIZE[0], 1)

@@ -843,9 +843,10 @@ class Calibration:
         m1x, m1y, m2x, m2y = self._maps(alpha)
         from stereovision._validate import remap_image
 
+        # cv2.remap drops the channel axis of an (H, W, 1) image: given back in its own shape
         return (
-            remap_image(la, m1x, m1y, cv2.INTER_LINEAR),
-            remap_image(ra, m2x, m2y, cv2.INTER_LINEAR),
+            remap_image(la, m1x, m1y, cv2.INTER_LINEAR).reshape(la.shape),
+            remap_image(ra, m2x, m2y, cv2.INTER_LINEAR).reshape(ra.shape),
         )
 
     def rectify_points(self, points: npt.ArrayLike, side: str = "left", alpha: float = 0.0) -> F64:
