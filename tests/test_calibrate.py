@@ -2556,3 +2556,27 @@ def test_mutation_audit_tilt_spread_sign_and_a_spread_past_the_warning() -> None
         cal, rep = calibrate(left, right, pattern=SYN_PATTERN, square_size=SYN_SQUARE)
     assert not any("degrees apart" in w for w in rep.warnings)
     assert cal.K1[0, 0] == pytest.approx(SYN_K1[0, 0], rel=0.02)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_an_image_that_is_a_fifo_or_a_broken_link_is_said_as_io_says_it(tmp_path: Path) -> None:
+    """A FIFO among the images (a capture script's pipe matched by the glob) was 'image file
+    not found', a file that is there; a link whose target moved was said without the link.
+    Both are said in imread's words now, before any image is read."""
+    blank = np.full((48, 64), 128, np.uint8)
+    images = []
+    for i in range(3):
+        cv2.imwrite(str(tmp_path / f"{i}.png"), blank)
+        images.append(tmp_path / f"{i}.png")
+    os.mkfifo(tmp_path / "pipe.png")
+    with pytest.raises(ValueError, match=r"^image file is not a regular file: .*pipe\.png$"):
+        calibrate(images, [*images[:2], tmp_path / "pipe.png"], square_size=1.0)
+    (tmp_path / "moved.png").symlink_to(tmp_path / "gone.png")
+    with pytest.raises(
+        FileNotFoundError,
+        match=r"^image file not found: .*moved\.png \(a link to .*gone\.png, which does not "
+        r"exist\)$",
+    ):
+        calibrate([tmp_path / "moved.png", *images[1:]], images, square_size=1.0)
+    with pytest.raises(FileNotFoundError, match=r"^image file not found: .*nothing\.png$"):
+        calibrate([tmp_path / "nothing.png", *images[1:]], images, square_size=1.0)

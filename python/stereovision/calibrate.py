@@ -1544,7 +1544,10 @@ def calibrate(
         if isinstance(item, (str, os.PathLike)) and not Path(item).is_file():
             if Path(item).is_dir():
                 raise ValueError(f"{item}: is a folder, not an image file; list its images")
-            raise FileNotFoundError(f"image file not found: {item}")
+            # in imread's words: a FIFO was "not found", a link whose target moved said bare
+            from stereovision.io import _existing_file
+
+            _existing_file(item, "image file")
 
     first_gray: np.ndarray | None = None
     for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
