@@ -1090,9 +1090,9 @@ def test_too_few_boards_among_the_pairs_max_pairs_kept_names_the_ones_it_left_ou
     assert main([*argv, "--max-pairs", "3", "-o", str(tmp_path / "c.yaml")]) == 2
     assert capsys.readouterr().err == (
         "stereovision: error: the chessboard 9x6 inner corners was found in both images of only "
-        "2 of 3 pairs; at least 3 are needed (rejected: left07.jpg / right07.jpg); --max-pairs 3 "
-        "left out 10 of the 13 pairs given before the board was looked for (a larger --max-pairs "
-        "looks at them)\n"
+        "2 of 3 pairs; at least 3 are needed (rejected: left07.jpg / right07.jpg: board not "
+        "found in right); --max-pairs 3 left out 10 of the 13 pairs given before the board was "
+        "looked for (a larger --max-pairs looks at them)\n"
     )
     assert not (tmp_path / "c.yaml").exists()
 
@@ -1881,7 +1881,10 @@ def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: P
         (tmp_path / side).mkdir()
         for i in range(3):
             cv2.imwrite(str(tmp_path / side / f"{i:02d}.png"), blank)
-    with pytest.raises(ValueError, match=r"\(rejected: 00\.png, 01\.png, 02\.png\)$"):
+    with pytest.raises(
+        ValueError,
+        match=r"\(rejected: 00\.png, 01\.png, 02\.png: board not found in either image\)$",
+    ):
         calibrate(
             sorted((tmp_path / "l").glob("*.png")),
             sorted((tmp_path / "r").glob("*.png")),
@@ -2058,7 +2061,8 @@ def test_a_repeated_pair_is_used_once_and_does_not_make_up_the_pairs_needed(
         pytest.raises(
             ValueError,
             match=r"was found in both images of only 2 of 4 pairs \(2 more repeat an earlier "
-            r"pair\); at least 3 are needed \(rejected: 02:left01\.jpg / right01\.jpg, ",
+            r"pair\); at least 3 are needed \(rejected: 02:left01\.jpg / right01\.jpg: the same "
+            r"board corners as 00:left01\.jpg / right01\.jpg in both images \(a repeated pair\); ",
         ),
     ):
         calibrate(left[:2] * 2, right[:2] * 2, square_size=1.0)
@@ -2580,3 +2584,20 @@ def test_an_image_that_is_a_fifo_or_a_broken_link_is_said_as_io_says_it(tmp_path
         calibrate([tmp_path / "moved.png", *images[1:]], images, square_size=1.0)
     with pytest.raises(FileNotFoundError, match=r"^image file not found: .*nothing\.png$"):
         calibrate([tmp_path / "nothing.png", *images[1:]], images, square_size=1.0)
+
+
+def test_too_few_pairs_says_why_each_pair_was_rejected() -> None:
+    """Boards seen by the left camera only (the right one's view blocked) were refused as
+    '(rejected: a, b, c)', the names alone: nothing said the right camera never saw the board.
+    The rejected pairs are grouped by their reasons, as the report says them."""
+    K = np.array([[300.0, 0.0, 160.0], [0.0, 300.0, 120.0], [0.0, 0.0, 1.0]])
+    board = render_chessboard(
+        K, np.zeros(5), [0.2, -0.1, 0.0], [-4.0, -2.5, 14.0], image_size=(320, 240)
+    )
+    blank = np.full((240, 320), 60, np.uint8)
+    with pytest.raises(
+        ValueError,
+        match=r"only 0 of 3 pairs; at least 3 are needed \(rejected: a, b: board not found in "
+        r"right; c: board not found in either image\)$",
+    ):
+        calibrate([board, board, blank], [blank] * 3, square_size=1.0, names=["a", "b", "c"])

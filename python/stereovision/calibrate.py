@@ -1377,6 +1377,15 @@ def _check_pairing(
     )
 
 
+def _rejected_words(rejected: dict[str, str]) -> str:
+    """The rejected pairs of a refusal, grouped by why: 'board not found in right' was left
+    unsaid, the pairs' names alone giving no clue that one camera never saw the board."""
+    groups: dict[str, list[str]] = {}
+    for name, why in rejected.items():
+        groups.setdefault(why, []).append(name)
+    return "; ".join(f"{', '.join(names)}: {why}" for why, names in groups.items())
+
+
 def _first_shown(names: Sequence[str]) -> str:
     """The first :data:`WORST_PAIRS_SHOWN` of ``names``, and how many more there are."""
     shown = ", ".join(names[:WORST_PAIRS_SHOWN])
@@ -1719,7 +1728,7 @@ def calibrate(
             + (f" ({len(repeats)} more repeat an earlier pair)" if repeats else "")
             + f"; at least {MIN_PAIRS} are needed"
             + (f"; {board_hint}" if board_hint else "")
-            + (f" (rejected: {', '.join(rejected)})" if rejected else "")
+            + (f" (rejected: {_rejected_words(rejected)})" if rejected else "")
         )
 
     gap = max(float(np.abs(corners_l[i] - corners_r[i]).max()) for i in used)  # type: ignore[operator]
@@ -1746,7 +1755,7 @@ def calibrate(
         if len(used) < MIN_PAIRS:
             raise ValueError(
                 f"only {len(used)} pairs can start the fisheye solver; at least {MIN_PAIRS} are "
-                f"needed (rejected: {', '.join(rejected)})"
+                f"needed (rejected: {_rejected_words(rejected)})"
             )
     outliers: list[str] = []
     for rnd in range(MAX_OUTLIER_ROUNDS + 1):
