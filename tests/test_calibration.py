@@ -2120,3 +2120,26 @@ def test_rectify_gives_a_one_channel_image_back_in_its_shape() -> None:
         assert out.shape == (SIZE[1], SIZE[0], 1) and out.dtype == np.uint8
         np.testing.assert_array_equal(out[:, :, 0], grey)
     assert rect_calib().rectify(left[:, :, None], right)[0].shape == (SIZE[1], SIZE[0], 1)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_a_folder_whose_calibration_is_a_fifo_says_so(tmp_path: Path) -> None:
+    """A scene folder whose Q.dat (or calib.txt, or a ROS left.yaml/right.yaml) is a FIFO or a
+    folder was said to be 'a folder without left.yaml and right.yaml (ROS camera_info),
+    calib.txt or Q.dat', a file the user could see there; it is said not to be a file, as the
+    file given alone is. Nothing is opened: a FIFO read would block."""
+    for names in (("Q.dat",), ("calib.txt",), ("left.yaml", "right.yaml")):
+        folder = tmp_path / names[0].replace(".", "_")
+        folder.mkdir()
+        for name in names:
+            os.mkfifo(folder / name)
+        with pytest.raises(
+            ValueError, match=rf"^calibration path is not a file: {re.escape(str(folder))}/"
+        ):
+            Calibration.from_file(folder)
+    (tmp_path / "dir" / "calib.txt").mkdir(parents=True)
+    with pytest.raises(ValueError, match=r"^calibration path is not a file: .*dir/calib\.txt$"):
+        Calibration.from_file(tmp_path / "dir")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match=r"is a folder without left\.yaml and right\.yaml"):
+        Calibration.from_file(tmp_path / "empty")

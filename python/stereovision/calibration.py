@@ -1581,6 +1581,11 @@ class Calibration:
                     _scene_image_size(q) if image_size is None else image_size,
                     unit=unit or "m",
                 )
+            # a FIFO or a device under one of those names: it is there, but not a file ("a
+            # folder without ... Q.dat" sent the user looking for a file they could see)
+            for name in ("left.yaml", "right.yaml", "left.yml", "right.yml", "calib.txt", "Q.dat"):
+                if (p / name).exists() and not (p / name).is_file():
+                    raise ValueError(f"calibration path is not a file: {p / name}")
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
                 "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
