@@ -2143,3 +2143,22 @@ def test_a_folder_whose_calibration_is_a_fifo_says_so(tmp_path: Path) -> None:
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match=r"is a folder without left\.yaml and right\.yaml"):
         Calibration.from_file(tmp_path / "empty")
+
+
+def test_describe_refuses_depths_without_a_depth_step() -> None:
+    """describe(depths=...) said a negative depth's step ('at -1 m 2.3 cm'), NaN's ('at nan m
+    none'), an empty tuple as a line without steps, and one number was TypeError "'float'
+    object is not iterable"; each is a ValueError naming depths, the default unchanged."""
+    c = rect_calib()
+    assert c.describe((1.0, 2)).splitlines() == c.describe((1.0, 2.0)).splitlines()
+    for bad, said in (
+        ((-1.0,), r"depths: expected a positive finite number, got -1\.0"),
+        ((float("nan"),), r"depths: expected a positive finite number, got nan"),
+        ((0.0, 1.0), r"depths: expected a positive finite number, got 0\.0"),
+        ((), r"depths: expected at least one depth in metres, got none"),
+        (5.0, r"depths: expected a sequence of depths in metres, got 5\.0"),
+        ("5", r"depths: expected a sequence of depths in metres, got '5'"),
+    ):
+        with pytest.raises(ValueError, match=rf"^{said}$"):
+            c.describe(bad)  # type: ignore[arg-type]
+    assert "at 1 m " in c.describe()

@@ -20,7 +20,7 @@ import math
 import os
 import re
 import reprlib
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1009,7 +1009,20 @@ class Calibration:
         -------
         str
             Lines for a terminal or a log.
+
+        Raises
+        ------
+        ValueError
+            If ``depths`` is not one or more positive finite numbers, or the rig is vertical (as
+            :meth:`rectified_calibration`).
         """
+        # a negative depth was said to have a step ("at -1 m 2.3 cm"), NaN "at nan m none", no
+        # depth an empty list, and one number TypeError "'float' object is not iterable"
+        if isinstance(depths, (str, bytes)) or not isinstance(depths, Iterable):
+            raise ValueError(f"depths: expected a sequence of depths in metres, got {depths!r}")
+        depths = tuple(positive_finite(z, "depths") for z in depths)
+        if not depths:
+            raise ValueError("depths: expected at least one depth in metres, got none")
         rc = self if self.rectified else self.rectified_calibration()
         w, h = self.image_size
         f, fy = float(rc.K1[0, 0]), float(rc.K1[1, 1])
