@@ -650,6 +650,29 @@ def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
     )
 
 
+def test_gui_main_says_warnings_and_a_path_with_a_newline_in_one_line_as_the_cli(capsys, tmp_path):
+    """``python -m stereovision.gui`` said a calibration's warning as Python does (``<frozen
+    runpy>:88: UserWarning: baseline ...``, no "stereovision: warning:") and cut an error at a
+    newline in a path given (``left source not found: a``), where ``stereovision gui`` says
+    both in one line. It now runs the command as the CLI does."""
+    import stereovision.gui as gui
+
+    calib = tmp_path / "calib.txt"  # a 9 km baseline: warned of, then the camera is refused
+    calib.write_text(
+        "cam0=[700 0 300; 0 700 200; 0 0 1]\ncam1=[700 0 300; 0 700 200; 0 0 1]\n"
+        "doffs=0\nbaseline=9000000\nwidth=600\nheight=400\n"
+    )
+    left = str(tmp_path / "a\nb.avi")
+    argv = ["--no-browser", "--calib", str(calib), "--left", left, "--right", left]
+    assert gui.main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    lines = err.splitlines()
+    assert len(lines) == 2, err
+    assert lines[0].startswith("stereovision: warning: baseline 9e+06 mm = 9000 m, longer")
+    assert lines[1] == f"stereovision: error: left source not found: {tmp_path}/a\\nb.avi"
+
+
 def test_scaled_calibration_and_compute_view():
     from stereovision.gui.app import compute_view, draw_matches
 

@@ -2609,6 +2609,14 @@ def _main(argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    return run_parsed(args)
+
+
+def run_parsed(args: argparse.Namespace) -> int:
+    """Run the command ``args.func`` with its parsed ``args`` as the CLI does: warnings and
+    errors in one line each (the paths given shown escaped), SIGTERM as :class:`Terminated`;
+    returns the exit status. Also ``python -m stereovision.gui``'s, which said its warnings
+    as Python does (``<frozen runpy>:88: UserWarning: ...``) and cut a path at its newline."""
     with warnings.catch_warnings():
         # Each run shows its warnings afresh (setting a filter resets the registry that would
         # hide a message already shown by an earlier call in the same process).

@@ -444,34 +444,10 @@ def _main(argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return 130
-    from stereovision._interrupt import Terminated, raise_terminated
-    from stereovision._validate import BUG_ERRORS, internal_error
+    from stereovision.cli import run_parsed
 
-    # SIGTERM as the CLI takes it (Terminated): it killed the process where the page's work is
-    # stopped and the camera closed on Ctrl+C
-    main_thread = threading.current_thread() is threading.main_thread()
-    kept = signal.signal(signal.SIGTERM, raise_terminated) if main_thread else None
-    try:
-        return cmd_gui(args)
-    except Terminated:  # as the CLI
-        print("stereovision: terminated (SIGTERM)", file=sys.stderr)
-        return 143
-    except KeyboardInterrupt:  # as the CLI: a word, where this said nothing
-        print("stereovision: interrupted", file=sys.stderr)
-        return 130
-    except BUG_ERRORS as exc:  # RuntimeErrors, but a bug of ours: said as the CLI says them
-        print(internal_error(exc), file=sys.stderr)
-        return 2
-    # ImportError: an optional package missing (rosbags for --from-bag), said with its pip line;
-    # MemoryError: as the CLI, one line for a frame size too large to allocate
-    except (ValueError, OSError, RuntimeError, ImportError, MemoryError) as exc:
-        from stereovision._validate import first_line
-
-        print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
-        return 2
-    except Exception as exc:  # a bug of ours: one line, as the CLI, not a traceback
-        print(internal_error(exc), file=sys.stderr)
-        return 2
-    finally:
-        if kept is not None:
-            signal.signal(signal.SIGTERM, kept)
+    # run as the CLI runs a command: its one-line errors and warnings (a calibration's warning
+    # came out as Python's "<frozen runpy>:88: UserWarning: ..."; a path given with a newline
+    # was cut there), SIGTERM as Terminated (143)
+    args.func = cmd_gui
+    return run_parsed(args)
