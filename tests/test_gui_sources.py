@@ -91,6 +91,35 @@ def test_roots_are_resolved_deduplicated_and_checked(data: Path, tmp_path: Path)
         AllowedFolders([data / "nothing"])
 
 
+@pytest.mark.parametrize("given", ["", " "])
+def test_an_empty_data_folder_is_refused_not_taken_for_the_current_one(
+    given: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``gui --data ""`` (an unset shell variable: ``--data "$SCENES"``) allowed the current
+    folder: the page listed and opened its files and saved into it. It is refused, one line
+    before anything is opened or served."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ValueError, match=rf"^data folder: expected a folder, got {given!r}$"):
+        AllowedFolders([given])
+    from stereovision.gui import main
+
+    assert main(["--data", given, "--no-browser", "--port", "0"]) == 2
+    assert capsys.readouterr() == (
+        "",
+        f"stereovision: error: data folder: expected a folder, got {given!r}\n",
+    )
+
+
+def test_a_data_folder_under_an_unknown_users_home_is_said_as_such() -> None:
+    """``gui --data ~nobody-such/scenes`` (the shell leaves an unknown user's ``~`` as typed)
+    said Python's 'Could not determine home directory.', naming neither the folder nor why."""
+    with pytest.raises(
+        ValueError,
+        match=r"^no home folder is known for ~nobody-such/scenes \(no user nobody-such is known\)",
+    ):
+        AllowedFolders(["~nobody-such/scenes"])
+
+
 def test_resolve_accepts_the_root_and_refuses_nul_and_rootless(data: Path) -> None:
     folders = AllowedFolders([data])
     assert folders.resolve(data) == data.resolve()

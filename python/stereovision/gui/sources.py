@@ -136,12 +136,21 @@ class AllowedFolders:
     ------
     FileNotFoundError
         If a root is not an existing folder.
+    ValueError
+        If a root is empty or blank, or under the home folder of a user no one knows.
     """
 
     def __init__(self, roots: Iterable[str | os.PathLike[str]]) -> None:
         resolved: list[Path] = []
         for r in roots:
-            p = Path(r).expanduser()
+            text = os.fspath(r)
+            if not text.strip():
+                # an unset shell variable (--data "$SCENES") was the current folder: the page
+                # listed, opened and saved into wherever the command was started
+                raise ValueError(f"data folder: expected a folder, got {text!r}")
+            # ~bob/x of an unknown user: said as the page says it (not "Could not determine
+            # home directory.")
+            p = expand_home(text)
             if not p.is_dir():  # a file that is there was said only as "not found"
                 there = " is a file, not a folder" if p.exists() else ""
                 raise FileNotFoundError(f"data folder not found: {r}{there}")
