@@ -58,6 +58,24 @@ def test_display_path_without_a_home_folder(monkeypatch: pytest.MonkeyPatch) -> 
     assert display_path("/srv/y", cwd=Path("/srv")) == "y"
 
 
+def test_display_path_in_a_removed_current_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``stereovision gui --data ~/scenes`` run from a folder since removed (a shell left in a
+    build folder made again) stopped at start-up with 'error: [Errno 2] No such file or
+    directory', naming nothing: the save field's path was shown relative to the current
+    folder, which has none. It is shown ``~``-abbreviated or whole."""
+    gone = tmp_path / "build"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert display_path(tmp_path / "home" / "scenes" / "saved") == "~/scenes/saved"
+    assert display_path(tmp_path / "data" / ".." / "saved") == str(tmp_path / "saved")
+    folders = AllowedFolders([tmp_path])
+    assert folders.roots == (tmp_path.resolve(),)
+
+
 # ----------------------------------------------------------------------------- AllowedFolders
 
 

@@ -86,10 +86,19 @@ def display_path(
     >>> display_path("/mnt/x", cwd=Path("/srv"), home=Path("/home/me"))
     '/mnt/x'
     """
-    cwd = Path.cwd() if cwd is None else cwd
-    p = Path(os.path.abspath(cwd / Path(path)))
-    if p.is_relative_to(cwd) and cwd != Path(cwd.anchor):  # not "tmp/..." from "/"
-        return p.relative_to(cwd).as_posix()
+    if cwd is None:
+        try:
+            cwd = Path.cwd()
+        except OSError:
+            # the current folder was removed (a shell left in a build folder made again): the
+            # GUI stopped at start-up with "[Errno 2] No such file or directory", naming nothing
+            cwd = None
+    if cwd is None:
+        p = Path(os.path.normpath(path))
+    else:
+        p = Path(os.path.abspath(cwd / Path(path)))
+        if p.is_relative_to(cwd) and cwd != Path(cwd.anchor):  # not "tmp/..." from "/"
+            return p.relative_to(cwd).as_posix()
     try:
         home = Path.home() if home is None else home
     except RuntimeError:  # no home folder known
