@@ -6714,6 +6714,56 @@ def test_a_topic_without_a_bag_is_refused_before_the_server_starts(
     assert capsys.readouterr() == ("", f"stereovision: error: {said}\n")
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="V4L2 device nodes")
+@pytest.mark.parametrize(("left", "right"), [("3", "3"), ("3", "/dev/video3")])
+def test_one_camera_given_twice_is_refused_as_capture_refuses_it(
+    capsys: pytest.CaptureFixture[str], left: str, right: str
+) -> None:
+    """``gui --left 3 --right 3`` (or ``/dev/video3``) opened the camera twice, the second open
+    failing with a hint about another program using it, where capture and stream refuse it
+    before any open: refused now in their words, one line, exit 2."""
+    import stereovision.gui as gui
+
+    assert gui.main(["--left", left, "--right", right, "--no-browser", "--port", "0"]) == 2
+    assert capsys.readouterr() == (
+        "",
+        f"stereovision: error: --left {left!r} and --right {right!r} are both camera "
+        "/dev/video3: give the rig's two cameras\n",
+    )
+
+
+def test_one_file_given_twice_is_warned_of_as_capture_does(tmp_path: Path) -> None:
+    """``gui --left l.avi --right ./l.avi`` showed every disparity 0 without a word, where
+    capture and stream warn that every pair is one view twice; the GUI warns in their words
+    (and, the warning made an error, closes the source it opened)."""
+    import warnings
+
+    import stereovision.gui as gui
+    from stereovision.gui import sources as gui_sources
+
+    video = _write_video(tmp_path / "l.avi", cv2.imread(str(CONES / "left.png")))
+    opened: list[Any] = []
+    real_open = gui_sources.open_stereo_source
+
+    def recorded(*args: Any, **kwargs: Any) -> Any:
+        opened.append(real_open(*args, **kwargs))
+        return opened[-1]
+
+    args = _gui_args("--left", str(video), "--right", f"{tmp_path}/./l.avi")
+    with pytest.MonkeyPatch.context() as mp, warnings.catch_warnings():
+        mp.setattr(gui_sources, "open_stereo_source", recorded)
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning) as said:
+            gui.build_app(args)
+    assert str(said.value) == (
+        f"--left and --right are the same source {str(video)!r}: every pair is one view twice "
+        "and every disparity comes out 0 (two cameras' views are needed)"
+    )
+    assert len(opened) == 1
+    with pytest.raises(OSError, match="closed"):
+        opened[0].read()
+
+
 def test_fail_says_a_path_with_a_newline_escaped_on_its_one_line(tmp_path):
     """_fail took the first line of the error before its path was shortened, and gave
     first_line no path: a cloud file named with a newline cut the page's error line at it

@@ -139,9 +139,39 @@ def build_app(args: argparse.Namespace) -> Any:
     label = None
     names = (str(args.left or ""), str(args.right or ""))
     if args.left is not None:
+        from stereovision.capture import _camera_device, _same_path
+        from stereovision.gui.sources import parse_source
+
+        left, right = parse_source(args.left), parse_source(args.right)
+        device = _camera_device(left)
+        if device is not None and device == _camera_device(right):
+            # refused as capture and stream refuse it: the second open failed with a hint
+            # about another program using the camera
+            raise ValueError(
+                f"--left {str(args.left)!r} and --right {str(args.right)!r} are both camera "
+                f"{device}: give the rig's two cameras"
+            )
         source = open_stereo_source(
             args.left, args.right, fourcc=getattr(args, "fourcc", None), read_timeout=read_timeout
         )
+        if _same_path(left, right):
+            # said as capture and stream say it (once the source opened: a missing one is
+            # said as such); the page showed every disparity 0 without a word
+            import warnings
+
+            from stereovision.capture import mask_url_secrets
+
+            try:
+                warnings.warn(
+                    f"--left and --right are the same source {mask_url_secrets(str(left))!r}: "
+                    "every pair is one view twice and every disparity comes out 0 (two "
+                    "cameras' views are needed)",
+                    UserWarning,
+                    stacklevel=2,
+                )
+            except BaseException:  # made an error (python -W error): the source is not used
+                source.close()
+                raise
     elif from_bag is not None:
         from stereovision.gui.sources import open_bag_source
 
