@@ -6732,6 +6732,26 @@ def test_one_camera_given_twice_is_refused_as_capture_refuses_it(
     )
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="V4L2 device nodes")
+def test_one_camera_typed_in_both_fields_is_refused_before_any_open(monkeypatch) -> None:
+    """The page's Open of camera 3 in both fields (or 3 and /dev/video3) opened it twice, the
+    second open failing with a hint about another program using the camera: refused now, as
+    gui --left/--right are, before any open (nothing is opened, the source in use stays)."""
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    opened: list[Any] = []
+    monkeypatch.setattr(capture, "StereoCamera", lambda *a, **k: opened.append(a))
+    app = _scene_app("test-one-camera-twice", [bundled_data_dir()])
+    for left, right in (("3", "3"), ("3", "/dev/video3")):
+        app.state.cam_left, app.state.cam_right = left, right
+        app.open_cameras()
+        assert app.state.error == (
+            "the left and right fields are both camera /dev/video3: give the rig's two cameras"
+        )
+    assert opened == [] and app.source is None
+
+
 def test_one_file_given_twice_is_warned_of_as_capture_does(tmp_path: Path) -> None:
     """``gui --left l.avi --right ./l.avi`` showed every disparity 0 without a word, where
     capture and stream warn that every pair is one view twice; the GUI warns in their words

@@ -2195,6 +2195,14 @@ class StereoApp:
         try:
             left = self._camera_source(self.state.cam_left)
             right = self._camera_source(self.state.cam_right)
+            device = _camera_device(left)
+            if device is not None and device == _camera_device(right):
+                # refused as gui --left/--right are: the second open failed with a hint about
+                # another program using the camera
+                raise ValueError(
+                    f"the left and right fields are both camera {device}: give the rig's two "
+                    "cameras"
+                )
             fourcc = None if self.state.fourcc == FOURCCS[0] else self.state.fourcc
             pending = [s for s in (left, right) if _pending_key(s) in self._opening]
             if pending:
