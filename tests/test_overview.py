@@ -826,3 +826,25 @@ def test_a_map_of_negative_disparities_is_coloured_by_its_values() -> None:
     assert len({tuple(c) for c in colorize(disparity, lo=0.0).reshape(-1, 3)}) > 50
     # a map reaching above the given end keeps it, as before
     assert colour_range(np.array([[-5.0, 3.0, 10.0]]), 0.0, None)[0] == 0.0
+
+
+def test_a_map_of_negative_disparities_with_a_few_positive_ones_is_coloured_by_its_values() -> None:
+    """A map of negative disparities with 5 % of its pixels at +3 px (a swapped pair's, a few
+    mismatches above 0) was coloured from the given 0 px to its 99th percentile: 95 % of it
+    at level 0, two colours in disparity.png. More than half of the map below the given end
+    takes its 1st and 99th percentiles, as a map wholly below 0 px does."""
+    from stereovision.cli import colorize
+
+    disparity = np.linspace(-40.0, -1.0, 10_000, dtype=np.float32)
+    disparity[::20] = 3.0
+    disparity = disparity.reshape(100, 100)
+    lo, hi = colour_range(disparity, 0.0, None)
+    assert (lo, hi) == pytest.approx(
+        (float(np.percentile(disparity, 1)), float(np.percentile(disparity, 99)))
+    )
+    assert np.mean(colour_levels(disparity, lo, hi) == 0) < 0.02
+    assert len({tuple(c) for c in colorize(disparity, lo=0.0).reshape(-1, 3)}) > 200
+    # half of the map at or above the given end keeps it (a disparity map's few negative
+    # sub-pixel values, or a half-empty one)
+    assert colour_range(np.array([[-5.0, -4.0, 0.0, 10.0]]), 0.0, None)[0] == 0.0
+    assert colour_range(np.array([[-5.0, -4.0, -3.0, 10.0]]), 0.0, None)[0] < 0.0

@@ -8,8 +8,9 @@ values between them, under a one-line title (pair, method, range, density). The 
 beside the bars is as wide as its longest label (``cv2.getTextSize``; ``"116123 mm"``), 64 px at
 least; an inner label keeps a digit's height of blank rows from an end's (:data:`_END_GAP`).
 The maps are coloured exactly as ``disparity.png`` and ``depth.png`` are (:func:`colour_range`):
-the disparity from 0 px to its 99th percentile, the depth on its inverse (near = warm) from the
-1st to the 99th percentile of ``1 / Z``, so the depth bar's ticks are not evenly spaced.
+the disparity from 0 px (its 1st percentile when most of it is below 0 px) to its 99th
+percentile, the depth on its inverse (near = warm) from the 1st to the 99th percentile of
+``1 / Z``, so the depth bar's ticks are not evenly spaced.
 """
 
 from __future__ import annotations
@@ -63,8 +64,9 @@ def colour_range(
         The map (NaN = none).
     lo, hi : float, optional
         Given ends; a missing one is the 1st (``lo``) or 99th (``hi``) percentile of the finite
-        values. When that percentile is not past the given end (``lo=0`` for a map of negative
-        disparities: a swapped pair's), both ends are the percentiles.
+        values. When that percentile is not past the given end, or more than half of the
+        finite values lie beyond the given end (``lo=0`` for a map of negative disparities: a
+        swapped pair's, with or without a few positive outliers), both ends are the percentiles.
 
     Returns
     -------
@@ -78,9 +80,12 @@ def colour_range(
     given = (lo, hi)
     lo = float(np.percentile(v, 1)) if lo is None else float(lo)
     hi = float(np.percentile(v, 99)) if hi is None else float(hi)
-    if hi <= lo and None in given:
-        # the given end above the map's values (below them for hi): the map was one colour,
-        # its bar labelled upside down (top -12 px, bottom 0 px)
+    # the given end past most of the map's values: a map of negative disparities (a swapped
+    # pair's) from a given 0 px was one colour, its bar upside down (top -12 px, bottom 0 px),
+    # and so was one with a few positive outliers (95 % of its pixels at level 0)
+    beyond = given[0] is not None and np.count_nonzero(v < lo) * 2 > v.size
+    beyond |= given[1] is not None and np.count_nonzero(v > hi) * 2 > v.size
+    if None in given and (hi <= lo or beyond):
         lo, hi = float(np.percentile(v, 1)), float(np.percentile(v, 99))
     return lo, hi
 
