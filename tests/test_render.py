@@ -709,6 +709,26 @@ def test_cloud_without_colours_is_coloured_by_depth_with_a_metre_scale():
         np.testing.assert_allclose(np.median(drawn, axis=0), expected, atol=12)
 
 
+def test_the_depth_scale_of_a_millimetre_cloud_has_labels_that_differ():
+    """A cloud without colours 4-6 mm ahead (a stereo microscope's) had its depth scale
+    labelled with two decimals of a metre: "0.00 0.00 0.01 0.01 0.01". Its labels now carry
+    the decimals that tell them apart; a scene of metres keeps two."""
+    rng = np.random.default_rng(7)
+    for (z0, z1), decimals in (((0.004, 0.006), 4), ((3.0, 6.0), 2)):
+        cloud = render.point_cloud(rng.uniform([-0.001, -0.001, z0], [0.001, 0.001, z1], (500, 3)))
+        plotter = render.make_plotter((200, 150))
+        try:
+            render.add_geometry(plotter, cloud)
+            bar = plotter.scalar_bars["depth Z (m)"]
+            fmt = bar.GetLabelFormat()
+            lo, hi = bar.GetLookupTable().GetRange()
+        finally:
+            plotter.close()
+        assert fmt == f"%.{decimals}f"
+        labels = [fmt % v for v in np.linspace(lo, hi, 5)]
+        assert len(set(labels)) == 5, labels
+
+
 def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):
     """``view SCENE -o SCENE/left.png`` computed the depth map, then replaced the scene's left
     image with the screenshot without a word."""
