@@ -1099,3 +1099,21 @@ def test_features_of_a_large_image_are_at_its_pixel_centres() -> None:
     pl, _ = _features(large)
     assert len(ps) > 100
     np.testing.assert_allclose(pl, (ps + 0.5) * 2 - 0.5, atol=1e-9)
+
+
+def test_a_12_bit_pair_in_16_bits_is_checked_on_its_features(data_dir: Path) -> None:
+    """A 12-bit camera's pair in uint16 (0-4095) was cut to 8 bits as 16-bit data: 0-16 grey
+    levels, no SIFT feature, and the check said "cannot tell, only 0 feature matches (...
+    point the cameras at something textured)" of the textured cones. A dark pair is now
+    stretched by one gain first, as depth_map's automatic range stretches it: the same
+    verdict as the 8-bit pair, and the rows 1 px apart still found."""
+    left, right = (
+        cv2.cvtColor(im, cv2.COLOR_BGR2GRAY) for im in _pair(data_dir, "middlebury2003/cones")
+    )
+    eight = check_rectification(left, right)
+    twelve = [((im.astype(np.int64) * 4095 + 127) // 255).astype(np.uint16) for im in (left, right)]
+    res = check_rectification(*twelve)
+    assert res.ok is True and res.matches >= 0.8 * eight.matches
+    assert res.median_dy < 0.3 and res.offset == pytest.approx(eight.offset, abs=0.1)
+    low = check_rectification(twelve[0], _warp(twelve[1], np.float32([[1, 0, 0], [0, 1, 1.0]])))
+    assert low.ok is False and low.offset - res.offset == pytest.approx(-1.0, abs=0.15)

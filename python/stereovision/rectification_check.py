@@ -218,7 +218,9 @@ def check_rectification(
     ----------
     left, right : array_like
         A raw pair (rectified with ``calib`` first) or, without ``calib``, a rectified pair;
-        grey or colour, any dtype the package reads.
+        grey or colour, any dtype the package reads. A dark pair (brightest grey under a
+        quarter of the range: a 12-bit camera's data in 16 bits) is stretched by one gain
+        for its features.
     calib : Calibration, optional
         The rig's calibration; omit it for a pair that is already rectified.
     tolerance : float
@@ -253,7 +255,7 @@ def check_rectification(
     if calib is not None:
         _require_type(calib, "Calibration", "calib")
         left, right = calib.rectify(left, right, alpha=alpha)
-    gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
+    gl, gr = _grey_pair(left, right)
     if gl.shape != gr.shape:
         (hl, wl), (hr, wr) = gl.shape, gr.shape
         raise ValueError(
@@ -271,6 +273,25 @@ def check_rectification(
     xl, yl = pl[pairs[:, 0]].T
     xr, yr = pr[pairs[:, 1]].T
     return _judge_rows(np.column_stack([xl, yl, xr, yr]), w, h, tol)
+
+
+def _grey_pair(
+    left: npt.ArrayLike, right: npt.ArrayLike
+) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+    """The pair's 8-bit grey images for SIFT; a dark pair (a 12-bit camera's data in 16 bits)
+    stretched by one gain, as ``depth_map``'s automatic range stretches it: cut to 8 bits it
+    kept 0-16 grey levels, no features, and the check said "cannot tell, only 0 feature
+    matches (... point the cameras at something textured)" of a textured pair."""
+    from stereovision._validate import as_gray_float
+    from stereovision.depth import _DARK_PAIR
+
+    fl = as_gray_float(left, "left", warn=False)
+    fr = as_gray_float(right, "right", warn=False)
+    top = max(float(fl.max()), float(fr.max())) if fl.shape == fr.shape else 1.0
+    if not 0.0 < top < _DARK_PAIR:  # the others as before: OpenCV's grey of an 8-bit image
+        return as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
+    gain = np.float32(255.0 / top)
+    return np.rint(fl * gain).astype(np.uint8), np.rint(fr * gain).astype(np.uint8)
 
 
 def _judge_rows(quad: npt.NDArray[np.float64], w: int, h: int, tol: float) -> RectificationCheck:
