@@ -1117,3 +1117,20 @@ def test_a_12_bit_pair_in_16_bits_is_checked_on_its_features(data_dir: Path) -> 
     assert res.median_dy < 0.3 and res.offset == pytest.approx(eight.offset, abs=0.1)
     low = check_rectification(twelve[0], _warp(twelve[1], np.float32([[1, 0, 0], [0, 1, 1.0]])))
     assert low.ok is False and low.offset - res.offset == pytest.approx(-1.0, abs=0.15)
+
+
+def test_the_plot_of_a_12_bit_pair_shows_its_images(data_dir: Path) -> None:
+    """draw_rectification_check drew a 12-bit pair in uint16 as 16-bit data: grey levels 0-16
+    dimmed to 0-11, a black picture under the check's dots. It is stretched by the check's
+    gain (its brightest grey to white): the 8-bit pair's picture, as bright within a third."""
+    from stereovision.rectification_check import draw_rectification_check
+
+    left, right = (im[:120, :160] for im in _pair(data_dir, "middlebury2003/cones"))
+    twelve = [((im.astype(np.int64) * 4095 + 127) // 255).astype(np.uint16) for im in (left, right)]
+    empty = _judge_rows(np.zeros((0, 4)), 160, 120, 0.5)
+    eight_plot = draw_rectification_check(left, right, empty).astype(int)
+    plot = draw_rectification_check(*twelve, empty).astype(int)
+    assert plot.shape == eight_plot.shape
+    pair, eight_pair = plot[-120:], eight_plot[-120:]  # below the summary band
+    assert abs(np.median(pair) - np.median(eight_pair)) < np.median(eight_pair) / 3
+    assert np.corrcoef(pair.ravel(), eight_pair.ravel())[0, 1] > 0.99

@@ -282,16 +282,25 @@ def _grey_pair(
     stretched by one gain, as ``depth_map``'s automatic range stretches it: cut to 8 bits it
     kept 0-16 grey levels, no features, and the check said "cannot tell, only 0 feature
     matches (... point the cameras at something textured)" of a textured pair."""
+    fl, fr, gain = _dark_pair_gain(left, right)
+    if gain is None:  # the others as before: OpenCV's grey of an 8-bit image
+        return as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
+    gain = np.float32(255.0 * gain)
+    return np.rint(fl * gain).astype(np.uint8), np.rint(fr * gain).astype(np.uint8)
+
+
+def _dark_pair_gain(
+    left: npt.ArrayLike, right: npt.ArrayLike
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], np.float32 | None]:
+    """The pair's grey images in [0, 1] and the gain that brings its brightest grey to 1 when
+    the pair is dark (under ``depth._DARK_PAIR`` of the range); None for the others."""
     from stereovision._validate import as_gray_float
     from stereovision.depth import _DARK_PAIR
 
     fl = as_gray_float(left, "left", warn=False)
     fr = as_gray_float(right, "right", warn=False)
     top = max(float(fl.max()), float(fr.max())) if fl.shape == fr.shape else 1.0
-    if not 0.0 < top < _DARK_PAIR:  # the others as before: OpenCV's grey of an 8-bit image
-        return as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
-    gain = np.float32(255.0 / top)
-    return np.rint(fl * gain).astype(np.uint8), np.rint(fr * gain).astype(np.uint8)
+    return fl, fr, np.float32(1.0 / top) if 0.0 < top < _DARK_PAIR else None
 
 
 def _judge_rows(quad: npt.NDArray[np.float64], w: int, h: int, tol: float) -> RectificationCheck:
@@ -383,8 +392,9 @@ def draw_rectification_check(
 ) -> npt.NDArray[np.uint8]:
     """The rectified pair side by side with the check's matches, coloured by their row error.
 
-    Each match is a dot in both images, green where ``|dy|`` is within the tolerance, yellow up
-    to 3 times it, red beyond; in the left image a tick from the dot shows ``10 dy`` (where the
+    Each match is a dot in both images (a dark pair stretched as :func:`check_rectification`
+    stretches it), green where ``|dy|`` is within the tolerance, yellow up to 3 times it, red
+    beyond; in the left image a tick from the dot shows ``10 dy`` (where the
     right image has the feature, ten times magnified). Faint lines every 40 px mark rows.
 
     Parameters
@@ -404,9 +414,18 @@ def draw_rectification_check(
     ValueError
         Images that are not images, or of different sizes.
     """
-    from stereovision._validate import as_bgr_uint8
+    from stereovision._validate import _to_unit_float, as_bgr_uint8
 
-    lb, rb = as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right")
+    gain = _dark_pair_gain(left, right)[2]
+    if gain is None:
+        lb, rb = as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right")
+    else:
+        # a dark pair (12-bit data in 16 bits) drawn as it is was black; stretched by the
+        # check's gain, the picture shows what its features are on
+        lb, rb = (
+            as_bgr_uint8(np.clip(_to_unit_float(as_image_array(im, n), n, False) * gain, 0, 1), n)
+            for im, n in ((left, "left"), (right, "right"))
+        )
     if lb.shape != rb.shape:
         # NumPy's concatenation error named neither image ("along dimension 1, the array at
         # index 0 has size 120"), and a narrower right image was found only at the band
