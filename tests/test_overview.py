@@ -848,3 +848,27 @@ def test_a_map_of_negative_disparities_with_a_few_positive_ones_is_coloured_by_i
     # sub-pixel values, or a half-empty one)
     assert colour_range(np.array([[-5.0, -4.0, 0.0, 10.0]]), 0.0, None)[0] == 0.0
     assert colour_range(np.array([[-5.0, -4.0, -3.0, 10.0]]), 0.0, None)[0] < 0.0
+
+
+@pytest.mark.parametrize("title", ["night run\nleft.png | fast", "night\trun\x00left.png | fast"])
+def test_a_title_with_a_newline_or_a_nul_stays_on_its_line(title: str) -> None:
+    """cv2.putText started a second line at a newline (a folder name's) over the captions
+    under the title, which cv2.getTextSize did not measure, and ended the text at a NUL.
+    Control characters are drawn as '?', as non-ASCII ones are: one line, whole."""
+    from types import SimpleNamespace
+
+    from stereovision.overview import _TITLE_H, cv2_text
+
+    disparity = np.tile(np.linspace(1.0, 40.0, 200, dtype=np.float32), (120, 1))
+    result = SimpleNamespace(
+        disparity=disparity, depth=None, confidence=np.ones_like(disparity), left_rectified=None
+    )
+    shown = title.replace("\n", "?").replace("\t", "?").replace("\x00", "?")
+    assert cv2_text(title) == shown
+    ov = overview_image(result, title)
+    plain = overview_image(result, shown)
+    assert ov.title == shown
+    np.testing.assert_array_equal(ov.image, plain.image)
+    # below the title band, the picture of a one-word title
+    one_word = overview_image(result, "x").image
+    np.testing.assert_array_equal(ov.image[_TITLE_H:], one_word[_TITLE_H:])

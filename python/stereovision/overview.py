@@ -269,14 +269,22 @@ def _end_label(value: float, unit: str) -> str:
     return f"{figure_shown(value)} {unit}" if unit else figure_shown(value)
 
 
+#: ``str.translate`` table of :func:`cv2_text`: the ASCII control characters as ``?``.
+_CONTROL_AS_QUESTION_MARK = {c: "?" for c in (*range(32), 127)}
+
+
 def cv2_text(text: str) -> str:
-    """``text`` as OpenCV's Hershey fonts can draw it: every non-ASCII character as ``?``.
+    """``text`` as OpenCV's Hershey fonts can draw it on one line: every non-ASCII character
+    and every control character (a newline, a tab, NUL) as ``?``.
 
     The fonts have glyphs for ASCII only, and a lone surrogate --
     a file name's non-UTF-8 byte as Python decodes it (``os.fsdecode``) -- crashes
-    ``cv2.getTextSize`` and ``cv2.putText`` (a segmentation fault, not an exception).
+    ``cv2.getTextSize`` and ``cv2.putText`` (a segmentation fault, not an exception). A
+    newline (a folder name's) started a second line over the picture below the text, which
+    ``cv2.getTextSize`` does not measure, and a NUL ended the text there.
     """
-    return text.encode("ascii", "replace").decode("ascii")
+    ascii_text = text.encode("ascii", "replace").decode("ascii")
+    return ascii_text.translate(_CONTROL_AS_QUESTION_MARK)
 
 
 def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
