@@ -140,7 +140,7 @@ class CtrlC(importlib.abc.MetaPathFinder):  # one Ctrl+C, as {module} is first i
     def find_spec(self, name, path=None, target=None):
         if name == {module!r} and self in sys.meta_path:
             sys.meta_path.remove(self)
-            os.kill(os.getpid(), signal.SIGINT)
+            os.kill(os.getpid(), signal.{signal})
         return None
 
 sys.meta_path.insert(0, CtrlC())
@@ -165,9 +165,40 @@ def test_ctrl_c_in_the_start_up_imports_is_one_line_and_130(entry: str, module: 
     in 60 interrupted at random start-up times). The package imports them on first use now,
     and the entry points say the interrupt as the CLI: one line, exit 130."""
     argv = ["--version"] if entry != "python -m stereovision.gui" else ["--port", "-1"]
-    code = _CTRL_C_IN_THE_IMPORTS.format(module=module, argv=argv, run=_ENTRIES[entry])
+    code = _CTRL_C_IN_THE_IMPORTS.format(
+        module=module, argv=argv, run=_ENTRIES[entry], signal="SIGINT"
+    )
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     proc = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
     )
     assert (proc.returncode, proc.stdout, proc.stderr) == (130, "", "stereovision: interrupted\n")
+
+
+# datetime: imported by NumPy's C initialisation (an interrupt there came out as NumPy's
+# ImportError, a traceback); stereovision.depth: by the CLI's parser, after the start-up imports
+@pytest.mark.parametrize("module", ["datetime", "stereovision.depth"])
+@pytest.mark.parametrize("entry", ["stereovision", "python -m stereovision"])
+@pytest.mark.parametrize(
+    ("signame", "expected"),
+    [
+        ("SIGTERM", (143, "", "stereovision: terminated (SIGTERM)\n")),
+        ("SIGINT", (130, "", "stereovision: interrupted\n")),
+    ],
+)
+def test_a_signal_in_the_start_up_is_one_line(
+    signame: str, expected: tuple[int, str, str], entry: str, module: str
+) -> None:
+    """A SIGTERM (``kill``, systemd) in the command's first 0.3 s, its imports and its parse,
+    killed it without a word (Python's default until the CLI set its handler, after the
+    parse), and a Ctrl+C inside NumPy's C initialisation printed NumPy's ImportError. The
+    entry point takes SIGTERM as the CLI does from its first import on, and holds both until
+    the imports are whole: one line, exit 143 or 130."""
+    code = _CTRL_C_IN_THE_IMPORTS.format(
+        module=module, argv=["--version"], run=_ENTRIES[entry], signal=signame
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert (proc.returncode, proc.stdout, proc.stderr) == expected

@@ -27,7 +27,7 @@ from typing import Any, NoReturn
 import cv2
 import numpy as np
 
-from stereovision._interrupt import Terminated, raise_terminated
+from stereovision._interrupt import HeldInterrupts, Terminated, raise_terminated
 from stereovision._jsonout import json_line
 from stereovision._validate import (
     BUG_ERRORS,
@@ -2603,9 +2603,14 @@ def _main(argv: Sequence[str] | None) -> int:
     """:func:`main`'s work: parse ``argv`` and run its command."""
     try:
         # the commands' modules are imported here (0.2 s): a Ctrl-C right after the command
-        # was typed printed a traceback of the import it stopped
-        parser = build_parser()
+        # was typed printed a traceback of the import it stopped; held until they are whole
+        # (an interrupt inside a C extension's initialisation can come out as its ImportError)
+        with HeldInterrupts():
+            parser = build_parser()
         args = parser.parse_args(argv)
+    except Terminated:  # python -m stereovision's handler, set before these imports
+        print("stereovision: terminated (SIGTERM)", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
