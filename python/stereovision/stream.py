@@ -350,11 +350,13 @@ class FrameServer:
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
         # a count's rule (whole_value): np.int64(8080) read from an array was refused
+        from stereovision.cli import PORT_WORDS, check_listen_address
+
         whole = whole_value(port)
         if whole is None or not 0 <= whole <= 65535:
-            raise ValueError(f"port: expected 0 to 65535 (0 = any free port), got {port!r}")
+            # in --serve's and gui --port's words
+            raise ValueError(f"port: {PORT_WORDS}, got {port!r}")
         port = whole
-        from stereovision.cli import check_listen_address
 
         # "" is a bind's every interface (0.0.0.0), said as http://:8765/
         host = check_listen_address(host, "host")
