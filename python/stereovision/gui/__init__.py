@@ -209,7 +209,9 @@ def url_for(host: str, port: int) -> str:
     >>> url_for("::1", 8080)
     'http://[::1]:8080/'
     """
-    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
+    from stereovision.stream import _host_port  # stream --serve's rule, said once
+
+    return f"http://{_host_port(host, port)}/"
 
 
 #: What the server's libraries log when a page is closed while a message to it is being sent.
