@@ -3653,3 +3653,46 @@ def test_gui_port_and_stream_serve_refuse_a_port_in_the_same_words(
         main(["stream", "--serve", "70000"])
     err = capsys.readouterr().err
     assert f"argument --serve: {words.rstrip()}" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["depth", "left.png", "right.png", "-o", ""], "-o/--output"),
+        (["depth", "left.png", "right.png", "--calib", "", "-o", "out"], "--calib"),
+        (["batch", "", "-o", "out"], "input"),
+        (["batch", ".", "-o", ""], "-o/--output"),
+        (["eval", ".", ""], "scenes"),
+        (["bench", ""], "scenes"),
+        (["info", ""], "calib"),
+        (["view", ""], "source"),
+        (["calibrate", "--left", "", "--right", "r", "--square", "1", "-o", "r.yaml"], "--left"),
+        (["gui", "--data", ""], "--data"),
+    ],
+)
+def test_an_empty_path_is_refused_not_taken_as_the_current_folder(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    argv: list[str],
+    name: str,
+) -> None:
+    """An empty value (``batch "$DATA" -o "$OUT"`` with a variable unset) was the current
+    folder: ``batch ''`` processed the pair there, ``depth ... -o ''`` wrote its outputs there,
+    ``--calib ''`` loaded the Q.dat found there, ``info ''`` described it. argparse refuses it
+    now naming the argument, exit 2, before any work."""
+    monkeypatch.chdir(tmp_path)
+    img = np.zeros((20, 40), np.uint8)  # a scene in the current folder, which '' named
+    for side in ("left", "right"):
+        cv2.imwrite(str(tmp_path / f"{side}.png"), img)
+    (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 10 0\n")
+    before = sorted(tmp_path.iterdir())
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    assert exit_.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == "" and sorted(tmp_path.iterdir()) == before
+    assert err == (
+        f"stereovision {argv[0]}: error: argument {name}: expected a value, got '' (an unset "
+        f"variable?) (see stereovision {argv[0]} --help)\n"
+    )

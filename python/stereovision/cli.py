@@ -2177,7 +2177,23 @@ class _Parser(argparse.ArgumentParser):
         self, args: Sequence[str] | None = None, namespace: Any = None
     ) -> tuple[Any, list[str]]:
         self.typed = tuple(sys.argv[1:] if args is None else args)
-        return super().parse_known_args(args, namespace)
+        namespace, extras = super().parse_known_args(args, namespace)
+        self._refuse_empty_values(namespace)
+        return namespace, extras
+
+    def _refuse_empty_values(self, namespace: Any) -> None:
+        """An empty value typed for a path, source, topic or pattern (``-o "$OUT"``, ``batch
+        "$DATA"`` with the variable unset) was taken as the current folder: ``batch ''``
+        processed the folder it was run in, ``-o ''`` wrote there, ``--calib ''`` loaded the
+        Q.dat found there. Refused here, before any work; the options with a type of their
+        own (``--host``, numbers) say it in their own words."""
+        for action in self._actions:
+            if action.type is not None or action.choices is not None or action.nargs == 0:
+                continue
+            value = getattr(namespace, action.dest, None)
+            if value == "" or (isinstance(value, list) and "" in value):
+                name = "/".join(action.option_strings) or action.metavar or action.dest
+                self.error(f"argument {name}: expected a value, got '' (an unset variable?)")
 
     def error(self, message: str) -> NoReturn:
         # argparse names the Python type ("invalid float value: 'abc'"): said as what to type.
