@@ -2145,3 +2145,50 @@ def test_load_scene_refuses_a_folder_named_gt_disp_pfm(tmp_path: Path) -> None:
     (tmp_path / "gt_disp.pfm").mkdir()
     with pytest.raises(ValueError, match=r"^PFM file is not a regular file: .*gt_disp\.pfm$"):
         load_scene(tmp_path)
+
+
+def test_io_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(tmp_path: Path) -> None:
+    """imread, read_pfm, write_ply, load_scene, find_scenes, Calibration.load ... given a bytes
+    name (or None) raised pathlib's "argument should be a str object or an os.PathLike object
+    returning str, not <class 'bytes'>", naming no argument; Calibration.from_file already said
+    which argument and to decode it (028e86f): each entry point now says so in those words."""
+    name = str(tmp_path / "a.png")
+    raw = os.fsencode(name)
+    cloud = np.zeros((2, 3), np.float32)
+    cases = [
+        (lambda p: imread(p), "path"),
+        (lambda p: read_image(p), "path"),
+        (lambda p: read_pfm(p), "path"),
+        (lambda p: write_pfm(p, np.zeros((2, 2), np.float32)), "path"),
+        (lambda p: write_ply(p, cloud), "path"),
+        (lambda p: read_ply(p), "path"),
+        (lambda p: load_scene(p), "directory"),
+        (lambda p: find_scenes(p), "root"),
+        (lambda p: scan_scenes(p), "root"),
+        (lambda p: Calibration.load(p), "path"),
+        (lambda p: Calibration.from_middlebury(p), "path"),
+        (lambda p: Calibration.from_ros(p, name), "left"),
+        (
+            lambda p: Calibration(
+                np.eye(3),
+                np.zeros(5),
+                np.eye(3),
+                np.zeros(5),
+                np.eye(3),
+                np.array([-0.1, 0.0, 0.0]),
+                (4, 4),
+            ).save(p),
+            "path",
+        ),
+    ]
+    for call, arg in cases:
+        with pytest.raises(TypeError) as info:
+            call(raw)
+        assert str(info.value) == (
+            f"{arg}: expected a str or os.PathLike file name, got the bytes {name!r}: decode "
+            f"it first (os.fsdecode({arg}))"
+        )
+        with pytest.raises(TypeError) as info:
+            call(None)
+        assert str(info.value) == f"{arg}: expected a str or os.PathLike file name, got NoneType"
+    assert not list(tmp_path.iterdir())  # nothing written

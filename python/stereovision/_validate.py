@@ -24,6 +24,7 @@ import reprlib
 import sys
 import warnings
 from collections.abc import Callable, Iterable
+from pathlib import Path
 from typing import Any, TypeGuard, TypeVar, cast
 
 import numpy as np
@@ -93,6 +94,41 @@ def path_given(obj: object) -> str | None:
         text = os.fsdecode(path) if isinstance(path, bytes) else str(path)
         return None if "\x00" in text else text
     return None
+
+
+def as_path(path: object, name: str = "path") -> Path:
+    """``path`` as a :class:`pathlib.Path`, or a TypeError naming the argument: pathlib's own
+    "argument should be a str object or an os.PathLike object returning str, not <class
+    'bytes'>" (or "... not 'NoneType'") named none, and a bytes name got no hint to decode it.
+
+    Parameters
+    ----------
+    path : object
+        What was given as a file or folder name (str or os.PathLike).
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    TypeError
+        If ``path`` is bytes (the library's paths are str or os.PathLike) or no name at all.
+    """
+    if isinstance(path, bytes):
+        said = path_given(path)
+        shown = f"the bytes {said!r}" if said is not None else f"{len(path)} bytes"
+        raise TypeError(
+            f"{name}: expected a str or os.PathLike file name, got {shown}: "
+            f"decode it first (os.fsdecode({name}))"
+        )
+    if isinstance(path, (str, os.PathLike)):
+        fs = os.fspath(path)
+        if isinstance(fs, str):
+            return Path(fs)
+    raise TypeError(f"{name}: expected a str or os.PathLike file name, got {type(path).__name__}")
 
 
 #: Most pixels of an image the kernels take, and its longest side: the Rust kernels hold pixel

@@ -33,10 +33,10 @@ import numpy.typing as npt
 from stereovision._validate import (
     NOT_NUMBERS,
     as_image_array,
+    as_path,
     crop_or_pad_hint,
     known_unit,
     number_shown,
-    path_given,
     positive_finite,
     real_number,
     renamed_keyword,
@@ -1273,7 +1273,7 @@ class Calibration:
         """
         from stereovision.io import atomic_write
 
-        p = Path(path)
+        p = as_path(path)
         text = self._file_text(p)
         with atomic_write(p, "w") as fh:
             fh.write(text)
@@ -1425,8 +1425,8 @@ class Calibration:
         return cls._from_mapping(obj.get, source)
 
     @staticmethod
-    def _read_text(path: PathLike) -> tuple[Path, str]:
-        p = Path(path)
+    def _read_text(path: PathLike, name: str = "path") -> tuple[Path, str]:
+        p = as_path(path, name)
         if not p.exists():
             raise FileNotFoundError(f"calibration file not found: {p}")
         if not p.is_file():
@@ -1531,15 +1531,8 @@ class Calibration:
         TypeError
             If ``path`` is bytes: the library's paths are str or os.PathLike, as io's are.
         """
-        if isinstance(path, bytes):
-            # pathlib's own "argument should be a str object or an os.PathLike object
-            # returning str, not <class 'bytes'>" named no argument; as path_given says a name
-            name = path_given(path)
-            said = f"the bytes {name!r}" if name is not None else f"{len(path)} bytes"
-            raise TypeError(
-                f"path: expected a str or os.PathLike file name, got {said}: "
-                "decode it first (os.fsdecode(path))"
-            )
+        # pathlib's own TypeError for a bytes name named no argument
+        as_path(path)
         if unit is not None:
             unit = known_unit(unit, UNIT_TO_METRES)
         calib = cls._read_any(path, image_size, unit)
@@ -2111,8 +2104,8 @@ class Calibration:
             If a file is not a ``camera_info`` (field named), the image sizes differ, a model is
             unsupported, or the files hold no baseline (two monocular calibrations).
         """
-        lp, ltext = cls._read_text(left)
-        rp, rtext = cls._read_text(right)
+        lp, ltext = cls._read_text(left, "left")
+        rp, rtext = cls._read_text(right, "right")
         return cls._from_ros_texts(ltext, rtext, str(lp), str(rp))
 
     @classmethod

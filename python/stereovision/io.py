@@ -33,7 +33,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS
+from stereovision._validate import NOT_NUMBERS, as_path
 from stereovision.baselines import round_up16
 
 if TYPE_CHECKING:
@@ -774,7 +774,7 @@ def _broken_link(link: Path) -> str:
 
 
 def _existing_file(path: PathLike, what: str) -> Path:
-    p = Path(path)
+    p = as_path(path)
     if not p.exists():
         # a link whose target moved reads as no file at all: which one is missing is said
         gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
@@ -1214,6 +1214,7 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     TypeError
         If ``little_endian`` is not True or False.
     """
+    dest = as_path(path)
     if not isinstance(little_endian, (bool, np.bool_)):
         # "no" was true: a little-endian file where the caller asked for the other order
         raise TypeError(f"little_endian: expected True or False, got {little_endian!r}")
@@ -1240,10 +1241,10 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     body = np.ascontiguousarray(a[::-1], dtype=dtype).tobytes()
     scale = b"-1.0" if little_endian else b"1.0"
     header = magic + b"\n" + f"{width} {height}".encode() + b"\n" + scale + b"\n"
-    with atomic_write(path) as fh:
+    with atomic_write(dest) as fh:
         fh.write(header)
         fh.write(body)
-    return Path(path)
+    return dest
 
 
 # ------------------------------------------------------------------------------------------ PLY
@@ -1318,6 +1319,7 @@ def write_ply(
     TypeError
         If ``drop_invalid`` is not True or False.
     """
+    dest = as_path(path)
     if not isinstance(drop_invalid, (bool, np.bool_)):
         # "no" (true) dropped the NaN points the caller meant to keep, None kept them
         raise TypeError(f"drop_invalid: expected True or False, got {drop_invalid!r}")
@@ -1370,10 +1372,10 @@ def write_ply(
         rec["red"], rec["green"], rec["blue"] = cols[:, 0], cols[:, 1], cols[:, 2]
         lines += ["property uchar red", "property uchar green", "property uchar blue"]
     lines.append("end_header")
-    with atomic_write(path) as fh:
+    with atomic_write(dest) as fh:
         fh.write(("\n".join(lines) + "\n").encode("ascii"))
         fh.write(rec.view(np.uint8))  # the records' bytes, not a copy of them (tobytes)
-    return Path(path)
+    return dest
 
 
 def read_ply(
@@ -1747,7 +1749,7 @@ def load_scene(directory: PathLike) -> Scene:
     """
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
-    d = Path(directory)
+    d = as_path(directory, "directory")
     if not d.is_dir():
         raise FileNotFoundError(f"scene directory not found: {d}")
     left = imread(d / "left.png")
@@ -1872,7 +1874,7 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     FileNotFoundError
         If ``root`` is not a directory.
     """
-    r = Path(root)
+    r = as_path(root, "root")
     if not r.is_dir():
         raise FileNotFoundError(f"scene root not found: {r}")
     # Links followed: Path.rglob does not enter a link to a folder, so scenes linked into a
