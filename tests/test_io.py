@@ -2192,3 +2192,25 @@ def test_io_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(tmp_path:
             call(None)
         assert str(info.value) == f"{arg}: expected a str or os.PathLike file name, got NoneType"
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_read_ply_ascii_damaged_count_or_out_of_type_value_is_said(tmp_path: Path) -> None:
+    """An ASCII PLY whose vertex count is damaged (99999999999 of one row) was a MemoryError of
+    terabytes (the table and records allocated for the count), not "truncated"; a uchar colour
+    of 300 or -1 (a value its type cannot hold) came back 44 and 255, wrapped by the cast."""
+    head = "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n"
+    head += "property float z\n{}end_header\n"
+    f = tmp_path / "c.ply"
+    f.write_text(head.format(99999999999, "") + "1 2 3\n")
+    with pytest.raises(ValueError, match=r"^truncated PLY file .*: expected 99999999999 vertices$"):
+        read_ply(f)
+    rgb = "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+    for row, said in (("1 2 3 300 0 2", "300"), ("1 2 3 7 -1 2", "-1"), ("1 2 3 7 1 2.5", "2.5")):
+        f.write_text(head.format(1, rgb) + row + "\n")
+        with pytest.raises(ValueError) as info:
+            read_ply(f)
+        assert str(info.value).endswith(f"holds {said}, not a whole number 0 to 255 as its type")
+    f.write_text(head.format(2, rgb) + "1 2 3 255 0 2\n4 5 6 0.0 128 1\n")
+    pts, cols = read_ply(f)
+    assert pts.tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert cols is not None and cols.tolist() == [[255, 0, 2], [0, 128, 1]]

@@ -1554,15 +1554,31 @@ def _ascii_ply_vertices(
 ) -> npt.NDArray[Any]:
     """The first ``count`` rows of an ASCII PLY body as records of ``dtype`` (one value per
     property; rows of later elements, faces, are not read)."""
-    rec = np.empty(count, dtype=dtype)
     if count == 0:
-        return rec
+        return np.empty(0, dtype=dtype)
     names = dtype.names or ()
-    table = _ascii_table(body, path, "PLY", len(names), rows=count, first=True)
+    # no more rows than the body has lines: a damaged count (99999999999 of one row) was a
+    # MemoryError of terabytes (NumPy's table, the records), not "truncated"
+    rows = min(count, body.count(b"\n") + 1)
+    table = _ascii_table(body, path, "PLY", len(names), rows=rows, first=True)
     if table.shape[0] < count:
         raise ValueError(f"truncated PLY file {path}: expected {count} vertices")
+    rec = np.empty(count, dtype=dtype)
     for i, name in enumerate(names):
-        rec[name] = table[:, i]
+        kind = dtype[name]
+        column = table[:, i]
+        if kind.kind in "iu":
+            # the cast wrapped a value the property's type cannot hold: a uchar red of 300
+            # came back 44, -1 255
+            info = np.iinfo(kind)
+            bad = ~((column >= info.min) & (column <= info.max) & (column == np.round(column)))
+            if bad.any():
+                raise ValueError(
+                    f"damaged PLY file {path}: vertex property {name!r} holds "
+                    f"{float(column[bad][0]):g}, not a whole number {info.min} to {info.max} "
+                    "as its type"
+                )
+        rec[name] = column
     return rec
 
 
