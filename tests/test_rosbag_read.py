@@ -2372,3 +2372,45 @@ def test_of_two_right_frames_with_one_stamp_the_first_is_paired(tmp_path: Path) 
     with BagCamera(bag) as cam:
         pair = cam.read()
     assert pair.right.max() == 0
+
+
+def test_a_ros1_bag_cut_short_or_unindexed_is_said_with_its_remedy(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A ROS 1 .bag cut short (an interrupted copy: its index, at its end, gone) was "not a
+    readable ROS 1 or ROS 2 bag: Bag index looks damaged: ('Header could not be read from
+    file.',)", one without an index (index_pos 0) "Bag is not indexed, reindex before
+    reading.", neither naming the command that indexes it. Each now says what it is and the
+    rosbag reindex that indexes its messages."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    frames = [(T0 + i * 10**8, small[0], T0 + i * 10**8, small[1]) for i in range(4)]
+    bag = write_bag(tmp_path / "whole.bag", frames, flavour="ros1")
+    data = bag.read_bytes()
+    at = data.index(b"index_pos=") + len(b"index_pos=")
+    index_pos = int.from_bytes(data[at : at + 8], "little")
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(data[: len(data) // 2])
+    inside = tmp_path / "inside.bag"  # cut inside its index
+    inside.write_bytes(data[: index_pos + 20])
+    unindexed = tmp_path / "unindexed.bag"
+    unindexed.write_bytes(data[:at] + bytes(8) + data[at + 8 :])
+    from stereovision.rosbag import bag_topics
+
+    why = {
+        cut: f"without its index (cut short: {len(data) // 2} bytes, the index due at byte "
+        f"{index_pos}; an interrupted copy or download, a full disk?)",
+        inside: "whose index is damaged (cut short?)",
+        unindexed: "without its index (its recorder stopped before writing it)",
+    }
+    for path, words in why.items():
+        said = (
+            f"{path} is a ROS 1 bag {words}: `rosbag reindex {path}` indexes the messages it holds"
+        )
+        for call in (bag_topics, BagCamera):
+            with pytest.raises(ValueError) as info:
+                call(path)
+            assert str(info.value) == said, (path, call)
+        code, _out, err = run("stream", "--from-bag", str(path), "--no-display")
+        assert code == 2 and err.strip().splitlines() == [f"stereovision: error: {said}"]
+    with BagCamera(bag) as cam:  # the whole bag reads as before
+        assert cam.read().left.shape == (48, 64, 3)

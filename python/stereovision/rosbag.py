@@ -812,6 +812,39 @@ def _unfinished_mcap(path: Path) -> Path | None:
     return None
 
 
+_ROS1_MAGIC = b"#ROSBAG V2.0\n"
+
+
+def _unindexed_ros1(path: Path) -> tuple[Path, int, int] | None:
+    """The ROS 1 bag file of ``path`` (the file, or a split recording's pieces) whose bag
+    header places its index nowhere in the file, with that position and the file's size: 0
+    when its recorder never wrote one, past the end when the file was cut short (an
+    interrupted copy or download, a full disk). rosbags said "Bag index looks damaged:
+    ('Header could not be read from file.',)" of a cut file, no remedy named."""
+    for f in _bag_paths(path):
+        try:
+            with f.open("rb") as fh:
+                head = fh.read(4096)
+                size = os.fstat(fh.fileno()).st_size
+        except OSError:
+            continue  # rosbags says what it can of an unreadable file
+        if not head.startswith(_ROS1_MAGIC):
+            continue
+        # the bag header record: its header's length, then fields of (length, name=value)
+        pos = len(_ROS1_MAGIC) + 4
+        end = min(len(head), pos + int.from_bytes(head[pos - 4 : pos], "little"))
+        while pos + 4 <= end:
+            n = int.from_bytes(head[pos : pos + 4], "little")
+            field = head[pos + 4 : pos + 4 + n]
+            pos += 4 + n
+            if field.startswith(b"index_pos=") and len(field) == 18:
+                index_pos = int.from_bytes(field[10:], "little")
+                if index_pos == 0 or index_pos >= size:
+                    return f, index_pos, size
+                break
+    return None
+
+
 _SPLIT_PIECE = re.compile(r"^(.*)_\d+\.bag(\.active)?$")
 
 
@@ -861,6 +894,19 @@ def _open_reader(path: Path) -> Any:
             f"{active[0]} is a ROS 1 recording left unfinished (its recorder stopped before "
             f"writing the index): `rosbag reindex {active[0]}` indexes it; then rename it to .bag"
         )
+    unindexed = _unindexed_ros1(path)
+    if unindexed is not None:
+        bag, index_pos, size = unindexed
+        why = (
+            "its recorder stopped before writing it"
+            if index_pos == 0
+            else f"cut short: {size} bytes, the index due at byte {index_pos}; an interrupted "
+            "copy or download, a full disk?"
+        )
+        raise _UnfinishedBagError(
+            f"{bag} is a ROS 1 bag without its index ({why}): `rosbag reindex {bag}` "
+            "indexes the messages it holds"
+        )
     cut = _unfinished_mcap(path)
     if cut is not None:
         raise _UnfinishedBagError(
@@ -868,8 +914,19 @@ def _open_reader(path: Path) -> Any:
             f"its summary, or is still recording): `mcap recover {cut} -o FIXED.mcap` (the mcap "
             "CLI) rebuilds it"
         )
-    reader = AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.ROS2_HUMBLE))
-    reader.open()
+    paths = _bag_paths(path)
+    reader = AnyReader(paths, default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    try:
+        reader.open()
+    except Exception as exc:  # rosbags' errors name no common base class
+        if "Bag index looks damaged" not in str(exc):
+            raise
+        # an index cut part-way (its start inside the file): the same remedy
+        named = paths[0] if len(paths) == 1 else path / "*.bag"
+        raise _UnfinishedBagError(
+            f"{named} is a ROS 1 bag whose index is damaged (cut short?): `rosbag reindex "
+            f"{named}` indexes the messages it holds"
+        ) from None
     return reader
 
 
