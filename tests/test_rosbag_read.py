@@ -2414,3 +2414,34 @@ def test_a_ros1_bag_cut_short_or_unindexed_is_said_with_its_remedy(
         assert code == 2 and err.strip().splitlines() == [f"stereovision: error: {said}"]
     with BagCamera(bag) as cam:  # the whole bag reads as before
         assert cam.read().left.shape == (48, 64, 3)
+
+
+def test_a_bag_of_one_camera_or_none_is_not_told_to_give_two_topics(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A bag holding one camera's image topic (the other camera not recorded) or none was told
+    "no left/right pair among the bag's image topics (/stereo/left/image_raw); give the
+    topics (--left-topic, --right-topic)", two topics the bag does not hold. It now says why
+    there is no pair; several topics without a pair keep the advice."""
+    small = cones.left[:48, :64], cones.right[:48, :64]
+    one = write_bag(tmp_path / "one", [(T0, small[0], None, small[1])])
+    said = (
+        f"no left/right pair among the bag's image topics ({LEFT}); a pair needs an image topic "
+        "per camera, and the bag holds one (was the other camera recorded?)"
+    )
+    with pytest.raises(ValueError) as info:
+        BagCamera(one)
+    assert str(info.value) == said
+    code, _out, err = run("stream", "--from-bag", str(one), "--no-display")
+    assert code == 2 and err.strip().splitlines() == [f"stereovision: error: {said}"]
+    with pytest.raises(ValueError) as info:
+        find_stereo_topics([])
+    assert str(info.value) == (
+        "no left/right pair among the bag's image topics (none); the bag holds no "
+        "sensor_msgs/Image or CompressedImage topic"
+    )
+    with pytest.raises(ValueError) as info:
+        find_stereo_topics(["/a/image", "/b/image"])
+    assert str(info.value).endswith(
+        "(/a/image, /b/image); give the topics (--left-topic, --right-topic)"
+    )

@@ -1209,10 +1209,16 @@ def find_stereo_topics(
     pairs = _stereo_pairs(image_topics)
     listing = ", ".join(sorted(image_topics)) or "none"
     if not pairs:
-        raise ValueError(
-            f"no left/right pair among the bag's image topics ({listing}); give the topics "
-            "(--left-topic, --right-topic)"
+        # two topics to give where the bag holds one or none was advice none could follow
+        advice = (
+            "give the topics (--left-topic, --right-topic)"
+            if len(image_topics) > 1
+            else "a pair needs an image topic per camera, and the bag holds one (was the other "
+            "camera recorded?)"
+            if image_topics
+            else "the bag holds no sensor_msgs/Image or CompressedImage topic"
         )
+        raise ValueError(f"no left/right pair among the bag's image topics ({listing}); {advice}")
 
     def held(topic: str) -> int:
         return 1 if counts is None else counts.get(topic, 0)
