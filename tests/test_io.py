@@ -1550,7 +1550,9 @@ def test_pair_check_keep_previous_and_quiet_decodes_edge_cases(tmp_path: Path) -
     assert keep_previous(tmp_path / "shot.png") is None
     assert sorted(p.name for p in tmp_path.iterdir()) == ["shot.png"]
     (tmp_path / "empty.png").write_bytes(b"")
-    with pytest.raises(ValueError, match=r"^cannot decode .*empty\.png as an image$"):
+    with pytest.raises(
+        ValueError, match=r"^cannot decode .*empty\.png as an image: the file is empty \(0 bytes\)$"
+    ):
         read_image(tmp_path / "empty.png")
     log = cv2.utils.logging  # type: ignore[attr-defined]
     before = log.getLogLevel()
@@ -2214,3 +2216,19 @@ def test_read_ply_ascii_damaged_count_or_out_of_type_value_is_said(tmp_path: Pat
     pts, cols = read_ply(f)
     assert pts.tolist() == [[1, 2, 3], [4, 5, 6]]
     assert cols is not None and cols.tolist() == [[255, 0, 2], [0, 128, 1]]
+
+
+def test_an_empty_image_file_is_said_to_be_empty(tmp_path: Path) -> None:
+    """A 0-byte image (an interrupted copy or save) was "cannot decode F as an image" alone, the
+    words of a damaged file or an unknown format; it now says the file is empty."""
+    empty = tmp_path / "left.png"
+    empty.write_bytes(b"")
+    for read in (imread, read_image):
+        with pytest.raises(ValueError) as info:
+            read(empty)
+        assert str(info.value) == f"cannot decode {empty} as an image: the file is empty (0 bytes)"
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(b"this is not an image")
+    with pytest.raises(ValueError) as info:
+        imread(bad)
+    assert str(info.value) == f"cannot decode {bad} as an image"

@@ -1003,6 +1003,10 @@ _BAG_SUFFIXES = (".bag", ".db3", ".mcap")
 def _not_an_image_hint(path: Path, data: npt.NDArray[np.uint8]) -> str:
     """What an undecodable file (its bytes ``data``) looks like instead, as the end of the
     error's one line."""
+    if data.size == 0:
+        # an interrupted copy or save leaves 0 bytes: "cannot decode" alone read as a damaged
+        # or unknown format
+        return ": the file is empty (0 bytes)"
     if _is_pfm(data):
         return (
             ": it is a PFM file of floating-point values (a disparity map?), not an 8- or "
