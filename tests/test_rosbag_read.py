@@ -2445,3 +2445,24 @@ def test_a_bag_of_one_camera_or_none_is_not_told_to_give_two_topics(
     assert str(info.value).endswith(
         "(/a/image, /b/image); give the topics (--left-topic, --right-topic)"
     )
+
+
+def test_the_bag_entry_points_refuse_a_bytes_or_no_path_naming_it(tmp_path: Path) -> None:
+    """BagCamera, BagWriter, bag_topics and is_bag given a bytes name raised pathlib's
+    "argument should be a str object or an os.PathLike object returning str, not <class
+    'bytes'>" (None "expected str, bytes or os.PathLike object"), naming no argument; they
+    now say it as io's readers and Calibration.from_file do."""
+    from stereovision.rosbag import BagWriter, bag_topics, is_bag
+
+    name = str(tmp_path / "rig.bag")
+    for call in (BagCamera, BagWriter, bag_topics, is_bag):
+        with pytest.raises(TypeError) as info:
+            call(name.encode())
+        assert str(info.value) == (
+            f"path: expected a str or os.PathLike file name, got the bytes {name!r}: decode it "
+            "first (os.fsdecode(path))"
+        )
+        with pytest.raises(TypeError) as info:
+            call(None)
+        assert str(info.value) == "path: expected a str or os.PathLike file name, got NoneType"
+    assert not list(tmp_path.iterdir())  # no bag folder made

@@ -83,6 +83,7 @@ import numpy as np
 from stereovision._interrupt import HeldInterrupts
 from stereovision._validate import (
     _plain_real,
+    as_path,
     number_shown,
     real_number,
     renamed_keyword,
@@ -267,7 +268,7 @@ ros2_static_transform>`.
         scan_frame_id: str = "base_footprint",
         tf: bool = True,
     ) -> None:
-        self.path = Path(path)
+        self.path = as_path(path)
         # checked before the folder is made: a bad keyword left an empty bag folder behind
         self.prefix = _topic_prefix(prefix)
         self.frame_id = _frame_name(frame_id, "frame_id")
@@ -979,7 +980,7 @@ def bag_topics(path: str | os.PathLike[str]) -> str:
     ImportError
         Without the ``rosbags`` package.
     """
-    p = Path(path)
+    p = as_path(path)
     if p.is_file() and (p.parent / "metadata.yaml").is_file():
         p = p.parent  # a file of a ROS 2 bag, as BagCamera takes it
     try:
@@ -1085,7 +1086,7 @@ def is_bag(path: str | os.PathLike[str]) -> bool:
     recording, whose last piece may be left unfinished), a ROS 2 bag folder
     (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it), one of its files, or a
     ``.db3`` / ``.mcap`` file alone (a recorder that left no metadata.yaml)?"""
-    p = Path(path)
+    p = as_path(path)
     # a bag's storage file alone is read (its recorder left no metadata.yaml): `info` took
     # it for a calibration file
     if p.is_file() and (p.suffix in (".bag", ".db3", ".mcap") or p.name.endswith(".bag.active")):
@@ -1321,7 +1322,7 @@ class BagCamera(PairSource):
     ) -> None:
         from stereovision.capture import parse_size
 
-        self.path = Path(path)
+        self.path = as_path(path)
         if not self.path.exists():
             raise FileNotFoundError(f"bag not found: {self.path}")
         if self.path.is_file() and (self.path.parent / "metadata.yaml").is_file():
