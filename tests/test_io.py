@@ -2232,3 +2232,17 @@ def test_an_empty_image_file_is_said_to_be_empty(tmp_path: Path) -> None:
     with pytest.raises(ValueError) as info:
         imread(bad)
     assert str(info.value) == f"cannot decode {bad} as an image"
+
+
+def test_read_ply_takes_a_comment_in_utf8(tmp_path: Path) -> None:
+    """A header comment in UTF-8 ('comment créé par Jürgen') made the whole file "not a PLY file
+    (non-ASCII header)"; a comment's text is free, the other lines still ASCII."""
+    body = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+    f = tmp_path / "c.ply"
+    head = "ply\nformat ascii 1.0\ncomment créé par Jürgen à Åre\n"  # Å: C3 85, 85 a NEL
+    f.write_bytes((head + body + "1 2 3\n").encode())
+    pts, cols = read_ply(f)
+    assert pts.tolist() == [[1, 2, 3]] and cols is None
+    f.write_bytes(("ply\nformat ascii 1.0\n" + body.replace(" x", " é") + "1 2 3\n").encode())
+    with pytest.raises(ValueError, match=r"^not a PLY file \(non-ASCII header\): "):
+        read_ply(f)

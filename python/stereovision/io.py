@@ -1425,10 +1425,16 @@ def read_ply(
     nl = raw.find(b"\n", end)
     if nl < 0:
         raise ValueError(f"not a PLY file (header not terminated): {p}")
-    try:
-        header = raw[:end].decode("ascii").splitlines()
-    except UnicodeDecodeError:
-        raise ValueError(f"not a PLY file (non-ASCII header): {p}") from None
+    # a comment's text is free (an author's name, a place, in UTF-8: refused as a "non-ASCII
+    # header", a cloud its writer reads); every other header line is ASCII
+    # split as bytes: str.splitlines also breaks at U+0085, a byte of UTF-8's "Å" (C3 85)
+    header = [line.decode("latin-1") for line in raw[:end].splitlines()]
+    if not all(
+        line.isascii()
+        for line in header
+        if line.split(maxsplit=1)[:1] not in (["comment"], ["obj_info"])
+    ):
+        raise ValueError(f"not a PLY file (non-ASCII header): {p}")
     order = ""
     count = -1
     props: list[tuple[str, str]] = []
