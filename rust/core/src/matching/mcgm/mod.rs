@@ -24,6 +24,8 @@ pub mod zerocross;
 #[cfg(test)]
 mod tests;
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
 use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
@@ -1019,18 +1021,27 @@ impl SidesBound {
         // Each column keeps its own base and weight, as the exact sums do (the bases are
         // consecutive but for rounding of x - d next to a whole pixel).
         let mut cols = [(0usize, 0.0f32, 0.0f32, 0.0f32); MAX_SIDES_WIDTH];
+        // The edge filters' column sums when they were computed for this half-height (the
+        // same additions in the same order as below, so the same bits).
+        let planes = scratch.sums.as_deref().filter(|s| s[0].hh == hh);
         for (c, k) in (inner..=outer).enumerate() {
             let (b, f) = base[c];
             let x = (xi + side * k) as usize;
-            let (mut top, mut bot) = (0.0f32, 0.0f32);
-            for (ri, dy) in (-hh..=hh).enumerate() {
-                let v = left.data[(yl + dy) as usize * left.width + x];
-                if ri < n_top {
-                    top += v;
-                } else {
-                    bot += v;
+            let (top, bot) = if let Some([l, _]) = planes {
+                let i = yl as usize * left.width + x;
+                (l.top[i], l.bot[i])
+            } else {
+                let (mut top, mut bot) = (0.0f32, 0.0f32);
+                for (ri, dy) in (-hh..=hh).enumerate() {
+                    let v = left.data[(yl + dy) as usize * left.width + x];
+                    if ri < n_top {
+                        top += v;
+                    } else {
+                        bot += v;
+                    }
                 }
-            }
+                (top, bot)
+            };
             cols[c] = ((b - b_min) as usize, f, top, bot);
         }
         let ltot: f32 = cols[..nc].iter().map(|c| c.2 + c.3).sum();
@@ -1040,16 +1051,27 @@ impl SidesBound {
         let p0 = (b_min - k_hi) as usize;
         let rows = &mut scratch.rows;
         let (v_top, v_bot) = (&mut rows.v_top, &mut rows.v_bot);
-        for v in [&mut *v_top, &mut *v_bot] {
-            v.clear();
-            v.resize(span + nk.div_ceil(8) * 8 - nk, 0.0);
-        }
-        for (ri, dy) in (-hh..=hh).enumerate() {
-            let o = (yr + dy) as usize * right.width + p0;
-            let rrow = &right.data[o..o + span];
-            let v = if ri < n_top { &mut *v_top } else { &mut *v_bot };
-            for (a, &x) in v.iter_mut().zip(rrow) {
-                *a += x;
+        let padded = span + nk.div_ceil(8) * 8 - nk;
+        if let Some([_, r]) = planes {
+            // Copied from the right image's column sums (no zero-fill and 2 hh + 1 row adds).
+            let o = yr as usize * right.width + p0;
+            for (v, plane) in [(&mut *v_top, &r.top), (&mut *v_bot, &r.bot)] {
+                v.clear();
+                v.extend_from_slice(&plane[o..o + span]);
+                v.resize(padded, 0.0);
+            }
+        } else {
+            for v in [&mut *v_top, &mut *v_bot] {
+                v.clear();
+                v.resize(padded, 0.0);
+            }
+            for (ri, dy) in (-hh..=hh).enumerate() {
+                let o = (yr + dy) as usize * right.width + p0;
+                let rrow = &right.data[o..o + span];
+                let v = if ri < n_top { &mut *v_top } else { &mut *v_bot };
+                for (a, &x) in v.iter_mut().zip(rrow) {
+                    *a += x;
+                }
             }
         }
         // One weight for all columns: each sum interpolated once here (every column and
@@ -1321,6 +1343,58 @@ struct SidesScratch {
     diffs: Vec<f32>,
     /// The largest absolute grey value of the pair (the bound's rounding slack).
     scale: f32,
+    /// The left and right images' [`HalfSums`] ([`edge_filters`] computes them once for all
+    /// matches when there are enough of them; without them each window sums its rows).
+    sums: Option<Arc<[HalfSums; 2]>>,
+}
+
+/// An image's column sums over the rows of [`SidesBound`]'s half-windows, for every pixel at
+/// once: at `(x, y)`, `top` sums rows `y - hh ..= y` and `bot` rows `y + 1 ..= y + hh` of
+/// column `x`, each from 0 in row order, the additions [`SidesBound::new`] makes for one
+/// window (so the same bits). Neighbouring matches' windows share most of their columns:
+/// summed once here instead of once per window. Rows within `hh` of the border stay 0 (no
+/// half-window fits there).
+struct HalfSums {
+    hh: i32,
+    top: Vec<f32>,
+    bot: Vec<f32>,
+}
+
+impl HalfSums {
+    /// The sums of `img` (`None` where its planes do not fit in memory: the windows then sum
+    /// their own rows, as before).
+    fn new(img: &Image, hh: i32) -> Option<Self> {
+        let (w, h) = img.size();
+        let mut top = try_zeroed::<f32>(w * h, FILTER_LISTS).ok()?;
+        let mut bot = try_zeroed::<f32>(w * h, FILTER_LISTS).ok()?;
+        let r = usize::try_from(hh).ok()?;
+        if w > 0 {
+            top.par_chunks_mut(w)
+                .zip(bot.par_chunks_mut(w))
+                .enumerate()
+                .filter(|(y, _)| *y >= r && y + r < h)
+                .for_each(|(y, (t, b))| half_sums_row(&img.data, w, y, r, t, b));
+        }
+        Some(Self { hh, top, bot })
+    }
+}
+
+simd_fn! {
+/// Row `y` of [`HalfSums`] (`r <= y < h - r`): rows `y - r ..= y` of `data` (`w` wide) added
+/// into `top`, rows `y + 1 ..= y + r` into `bot`, in row order. Compiled for AVX2 too: the
+/// same additions per element (lanes are independent), eight at a time.
+fn half_sums_row(data: &[f32], w: usize, y: usize, r: usize, top: &mut [f32], bot: &mut [f32]) {
+    for ry in y - r..=y {
+        for (a, &v) in top.iter_mut().zip(&data[ry * w..(ry + 1) * w]) {
+            *a += v;
+        }
+    }
+    for ry in y + 1..=y + r {
+        for (a, &v) in bot.iter_mut().zip(&data[ry * w..(ry + 1) * w]) {
+            *a += v;
+        }
+    }
+}
 }
 
 /// Widest half-window of the both-sides check (columns; validated).
@@ -1595,6 +1669,20 @@ pub fn edge_filters(
             .iter()
             .chain(&right.data)
             .fold(0.0f32, |a, &v| if v.abs() > a { v.abs() } else { a });
+    // The half-windows' column sums of both images, when the matches are many enough for
+    // their windows to cover the image several times over (each half-window sums
+    // `sides_height` rows over the disparity range; one per 64 pixels is far above break-even
+    // on the scenes): the same values, so the same answers, either way.
+    let hh = f.sides_height / 2;
+    let sums = (f.sides
+        && f.sides_best
+        && 2 * i64::from(hh) < h as i64
+        && matches.len().saturating_mul(64) >= w * h)
+        .then(|| {
+            let (l, r) = rayon::join(|| HalfSums::new(left, hh), || HalfSums::new(right, hh));
+            Some(Arc::new([l?, r?]))
+        })
+        .flatten();
     let mut ok: Vec<bool> = Vec::new();
     try_reserve_len(&mut ok, order.len(), FILTER_LISTS)?;
     // Into the reserved room (no reallocation) by `par_extend`, the path `collect` took:
@@ -1602,6 +1690,7 @@ pub fn edge_filters(
     ok.par_extend(order.par_iter().map_init(
         || SidesScratch {
             scale,
+            sums: sums.clone(),
             ..SidesScratch::default()
         },
         |scratch, &i| {

@@ -2628,6 +2628,89 @@ fn bound_sums_twice(
 }
 
 #[test]
+fn half_sums_planes_give_each_windows_own_sums_bit_for_bit() {
+    // The edge filters' column sums of both images against the sums each window makes of its
+    // own rows: the bound's column sums (left) and right row sums, and half_better's answers,
+    // bit for bit. Grey values of mixed magnitudes and signs (and signed zeros), so that any
+    // other order or grouping of the additions would round differently somewhere.
+    let (w, h) = (80usize, 23usize);
+    let mut st = 0x2545_f491_4f6c_dd1du64;
+    let mut grey = || {
+        st ^= st << 13;
+        st ^= st >> 7;
+        st ^= st << 17;
+        let m = [1e-3f32, 0.37, 1.0, 97.0, 1e3][(st % 5) as usize];
+        match st >> 61 {
+            0 => -0.0,
+            1 => 0.0,
+            _ => m * ((st >> 40) as f32 / (1u64 << 24) as f32 - 0.3),
+        }
+    };
+    let l = Image::new(w, h, (0..w * h).map(|_| grey()).collect()).unwrap();
+    let r = Image::new(w, h, (0..w * h).map(|_| grey()).collect()).unwrap();
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let mut checked = 0;
+    for hh in [0, 1, 3, 5] {
+        let planes = [
+            HalfSums::new(&l, hh).unwrap(),
+            HalfSums::new(&r, hh).unwrap(),
+        ];
+        let mut with = SidesScratch {
+            scale: 1e3,
+            sums: Some(Arc::new(planes)),
+            ..SidesScratch::default()
+        };
+        let mut own = SidesScratch {
+            scale: 1e3,
+            ..SidesScratch::default()
+        };
+        for (inner, outer) in [(1, 6), (2, 2), (1, 16)] {
+            let geom = (inner, outer, hh);
+            // First and last rows a window fits on, rows between; straddling weights too.
+            for (yl, yr) in [(hh, hh), (h as i32 - 1 - hh, h as i32 - 1 - hh), (11, 12)] {
+                for (xi, d) in [(38, 5.3f32), (40, 11.0), (30, 2e-5)] {
+                    let at = (xi, yl, yr, d);
+                    for side in [-1, 1] {
+                        let ks = (-6, 9);
+                        let (base, b_range, (k_lo, k_hi)) = window_bases(at, side, geom, ks, w);
+                        assert!(k_hi >= k_lo, "{geom:?} {at:?} {side}");
+                        let nk = (k_hi - k_lo + 1) as usize;
+                        let kb = (k_hi, nk);
+                        let bb = (&base, b_range);
+                        let a = SidesBound::new(&l, &r, at, side, geom, kb, bb, &mut with);
+                        let b = SidesBound::new(&l, &r, at, side, geom, kb, bb, &mut own);
+                        let what = format!("hh {hh} {geom:?} {at:?} side {side}");
+                        for (ca, cb) in a.cols.iter().zip(&b.cols) {
+                            assert_eq!(ca.0, cb.0, "{what}");
+                            assert_eq!(
+                                bits(&[ca.1, ca.2, ca.3]),
+                                bits(&[cb.1, cb.2, cb.3]),
+                                "{what}"
+                            );
+                        }
+                        assert_eq!(a.ltot.to_bits(), b.ltot.to_bits(), "{what}");
+                        assert_eq!(bits(&with.rows.v_top), bits(&own.rows.v_top), "{what}");
+                        assert_eq!(bits(&with.rows.v_bot), bits(&own.rows.v_bot), "{what}");
+                        for mean_free in [false, true] {
+                            for here in [0.0f32, 0.5, 5.0, 50.0, f32::INFINITY] {
+                                let args = (at, side, geom, mean_free, ks, (here, 0.0));
+                                let run = |s: &mut SidesScratch| {
+                                    let (at, side, geom, mean_free, ks, lim) = args;
+                                    half_better(&l, &r, at, side, geom, mean_free, ks, lim, s)
+                                };
+                                assert_eq!(run(&mut with), run(&mut own), "{what} {here}");
+                            }
+                        }
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 4 * 3 * 3 * 3 * 2);
+}
+
+#[test]
 fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
     // Every block of lanes (the last one partial: lane counts not a multiple of 8), windows of
     // 16 columns then 1 (a stale column sum of the wider window would enter the narrow one's),
