@@ -272,6 +272,24 @@ def test_an_infinite_parameter_is_said_to_be_one() -> None:
         assert res.disparity.shape == (20, 30)
 
 
+def test_a_range_past_float32_is_said_to_be_one() -> None:
+    """max_disparity=1e39 (or min_disparity=-1e39), inf in the kernel's float32, was "invalid
+    parameter `range`: need finite d_min < d_max, got 0, inf", naming neither the argument nor
+    the value given; 1e20, within float32, is still no upper bound."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    for kwargs, said in (
+        ({"max_disparity": 1e39}, "max_disparity: expected a finite number in float32, the "
+         "kernel's precision, got 1e+39"),
+        ({"max_disparity": 8, "min_disparity": -(10**39)}, "min_disparity: expected a finite "
+         "number in float32, the kernel's precision, got -1e+39"),
+    ):  # fmt: skip
+        with pytest.raises(ValueError) as err:
+            refine_disparity(a, a, a, **kwargs)  # type: ignore[arg-type]
+        assert str(err.value) == said
+    res = refine_disparity(a, a, a, max_disparity=1e20)
+    assert res.disparity.shape == (20, 30)
+
+
 def test_an_unknown_parameter_names_the_valid_ones() -> None:
     """A misspelt key was "unknown refinement parameter(s): ['win_sigmma']": neither the
     nearest spelling nor the valid keys, which the matchers' own errors give."""

@@ -195,6 +195,15 @@ def refine_disparity(
         conf = np.where(measured | np.isfinite(conf), conf, np.float32(0))
     # the checked floats go to the kernel (float() of np.array([8.0]) was NumPy's bare TypeError)
     lo, hi = disparity_range(min_disparity, max_disparity)
+    top = float(np.finfo(np.float32).max)
+    for name, v in (("min_disparity", lo), ("max_disparity", hi)):
+        # inf in the kernel's float32: max_disparity=1e39 was "invalid parameter `range`: need
+        # finite d_min < d_max, got 0, inf", naming neither argument nor the value given
+        if abs(v) > top:
+            raise ValueError(
+                f"{name}: expected a finite number in float32, the kernel's precision, got "
+                f"{number_shown(v)}"
+            )
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:
@@ -209,7 +218,6 @@ def refine_disparity(
     # The kernel's float32 reads an infinity, or a value past float32 (1e39), as inf: "invalid
     # parameter `base_sigma`: must be > 0, got inf" told the caller to give a larger value.
     # fill_max_residual's inf means no test; NaN is left to the kernel's words.
-    top = float(np.finfo(np.float32).max)
     for k, v in [*f.items(), *(("fill sigma", s) for s, _ in fills)]:
         if k != "fill_max_residual" and abs(v) > top:
             raise ValueError(f"{k} must be a finite number, got {number_shown(v)}")
