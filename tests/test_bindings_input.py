@@ -458,6 +458,22 @@ try:
                 _core.refine_disparity(grey, right, grey, grey, *{refine_args})
             except (ValueError, MemoryError) as e:
                 print(f"{{type(e).__name__}}: {{e}}")
+    elif case == "pairs_before_copies":
+        # the matchers' pair kernels: a 16 GiB view as left, with a right of its shape, then
+        # another's
+        grey = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
+        for right in (grey, np.zeros((6, 8), np.float32)):
+            for call in (
+                lambda: _core.gabor_disparity(grey, right, 0.0, 8.0),
+                lambda: _core.hopfield_match(grey, right, {{}}),
+                lambda: _core.hopfield_candidates(grey, right, {{}}),
+                lambda: _core.mcgm_match(grey, right, {{}}),
+                lambda: _core.mcgm_filter(grey, right, np.zeros((0, 4), np.float32), {{}}),
+            ):
+                try:
+                    call()
+                except (ValueError, MemoryError) as e:
+                    print(f"{{type(e).__name__}}: {{e}}")
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -558,6 +574,24 @@ def test_refine_disparity_refuses_a_huge_or_mismatched_pair_before_copying_it() 
         "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)",
         "ValueError: right: expected shape (65536, 65536) like left, got (6, 8)",
     ], out.stdout
+
+
+def test_pair_kernels_refuse_a_huge_or_mismatched_pair_before_copying_it() -> None:
+    """gabor_disparity, hopfield_match, hopfield_candidates, mcgm_match and mcgm_filter copied a
+    broadcast ``left`` before the kernel refused its size, or a ``right`` of another shape, as
+    refine_disparity did: a 65536 x 65536 one was "MemoryError: out of memory: a copy of left
+    needs 16.00 GiB" under ``ulimit -v`` (the memory taken without one)."""
+    out = _under_address_limit("pairs_before_copies", 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    too_large = (
+        "ValueError: left: image of 65536x65536 pixels is too large: the kernels index pixels "
+        "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
+    )
+    differ = (
+        "ValueError: left and right images differ in size: left (65536, 65536), right (8, 6) "
+        "(width, height)"
+    )
+    assert out.stdout.splitlines() == [too_large] * 5 + [differ] * 5, out.stdout
 
 
 @pytest.mark.parametrize("channels", [2, 5])

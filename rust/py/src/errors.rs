@@ -32,6 +32,31 @@ pub fn check_size(w: usize, h: usize, max_pixels: usize, name: &str, noun: &str)
     })
 }
 
+/// A pair's shapes (`(H, W)` each) and the core's 32-bit size ([`check_size`]), from the
+/// shapes alone: before either image is copied (a broadcast or strided one is). A broadcast
+/// 65536 x 65536 `left` was a 16 GiB copy, a `MemoryError` under a memory limit, before the
+/// kernel refused its size or a `right` of another shape. The words are the kernel's; an empty
+/// image is left to the copy's own check.
+pub fn check_pair_size(left: (usize, usize), right: (usize, usize)) -> PyResult<()> {
+    let ((lh, lw), (rh, rw)) = (left, right);
+    if lh * lw == 0 || rh * rw == 0 {
+        return Ok(());
+    }
+    if left != right {
+        return Err(to_pyerr(CoreError::SizeMismatch {
+            left: (lw, lh),
+            right: (rw, rh),
+        }));
+    }
+    check_size(
+        lw,
+        lh,
+        stereovision_core::image::MAX_PIXELS,
+        "left",
+        "image",
+    )
+}
+
 /// `MemoryError` for a copy of `n` values of `T` the binding could not allocate.
 pub fn copy_oom<T>(n: usize, what: &str) -> PyErr {
     let bytes = n.saturating_mul(std::mem::size_of::<T>());

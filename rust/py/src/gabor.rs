@@ -121,6 +121,8 @@ pub fn gabor_disparity<'py>(
 ) -> PyResult<Pair<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    // both shapes and the size before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_size(left.as_array().dim(), right.as_array().dim())?;
     // The NumPy buffers themselves (no copy of the pair); read-only borrows held across the call.
     let (lg, rg) = (
         grey_from_numpy(&left, "left")?,

@@ -225,6 +225,8 @@ pub fn hopfield_match<'py>(
 ) -> PyResult<MatchOut<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    // both shapes and the size before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_size(left.as_array().dim(), right.as_array().dim())?;
     // The arrays' own buffers (no copy: the wrappers pass C-contiguous arrays).
     let (l, r) = (
         grey_from_numpy(&left, "left")?,
@@ -341,6 +343,8 @@ pub fn hopfield_candidates<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    // both shapes and the size before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_size(left.as_array().dim(), right.as_array().dim())?;
     // The arrays' own buffers (no copy: the wrappers pass C-contiguous arrays).
     let (l, r) = (
         grey_from_numpy(&left, "left")?,

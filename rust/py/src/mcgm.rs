@@ -292,6 +292,8 @@ pub fn mcgm_match<'py>(
 ) -> PyResult<MatchOut<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    // both shapes and the size before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_size(left.as_array().dim(), right.as_array().dim())?;
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let p = self::params(params)?;
@@ -378,6 +380,8 @@ pub fn mcgm_filter<'py>(
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    // both shapes and the size before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_size(left.as_array().dim(), right.as_array().dim())?;
     let matches: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(matches, "matches")?;
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
