@@ -804,6 +804,24 @@ def test_matches_from_csv_refuses_an_image_shape_its_matches_lie_outside(tmp_pat
     np.testing.assert_array_equal(back.to_array(), m.to_array())
 
 
+def test_matches_from_csv_suggests_the_swap_only_when_every_match_fits_it(tmp_path: Path) -> None:
+    """With one match outside (80, 30) and another outside (30, 80), each shape's error asked
+    "image_shape is the left image's (H, W): (30, 80)?" and "(80, 30)?": the other, which
+    refused the file in its turn. The swap is suggested only when all the matches fit it."""
+    m = sv.Matches(
+        xl=[70.0, 5.0], yl=[20.0, 50.0], xr=[66.0, 1.0], yr=[20.0, 50.0], score=[1.0, 0.5],
+        image_shape=(80, 80),
+    )  # fmt: skip
+    path = m.save_csv(tmp_path / "m.csv")
+    for shape, where in (((80, 30), "x 70, y 20"), ((30, 80), "x 5, y 50")):
+        with pytest.raises(ValueError) as err:
+            sv.Matches.from_csv(path, shape)
+        assert str(err.value) == (
+            f"{path}: 1 of the 2 matches lie outside image_shape {shape} (left positions up to "
+            f"{where}); image_shape is the left image's (H, W)"
+        )
+
+
 def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_path: Path) -> None:
     """An image given as the matches' CSV was a UnicodeDecodeError naming no file ("'utf-8'
     codec can't decode byte 0x89 in position 0"), a folder an IsADirectoryError: each now

@@ -405,9 +405,12 @@ class Matches:
         h, w = m.image_shape
         rx, ry = np.rint(m.xl), np.rint(m.yl)
         with np.errstate(invalid="ignore"):
-            out = np.isfinite(rx) & np.isfinite(ry) & ((rx < 0) | (rx >= w) | (ry < 0) | (ry >= h))
+            fin = np.isfinite(rx) & np.isfinite(ry)
+            out = fin & ((rx < 0) | (rx >= w) | (ry < 0) | (ry >= h))
         if out.any():
-            inside_swapped = not np.any(out & ((rx < 0) | (rx >= h) | (ry < 0) | (ry >= w)))
+            # all the matches, not only those outside: (80, 30) and (30, 80) each suggested
+            # the other when one match lay outside each
+            inside_swapped = not np.any(fin & ((rx < 0) | (rx >= h) | (ry < 0) | (ry >= w)))
             hint = f": ({w}, {h})?" if inside_swapped else ""
             raise ValueError(
                 f"{path}: {int(out.sum())} of the {len(m)} matches lie outside image_shape "
