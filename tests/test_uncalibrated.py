@@ -813,6 +813,24 @@ def test_rectify_names_an_interpolation_that_is_no_warp_method(interpolation: ob
         assert rect.rectify(img, img, interpolation=method)[0].shape == (8, 12)
 
 
+def test_rectify_gives_a_one_channel_image_back_with_its_channel() -> None:
+    """An (H, W, 1) pair came back (H, W) (cv2.warpPerspective drops the channel axis), the
+    gap 7ebb27e closed in Calibration.rectify: it keeps its channel, the values those of the
+    (H, W) pair's; colour keeps its three."""
+    img = np.tile(np.array([0, 100], np.uint8), (8, 6))
+    half = np.array([[1.0, 0, 0.5], [0, 1, 0], [0, 0, 1]])
+    rect = UncalibratedRectification(
+        half, half, (14, 9), (12, 8), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16, (0.0, 0.0),
+        (1.0, 1.0),
+    )  # fmt: skip
+    flat = rect.rectify(img, img)
+    for out, grey in zip(rect.rectify(img[:, :, None], img[:, :, None]), flat, strict=True):
+        assert out.shape == (9, 14, 1) and out.dtype == np.uint8
+        np.testing.assert_array_equal(out[:, :, 0], grey)
+    assert rect.rectify(np.dstack([img] * 3), img)[0].shape == (9, 14, 3)
+    assert rect.rectify(img.astype(np.float16)[:, :, None], img)[0].dtype == np.float16
+
+
 def test_the_coarse_probe_widens_the_range_unless_it_ran_out(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

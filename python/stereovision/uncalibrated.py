@@ -371,7 +371,8 @@ class UncalibratedRectification:
         Returns
         -------
         tuple of ndarray
-            The rectified left and right images, of :attr:`size`, the input's dtype.
+            The rectified left and right images, of :attr:`size`, the input's dtype and
+            channels (an ``(H, W, 1)`` image stays one).
 
         Raises
         ------
@@ -402,6 +403,8 @@ class UncalibratedRectification:
             if arr.dtype.kind == "f" and arr.dtype.itemsize not in (4, 8):  # float16, long double
                 work = arr.astype(np.float32 if arr.dtype.itemsize == 2 else np.float64)
             warped = np.asarray(cv2.warpPerspective(work, hom, self.size, flags=method))
+            if arr.ndim == 3 and warped.ndim == 2:  # OpenCV drops an (H, W, 1) image's channel
+                warped = warped[..., None]
             out.append(warped if warped.dtype == arr.dtype else warped.astype(arr.dtype))
         return out[0], out[1]
 
