@@ -1217,6 +1217,14 @@ def test_rectified_calibration_alpha_must_be_finite(alpha: float) -> None:
         (5.0, -1.0, "disparity_step: expected a positive finite number, got -1.0"),
         (5.0, float("nan"), "disparity_step: expected a positive finite number, got nan"),
         (5.0, "1", "disparity_step: expected a positive finite number, got str '1'"),
+        # Z^2 gave -1 m the step of +1 m
+        (-1.0, 1.0, "depth_m: expected depths in metres, 0 or more, got -1.0"),
+        (-np.inf, 1.0, "depth_m: expected depths in metres, 0 or more, got -inf"),
+        (
+            np.array([[5.0, np.nan], [-2.0, -3.0]]),
+            1.0,
+            "depth_m: expected depths in metres, 0 or more, got 2 of 4 negative, the first -2.0",
+        ),
     ],
 )
 def test_depth_step_refuses_what_is_not_a_depth_or_a_step(
@@ -1227,6 +1235,7 @@ def test_depth_step_refuses_what_is_not_a_depth_or_a_step(
     c = rect_calib()
     assert c.depth_step(5.0) == pytest.approx(25.0 / (c.focal_px * c.baseline_m))
     assert np.isnan(c.depth_step(np.array([np.nan, 5.0]))[0])  # a map's pixels without depth
+    assert c.depth_step(0.0) == 0.0
     with pytest.raises(ValueError, match=re.escape(says)):
         c.depth_step(depth, step)  # type: ignore[arg-type]
 

@@ -979,8 +979,8 @@ class Calibration:
         Raises
         ------
         ValueError
-            If ``depth_m`` is not real numbers or ``disparity_step`` not a positive finite
-            number.
+            If ``depth_m`` is not real numbers, or a negative one, or ``disparity_step`` not a
+            positive finite number.
         """
         # NumPy's conversions read "5" as 5 m, None as NaN and True as 1 without a word, and a
         # step of 0, -1 or NaN gave a resolution of 0, a negative one or NaN
@@ -992,6 +992,13 @@ class Calibration:
             )
         step = positive_finite(disparity_step, "disparity_step")
         z = raw.astype(np.float64)
+        # Z^2 gave -1 m the step of +1 m (a sign slip, a z axis pointing back) without a word
+        behind = z[z < 0]  # NaN (no depth) compares False: still NaN below
+        if behind.size:
+            got = f"{float(behind[0])!r}"
+            if z.ndim:
+                got = f"{behind.size} of {z.size} negative, the first {got}"
+            raise ValueError(f"depth_m: expected depths in metres, 0 or more, got {got}")
         fb = self.focal_px * self.baseline_m
         out: F64 = z * z * step / fb
         return out
