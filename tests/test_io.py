@@ -1692,6 +1692,37 @@ def test_write_together_refuses_a_folder_or_missing_folder_naming_the_destinatio
     assert sorted(os.listdir(tmp_path)) == ["b.yaml"]
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs as on POSIX")
+def test_a_fifo_destination_is_refused_not_replaced_by_a_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o pipe.png`` where ``pipe.png`` is a FIFO (a reader waiting on it), or a link to
+    one, was replaced by a regular file without a word (``stereovision board -o`` exit 0), the
+    reader getting nothing. It is refused, the FIFO left in place; a regular file is still
+    replaced."""
+    from stereovision.cli import main
+
+    fifo = tmp_path / "pipe.png"
+    os.mkfifo(fifo)
+    (tmp_path / "link.png").symlink_to("pipe.png")
+    said = f"cannot write {fifo}: it is not a regular file (a FIFO or a device)"
+    for dest in (fifo, tmp_path / "link.png"):
+        with pytest.raises(OSError) as refused, atomic_write(dest) as fh:
+            fh.write(b"x")
+        assert str(refused.value) == said
+        with pytest.raises(OSError) as together:
+            write_together([(tmp_path / "a.yaml", b"1"), (dest, b"2")])
+        assert str(together.value) == said
+    assert main(["board", "-o", str(fifo), "--square", "20", "--unit", "mm"]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+    assert sorted(os.listdir(tmp_path)) == ["link.png", "pipe.png"]  # nothing written
+    assert not fifo.is_file() and fifo.exists()
+    (tmp_path / "plain.png").write_bytes(b"old")
+    with atomic_write(tmp_path / "plain.png") as fh:
+        fh.write(b"new")
+    assert (tmp_path / "plain.png").read_bytes() == b"new"
+
+
 def test_load_scene_of_a_folder_at_the_filesystem_root_has_no_leading_slash(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -509,6 +509,9 @@ def _writable_destination(dest: Path) -> Path:
     directory = dest.parent if str(dest.parent) else Path(".")
     if dest.is_dir():
         raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
+    if dest.exists() and not dest.is_file():
+        # a FIFO (a reader waiting on it) or a device was replaced by a regular file unsaid
+        raise OSError(f"cannot write {dest}: it is not a regular file (a FIFO or a device)")
     if directory.exists() and not directory.is_dir():
         raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
     if not directory.is_dir():
@@ -557,7 +560,8 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     IsADirectoryError, NotADirectoryError
         If ``path`` is a folder, or its directory is a file.
     OSError
-        If ``path`` is a link that loops.
+        If ``path`` is a link that loops, or a FIFO or a device (replaced, the reader waiting
+        on it got nothing).
     """
     dest = _through_links(Path(path))
     _writable_destination(dest)
