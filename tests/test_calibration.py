@@ -2154,6 +2154,30 @@ def test_a_folder_whose_calibration_is_a_fifo_says_so(tmp_path: Path) -> None:
         Calibration.from_file(tmp_path / "empty")
 
 
+def test_a_calibration_link_to_nothing_names_its_target_in_a_folder_or_alone(
+    tmp_path: Path,
+) -> None:
+    """A scene folder whose Q.dat (or calib.txt) is a link whose target moved was said to be 'a
+    folder without left.yaml and right.yaml (ROS camera_info), calib.txt or Q.dat' (the file
+    c26efd0 named for a FIFO there), and the link given alone 'calibration file not found:
+    Q.dat', without the link: both now say it as imread does, naming the missing target."""
+    for name in ("Q.dat", "calib.txt"):
+        folder = tmp_path / name.replace(".", "_")
+        folder.mkdir()
+        (folder / name).symlink_to(tmp_path / "moved" / name)
+        said = (
+            f"calibration file not found: {folder / name} (a link to "
+            f"{tmp_path / 'moved' / name}, which does not exist)"
+        )
+        for given in (folder, folder / name):
+            with pytest.raises(FileNotFoundError) as info:
+                Calibration.from_file(given)
+            assert str(info.value) == said
+    with pytest.raises(FileNotFoundError) as plain:
+        Calibration.from_file(tmp_path / "none.yaml")  # no link: said as before
+    assert str(plain.value) == f"calibration file not found: {tmp_path / 'none.yaml'}"
+
+
 def test_describe_refuses_depths_without_a_depth_step() -> None:
     """describe(depths=...) said a negative depth's step ('at -1 m 2.3 cm'), NaN's ('at nan m
     none'), an empty tuple as a line without steps, and one number was TypeError "'float'

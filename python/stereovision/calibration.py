@@ -1435,7 +1435,11 @@ class Calibration:
     def _read_text(path: PathLike, name: str = "path") -> tuple[Path, str]:
         p = as_path(path, name)
         if not p.exists():
-            raise FileNotFoundError(f"calibration file not found: {p}")
+            # a link whose target moved: which file is missing is said, as imread says it
+            from stereovision.io import _broken_link
+
+            gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+            raise FileNotFoundError(f"calibration file not found: {p}{gone}")
         if not p.is_file():
             raise ValueError(f"calibration path is not a file: {p}")
         try:
@@ -1594,11 +1598,12 @@ class Calibration:
                     _scene_image_size(q) if image_size is None else image_size,
                     unit=unit or "m",
                 )
-            # a FIFO or a device under one of those names: it is there, but not a file ("a
-            # folder without ... Q.dat" sent the user looking for a file they could see)
+            # a FIFO, a device or a link to nothing under one of those names: it is there, but
+            # not a file ("a folder without ... Q.dat" sent the user looking for a file they
+            # could see); said as the file given alone is, nothing opened
             for name in ("left.yaml", "right.yaml", "left.yml", "right.yml", "calib.txt", "Q.dat"):
-                if (p / name).exists() and not (p / name).is_file():
-                    raise ValueError(f"calibration path is not a file: {p / name}")
+                if ((p / name).exists() or (p / name).is_symlink()) and not (p / name).is_file():
+                    cls._read_text(p / name)
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
                 "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
