@@ -2191,6 +2191,8 @@ def test_describe_refuses_depths_without_a_depth_step() -> None:
         ((), r"depths: expected at least one depth in metres, got none"),
         (5.0, r"depths: expected a sequence of depths in metres, got 5\.0"),
         ("5", r"depths: expected a sequence of depths in metres, got '5'"),
+        # Iterable, but "iteration over a 0-d array" (TypeError)
+        (np.array(5.0), r"depths: expected a sequence of depths in metres, got array\(5\.\)"),
     ):
         with pytest.raises(ValueError, match=rf"^{said}$"):
             c.describe(bad)  # type: ignore[arg-type]

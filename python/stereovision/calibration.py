@@ -1025,7 +1025,12 @@ class Calibration:
         """
         # a negative depth was said to have a step ("at -1 m 2.3 cm"), NaN "at nan m none", no
         # depth an empty list, and one number TypeError "'float' object is not iterable"
-        if isinstance(depths, (str, bytes)) or not isinstance(depths, Iterable):
+        # a 0-d array is Iterable, but iterating it was TypeError "iteration over a 0-d array"
+        if (
+            isinstance(depths, (str, bytes))
+            or not isinstance(depths, Iterable)
+            or (isinstance(depths, np.ndarray) and depths.ndim == 0)
+        ):
             raise ValueError(f"depths: expected a sequence of depths in metres, got {depths!r}")
         depths = tuple(positive_finite(z, "depths") for z in depths)
         if not depths:
