@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import subprocess
 import sys
@@ -1130,6 +1131,28 @@ def test_loading_a_directory_is_file_not_found(tmp_path: Path) -> None:
     IsADirectoryError from reading it): a directory given as the file is named as not found."""
     with pytest.raises(FileNotFoundError, match="rectification file not found: "):
         UncalibratedRectification.load(tmp_path)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_loading_a_fifo_or_a_link_to_nothing_says_it_as_imread_does(tmp_path: Path) -> None:
+    """``--rectification rect.json`` where rect.json is a FIFO was 'rectification file not
+    found: rect.json', a file the user can see, and a link whose target moved was said without
+    the link; both are said in imread's words (f97b4e0 did the same for calibrate's images),
+    the FIFO not opened. A missing file and a folder are said as before."""
+    os.mkfifo(tmp_path / "rect.json")
+    (tmp_path / "gone.json").symlink_to(tmp_path / "moved.json")
+    with pytest.raises(ValueError) as fifo:
+        UncalibratedRectification.load(tmp_path / "rect.json")
+    assert str(fifo.value) == f"rectification file is not a regular file: {tmp_path / 'rect.json'}"
+    with pytest.raises(FileNotFoundError) as gone:
+        UncalibratedRectification.load(tmp_path / "gone.json")
+    assert str(gone.value) == (
+        f"rectification file not found: {tmp_path / 'gone.json'} (a link to "
+        f"{tmp_path / 'moved.json'}, which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as missing:
+        UncalibratedRectification.load(tmp_path / "none.json")
+    assert str(missing.value) == f"rectification file not found: {tmp_path / 'none.json'}"
 
 
 def test_lenses_differing_by_more_than_30_percent_are_not_two_turned_cameras(

@@ -591,9 +591,10 @@ class UncalibratedRectification:
         Raises
         ------
         FileNotFoundError
-            If it does not exist.
+            If it does not exist (a link to nothing: its target named).
         ValueError
-            If it is not such a file (the field named), or its values cannot rectify a pair
+            If it is not a regular file (a FIFO) or not such a file (the field named), or its
+            values cannot rectify a pair
             (NaN or singular homographies, sizes of 0 or less, an unknown model).
         """
         p = Path(path)
@@ -603,8 +604,11 @@ class UncalibratedRectification:
                 f"rectification file not found: {p} is a folder; give "
                 + (f"its {inside}" if inside.is_file() else "the rectification.json in it")
             )
-        if not p.is_file():
-            raise FileNotFoundError(f"rectification file not found: {p}")
+        # a FIFO was "not found", a file that is there, and a link whose target moved said
+        # without the link: in imread's words (a FIFO is not opened: its read would block)
+        from stereovision.io import _existing_file
+
+        _existing_file(p, "rectification file")
         try:
             d = json.loads(p.read_text())
         except (UnicodeDecodeError, json.JSONDecodeError):
