@@ -872,3 +872,22 @@ def test_a_title_with_a_newline_or_a_nul_stays_on_its_line(title: str) -> None:
     # below the title band, the picture of a one-word title
     one_word = overview_image(result, "x").image
     np.testing.assert_array_equal(ov.image[_TITLE_H:], one_word[_TITLE_H:])
+
+
+@pytest.mark.parametrize("name", ["depth", "confidence"])
+def test_a_map_of_another_size_than_the_disparity_is_named(name: str) -> None:
+    """A hand-made result whose depth or confidence map had another size than its disparity
+    map gave NumPy's "operands could not be broadcast together with shapes (120,200)
+    (60,100)", naming neither map. The message names the map and both shapes."""
+    from types import SimpleNamespace
+
+    disparity = np.tile(np.linspace(1.0, 40.0, 200, dtype=np.float32), (120, 1))
+    maps = {"depth": None, "confidence": np.ones_like(disparity)}
+    maps[name] = np.ones((60, 100), np.float32)
+    result = SimpleNamespace(disparity=disparity, left_rectified=None, **maps)
+    with pytest.raises(
+        ValueError,
+        match=rf"^result: expected a {name} map of the disparity "
+        r"map's shape \(120, 200\), got shape \(60, 100\)$",
+    ):
+        overview_image(result, "t")

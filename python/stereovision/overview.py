@@ -313,7 +313,8 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     ------
     ValueError
         An unknown ``unit`` (the message names the allowed ones), a disparity map that is not
-        ``(H, W)`` or has no pixel, or a left image that is not grey, BGR or BGRA, or not uint8.
+        ``(H, W)`` or has no pixel, a depth or confidence map of another shape, or a left image
+        that is not grey, BGR or BGRA, or not uint8.
     """
     from stereovision._validate import known_unit
     from stereovision.calibration import UNIT_TO_METRES
@@ -353,6 +354,15 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         if left.ndim == 2:
             left = cv2.cvtColor(np.ascontiguousarray(left), cv2.COLOR_GRAY2BGR)
     valid = np.isfinite(disparity)
+    # a hand-made result's maps of another size than its disparity map's gave NumPy's
+    # "operands could not be broadcast together with shapes (120,200) (60,100)"
+    for name in ("depth", "confidence"):
+        shape = np.shape(getattr(result, name))
+        if shape and shape != disparity.shape:
+            raise ValueError(
+                f"result: expected a {name} map of the disparity map's shape {disparity.shape}, "
+                f"got shape {shape}"
+            )
     confidence = np.where(valid, np.asarray(result.confidence, np.float32), np.nan)
     # name, values as mapped, fixed ends, caption, labelled value -> mapped value, tick values
     maps: list[tuple[str, Any, Any, str, Callable[[float], float], str, str]] = [
