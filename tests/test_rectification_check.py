@@ -1134,3 +1134,28 @@ def test_the_plot_of_a_12_bit_pair_shows_its_images(data_dir: Path) -> None:
     pair, eight_pair = plot[-120:], eight_plot[-120:]  # below the summary band
     assert abs(np.median(pair) - np.median(eight_pair)) < np.median(eight_pair) / 3
     assert np.corrcoef(pair.ravel(), eight_pair.ravel())[0, 1] > 0.99
+
+
+def test_the_plot_dims_the_pair_without_a_float_copy_of_it() -> None:
+    """draw_rectification_check dimmed the side-by-side pair by ``canvas * 0.7``: a float64
+    copy of the whole picture (576 MB for a 12 MP pair), 8 times the picture's size at its
+    peak. The same grey levels now come from a table, at a peak within 3 times it."""
+    import tracemalloc
+
+    from stereovision.rectification_check import draw_rectification_check
+
+    rng = np.random.default_rng(3)
+    left = rng.integers(0, 256, (600, 800, 3), dtype=np.uint8)
+    right = rng.integers(0, 256, (600, 800, 3), dtype=np.uint8)
+    empty = _judge_rows(np.zeros((0, 4)), 800, 600, 0.5)
+    tracemalloc.start()
+    try:
+        plot = draw_rectification_check(left, right, empty)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 3 * plot.nbytes
+    # the same dimmed grey levels as before, above the first row line (y = 20)
+    pair = plot[plot.shape[0] - 600 :]
+    expected = (np.concatenate([left, right], axis=1) * 0.7).astype(np.uint8)
+    np.testing.assert_array_equal(pair[:16], expected[:16])

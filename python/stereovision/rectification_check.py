@@ -387,6 +387,10 @@ def already_rectified(left: npt.ArrayLike, right: npt.ArrayLike) -> Rectificatio
     return check if check.ok is True and not check.swapped else None
 
 
+#: :func:`draw_rectification_check`'s dimming of the pair under its dots, grey level -> level.
+_DIM = (np.arange(256) * 0.7).astype(np.uint8)
+
+
 def draw_rectification_check(
     left: npt.ArrayLike, right: npt.ArrayLike, check: RectificationCheck
 ) -> npt.NDArray[np.uint8]:
@@ -435,7 +439,9 @@ def draw_rectification_check(
         )
     h, w = lb.shape[:2]
     canvas = np.concatenate([lb, rb], axis=1)
-    canvas = (canvas * 0.7).astype(np.uint8)
+    # dimmed to 0.7 by a table: ``canvas * 0.7`` made a float64 copy of the whole picture
+    # (576 MB for a 12 MP pair side by side), for the same grey levels
+    canvas = cv2.LUT(canvas, _DIM)
     for y in range(20, h, 40):
         cv2.line(canvas, (0, y), (2 * w - 1, y), (200, 200, 200), 1, cv2.LINE_AA)
     tol = check.tolerance
