@@ -1645,3 +1645,20 @@ def test_a_file_with_a_count_that_is_no_whole_number_is_named(
     back = UncalibratedRectification.load(path)
     assert back.size == (640, 360) and back.max_disparity == 48
     assert type(back.size[0]) is int and type(back.max_disparity) is int
+
+
+def test_a_12_bit_pair_in_16_bits_is_rectified_from_its_features(data_dir: Path) -> None:
+    """A 12-bit camera's pair in uint16 (0-4095) was cut to 8 bits as 16-bit data: 0-16 grey
+    levels, no SIFT feature, and rectify_uncalibrated (stereovision rectify) said "only 0
+    feature matches ... point the cameras at something textured" of the textured cones, as
+    check_rectification did before 63769d7; its check() alike. A dark pair is stretched by
+    one gain first, as the check stretches it: the 8-bit pair's matches and rows."""
+    left, right = (
+        cv2.imread(str(data_dir / "middlebury2003/cones" / f), cv2.IMREAD_GRAYSCALE)
+        for f in ("left.png", "right.png")
+    )
+    twelve = [((im.astype(np.int64) * 4095 + 127) // 255).astype(np.uint16) for im in (left, right)]
+    rect = rectify_uncalibrated(*twelve)
+    assert rect.matches > 400 and rect.median_dy < 0.3  # the 8-bit pair: 524, 0.05 px
+    check = rect.check(*twelve)
+    assert check.ok is True and check.matches > 400

@@ -44,7 +44,6 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
-    as_gray_uint8,
     as_image_array,
     number_shown,
     real_number,
@@ -57,6 +56,7 @@ from stereovision.rectification_check import (
     MIN_MATCHES,
     RectificationCheck,
     _features,
+    _grey_pair,
     _judge_rows,
     _mutual_matches,
 )
@@ -505,11 +505,10 @@ class UncalibratedRectification:
             raise ValueError(
                 f"tolerance: expected a positive number of pixels, got {number_shown(tolerance)}"
             )
-        grays = []
-        for name, img in (("left", left), ("right", right)):
-            g = as_gray_uint8(img, name)
+        # a dark pair (12-bit data in 16 bits) stretched as check_rectification stretches it
+        grays = _grey_pair(left, right)
+        for name, g in zip(("left", "right"), grays, strict=True):
             self._check_input_size(name, g.shape)
-            grays.append(g)
         pl, dl = _features(grays[0])
         pr, dr = _features(grays[1])
         pairs = (
@@ -771,7 +770,10 @@ def rectify_uncalibrated(
     if not (real_number(ransac_px) and math.isfinite(ransac_px) and ransac_px > 0):
         raise ValueError(f"ransac_px: expected a positive number of pixels, got {ransac_px!r}")
     ransac = float(ransac_px)
-    gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
+    # a 12-bit camera's pair in 16 bits cut to 8 bits kept 0-16 grey levels: "only 0 feature
+    # matches (... point the cameras at something textured)" of a textured pair; a dark pair
+    # is stretched by one gain, as check_rectification stretches it
+    gl, gr = _grey_pair(left, right)
     if gl.shape != gr.shape:
         raise ValueError(
             f"left is {gl.shape[1]}x{gl.shape[0]} px, right is {gr.shape[1]}x{gr.shape[0]} px: "
