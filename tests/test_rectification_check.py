@@ -1159,3 +1159,26 @@ def test_the_plot_dims_the_pair_without_a_float_copy_of_it() -> None:
     pair = plot[plot.shape[0] - 600 :]
     expected = (np.concatenate([left, right], axis=1) * 0.7).astype(np.uint8)
     np.testing.assert_array_equal(pair[:16], expected[:16])
+
+
+def test_align_rows_refuses_a_check_of_a_pair_of_another_size(data_dir: Path) -> None:
+    """align_rows took a check made on another size of the pair (the full-size pair's, to
+    align a half-size copy) and moved the rows by that pair's row model, about its centre:
+    cones 2 px apart, checked at 450x375 and aligned at 225x188, were left 0.9 px apart
+    without a word. The check keeps the size it was made on, and align_rows names both."""
+    from stereovision.rectification_check import align_rows
+
+    left, right = _pair(data_dir, "middlebury2003/cones")
+    right = _warp(right, np.float32([[1, 0, 0], [0, 1, 2.0]]))
+    check = check_rectification(left, right)
+    assert check.size == (450, 375) and "size" not in check.as_dict()
+    half = [cv2.resize(im, (225, 188), interpolation=cv2.INTER_AREA) for im in (left, right)]
+    with pytest.raises(
+        ValueError,
+        match=r"^check: made on a 450x375 px pair, the right image is 225x188 px: check the "
+        r"pair that is aligned$",
+    ):
+        align_rows(*half, check)
+    # the pair it was made on is aligned as before
+    aligned, used = align_rows(left, right, check)
+    assert used is check and check_rectification(left, aligned).ok is True

@@ -73,6 +73,9 @@ class RectificationCheck:
     points : ndarray, float32 (N, 4)
         The matches the figures are over, ``[x_left, y_left, x_right, y_right]`` in the
         rectified pair (for :func:`draw_rectification_check`; not in :meth:`as_dict`).
+    size : tuple of int or None
+        ``(width, height)`` of the pair checked, px (:func:`align_rows` refuses a pair of
+        another size; not in :meth:`as_dict`); None for a check made by hand.
 
     Notes
     -----
@@ -92,6 +95,7 @@ class RectificationCheck:
     points: npt.NDArray[np.float32] = field(
         default_factory=lambda: np.zeros((0, 4), np.float32), repr=False, compare=False
     )
+    size: tuple[int, int] | None = field(default=None, repr=False, compare=False)
 
     def as_dict(self) -> dict[str, Any]:
         """The fields as a JSON-ready dict (NaN as None).
@@ -99,12 +103,12 @@ class RectificationCheck:
         Returns
         -------
         dict
-            Field name to value, ``points`` left out.
+            Field name to value, ``points`` and ``size`` left out.
         """
         out: dict[str, Any] = {}
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name != "points":
+            if f.name not in ("points", "size"):
                 out[f.name] = None if isinstance(v, float) and not np.isfinite(v) else v
         return out
 
@@ -311,7 +315,7 @@ def _judge_rows(quad: npt.NDArray[np.float64], w: int, h: int, tol: float) -> Re
     quad = np.asarray(quad, np.float64).reshape(-1, 4)
     nan = float("nan")
     if len(quad) < MIN_MATCHES:
-        return RectificationCheck(len(quad), nan, nan, nan, nan, nan, None, tol)
+        return RectificationCheck(len(quad), nan, nan, nan, nan, nan, None, tol, size=(w, h))
     xl, yl, xr, yr = quad.T
     dy, dx = yl - yr, xl - xr
     # A rectified side-by-side rig: a match far off its row, or with a disparity well below
@@ -347,6 +351,7 @@ def _judge_rows(quad: npt.NDArray[np.float64], w: int, h: int, tol: float) -> Re
             med <= tol,
             tol,
             points=pts[inl],
+            size=(w, h),
         )
     # Plenty of matches, but not on a common row model (a pair far from rectified, or not a
     # side-by-side pair at all) or mostly at negative disparities: not rectified.
@@ -362,6 +367,7 @@ def _judge_rows(quad: npt.NDArray[np.float64], w: int, h: int, tol: float) -> Re
         tol,
         swapped=swapped,
         points=pts,
+        size=(w, h),
     )
 
 
@@ -613,9 +619,22 @@ def align_rows(
         within its own range, bicubic's overshoot clipped) and the check it was aligned by.
         The right image is returned unchanged when the check found no common row model (too
         little texture, or far from rectified).
+
+    Raises
+    ------
+    ValueError
+        A ``check`` made on a pair of another size than ``right`` (its row model's offsets
+        and slopes are of that pair).
     """
     ra = as_image_array(right, "right")
     res = check if check is not None else check_rectification(left, right)
+    if res.size is not None and res.size != (ra.shape[1], ra.shape[0]):
+        # its row model (offsets about the centre of the pair it was fitted on) moved the rows
+        # of a half-size pair by a full-size pair's offsets: 0.9 px apart, without a word
+        raise ValueError(
+            f"check: made on a {res.size[0]}x{res.size[1]} px pair, the right image is "
+            f"{ra.shape[1]}x{ra.shape[0]} px: check the pair that is aligned"
+        )
     if res.ok is None or not np.isfinite(res.offset):
         return ra, res
     h, w = ra.shape[:2]
