@@ -202,3 +202,31 @@ def test_a_signal_in_the_start_up_is_one_line(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
     )
     assert (proc.returncode, proc.stdout, proc.stderr) == expected
+
+
+# datetime: imported by NumPy's C initialisation; stereovision.cli: by the GUI's parser
+@pytest.mark.parametrize("module", ["datetime", "stereovision.cli"])
+@pytest.mark.parametrize(
+    ("signame", "expected"),
+    [
+        ("SIGTERM", (143, "", "stereovision: terminated (SIGTERM)\n")),
+        ("SIGINT", (130, "", "stereovision: interrupted\n")),
+    ],
+)
+def test_a_signal_in_the_guis_start_up_is_one_line(
+    signame: str, expected: tuple[int, str, str], module: str
+) -> None:
+    """``python -m stereovision.gui``, as ``python -m stereovision``: a SIGTERM in its imports
+    and its parse (the second before the CLI's runner set its handler) killed it without a
+    word, and a Ctrl+C inside NumPy's C initialisation printed NumPy's ImportError, exit 1."""
+    code = _CTRL_C_IN_THE_IMPORTS.format(
+        module=module,
+        argv=["--port", "-1"],
+        run=_ENTRIES["python -m stereovision.gui"],
+        signal=signame,
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert (proc.returncode, proc.stdout, proc.stderr) == expected

@@ -467,12 +467,20 @@ def _main(argv: Sequence[str] | None) -> int:
     """:func:`main`'s work: parse ``argv`` and run the GUI."""
     # the CLI's parser: a refused value in one line, with the unit hint (``--read-timeout
     # 10s``), where argparse's own printed its usage block and no hint
-    try:  # the CLI's module and the options' are imported here (0.2 s), as the CLI's _main
-        from stereovision.cli import _Parser
+    from stereovision._interrupt import HeldInterrupts, Terminated
 
-        p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
-        add_arguments(p)
+    try:  # the CLI's module and the options' are imported here (0.2 s), as the CLI's _main
+        # held until they are whole, as the CLI's are: a Ctrl+C inside NumPy's C
+        # initialisation came out as NumPy's ImportError, a traceback
+        with HeldInterrupts():
+            from stereovision.cli import _Parser
+
+            p = _Parser(prog="stereovision gui", description=__doc__.splitlines()[0])
+            add_arguments(p)
         args = p.parse_args(argv)
+    except Terminated:  # python -m stereovision.gui's handler, set before these imports
+        print("stereovision: terminated (SIGTERM)", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return 130
