@@ -6721,15 +6721,20 @@ def test_one_camera_given_twice_is_refused_as_capture_refuses_it(
 ) -> None:
     """``gui --left 3 --right 3`` (or ``/dev/video3``) opened the camera twice, the second open
     failing with a hint about another program using it, where capture and stream refuse it
-    before any open: refused now in their words, one line, exit 2."""
+    before any open: refused now in their words (``3`` and ``3`` was "'3' and '3' are both
+    camera /dev/video3", stream's "both camera 3"), one line, exit 2."""
     import stereovision.gui as gui
+    from stereovision.cli import main
 
+    assert main(["stream", "--left", left, "--right", right]) == 2
+    stream_said = capsys.readouterr()
+    said = {
+        "3": "--left and --right are both camera 3",
+        "/dev/video3": "--left '3' and --right '/dev/video3' are both camera /dev/video3",
+    }[right]
+    assert stream_said == ("", f"stereovision: error: {said}: give the rig's two cameras\n")
     assert gui.main(["--left", left, "--right", right, "--no-browser", "--port", "0"]) == 2
-    assert capsys.readouterr() == (
-        "",
-        f"stereovision: error: --left {left!r} and --right {right!r} are both camera "
-        "/dev/video3: give the rig's two cameras\n",
-    )
+    assert capsys.readouterr() == stream_said
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="V4L2 device nodes")

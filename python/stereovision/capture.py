@@ -2335,6 +2335,27 @@ def _http_url(src: object) -> bool:
     return isinstance(src, str) and re.match(r"\s*https?://", src, re.IGNORECASE) is not None
 
 
+def _refuse_one_camera_twice(left: object, right: object) -> None:
+    """Refuse ``--left`` and ``--right`` sources (as :func:`parse_source` reads them) that name
+    one camera: its second open failed with a hint about another program using the camera.
+    Said in one way by capture, stream and gui.
+
+    Raises
+    ------
+    ValueError
+        If both are one camera index, or name one device (``0`` and ``/dev/video0``).
+    """
+    if isinstance(left, int) and left == right:
+        raise ValueError(f"--left and --right are both camera {left}: give the rig's two cameras")
+    device = _camera_device(left)
+    if device is not None and device == _camera_device(right):
+        # one camera named two ways (--left 0 --right /dev/video0, or a /dev/v4l link)
+        raise ValueError(
+            f"--left {str(left)!r} and --right {str(right)!r} are both camera {device}: give "
+            "the rig's two cameras"
+        )
+
+
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     """The :class:`StereoCamera` or :class:`~stereovision.rosbag.BagCamera` the options name.
 
@@ -2385,17 +2406,7 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     if args.left is None or args.right is None:
         raise ValueError("give the two cameras (--left and --right) or a recording (--from-bag)")
     left, right = parse_source(args.left), parse_source(args.right)
-    if isinstance(left, int) and left == right:
-        # the second open failed with a hint about another program using the camera
-        raise ValueError(f"--left and --right are both camera {left}: give the rig's two cameras")
-    device = _camera_device(left)
-    if device is not None and device == _camera_device(right):
-        # one camera named two ways (--left 0 --right /dev/video0, or a /dev/v4l link): the
-        # second open failed with a hint about another program using the camera
-        raise ValueError(
-            f"--left {str(left)!r} and --right {str(right)!r} are both camera {device}: give "
-            "the rig's two cameras"
-        )
+    _refuse_one_camera_twice(left, right)
     cam = StereoCamera(
         left,
         right,

@@ -139,18 +139,14 @@ def build_app(args: argparse.Namespace) -> Any:
     label = None
     names = (str(args.left or ""), str(args.right or ""))
     if args.left is not None:
-        from stereovision.capture import _camera_device, _same_path
+        from stereovision.capture import _refuse_one_camera_twice, _same_path
         from stereovision.gui.sources import parse_source
 
         left, right = parse_source(args.left), parse_source(args.right)
-        device = _camera_device(left)
-        if device is not None and device == _camera_device(right):
-            # refused as capture and stream refuse it: the second open failed with a hint
-            # about another program using the camera
-            raise ValueError(
-                f"--left {str(args.left)!r} and --right {str(args.right)!r} are both camera "
-                f"{device}: give the rig's two cameras"
-            )
+        # in capture's and stream's words (--left 3 --right 3 was "'3' and '3' are both
+        # camera /dev/video3" here, "both camera 3" there): the second open failed with a
+        # hint about another program using the camera
+        _refuse_one_camera_twice(left, right)
         source = open_stereo_source(
             args.left, args.right, fourcc=getattr(args, "fourcc", None), read_timeout=read_timeout
         )
