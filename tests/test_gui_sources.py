@@ -121,6 +121,16 @@ def test_an_empty_data_folder_is_refused_not_taken_for_the_current_one(
         AllowedFolders([given])
     from stereovision.gui import main
 
+    if not given:  # refused by the CLI's parser first, as any empty argument (46356f4)
+        with pytest.raises(SystemExit) as exit_:
+            main(["--data", given, "--no-browser", "--port", "0"])
+        assert exit_.value.code == 2
+        assert capsys.readouterr() == (
+            "",
+            "stereovision gui: error: argument --data: expected a value, got '' (an unset "
+            "variable?) (see stereovision gui --help)\n",
+        )
+        return
     assert main(["--data", given, "--no-browser", "--port", "0"]) == 2
     assert capsys.readouterr() == (
         "",
