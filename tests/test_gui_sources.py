@@ -138,6 +138,22 @@ def test_an_empty_data_folder_is_refused_not_taken_for_the_current_one(
     )
 
 
+def test_a_data_folder_named_with_spaces_is_taken(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A folder named " " (a legal name, which the CLI's parser takes) was refused as "data
+    folder: expected a folder, got ' '" though it is one; blank text naming no folder still is
+    (test_an_empty_data_folder_is_refused_not_taken_for_the_current_one)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / " ").mkdir()
+    (tmp_path / " " / "left.png").write_bytes(b"")
+    (tmp_path / "other.png").write_bytes(b"")
+    allowed = AllowedFolders([" "])
+    assert allowed.roots == ((tmp_path / " ").resolve(),)
+    assert allowed.contains(tmp_path / " " / "left.png")
+    assert not allowed.contains(tmp_path / "other.png")
+
+
 def test_a_data_folder_under_an_unknown_users_home_is_said_as_such() -> None:
     """``gui --data ~nobody-such/scenes`` (the shell leaves an unknown user's ``~`` as typed)
     said Python's 'Could not determine home directory.', naming neither the folder nor why."""

@@ -146,16 +146,18 @@ class AllowedFolders:
     FileNotFoundError
         If a root is not an existing folder.
     ValueError
-        If a root is empty or blank, or under the home folder of a user no one knows.
+        If a root is empty or blank (spaces naming no folder), or under the home folder of a
+        user no one knows.
     """
 
     def __init__(self, roots: Iterable[str | os.PathLike[str]]) -> None:
         resolved: list[Path] = []
         for r in roots:
             text = os.fspath(r)
-            if not text.strip():
+            if not text or not (text.strip() or os.path.isdir(text)):
                 # an unset shell variable (--data "$SCENES") was the current folder: the page
-                # listed, opened and saved into wherever the command was started
+                # listed, opened and saved into wherever the command was started (a folder
+                # named with spaces, a legal name, is taken as the CLI takes it)
                 raise ValueError(f"data folder: expected a folder, got {text!r}")
             # ~bob/x of an unknown user: said as the page says it (not "Could not determine
             # home directory.")
