@@ -1882,6 +1882,32 @@ def test_a_folder_without_write_permission_is_named_not_the_temporary_file(
     assert (tmp_path / "ro" / "rig.yaml").read_text() == "old"
 
 
+def test_a_folder_refusing_new_files_for_another_reason_is_named_not_the_temporary_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Only PermissionError was said of the file and its folder: board -o /proc/x.png (mkstemp:
+    ENOENT) printed '[Errno 2] No such file or directory: '/proc/.x.png.58m0qpf3.tmp''. Any
+    refusal names the file and its folder, keeping its class and errno."""
+    import tempfile
+
+    def refused(prefix: str = "", suffix: str = "", dir: object = None) -> tuple[int, str]:
+        raise FileNotFoundError(2, "No such file or directory", f"{dir}/{prefix}58m0qpf3{suffix}")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refused)
+    want = (
+        f"cannot write {tmp_path / 'x.png'}: no file can be made in its folder {tmp_path} "
+        "(No such file or directory)"
+    )
+    with pytest.raises(FileNotFoundError) as info:
+        with atomic_write(tmp_path / "x.png") as fh:
+            fh.write(b"x")
+    assert str(info.value) == want and info.value.errno == 2
+    with pytest.raises(FileNotFoundError) as together:
+        write_together([(tmp_path / "x.png", b"x")])
+    assert str(together.value) == want
+    assert not (tmp_path / "x.png").exists()
+
+
 # ------------------------------------------------------- third mutation audit of the safe writes
 
 

@@ -533,6 +533,15 @@ def _temp_beside(dest: Path, suffix: str) -> tuple[int, str]:
         )
         refused.errno = errno.EACCES
         raise refused from exc
+    except OSError as exc:
+        # any other refusal of the folder (/proc: ENOENT, a read-only filesystem: EROFS) named
+        # the temporary file too ('No such file or directory: '/proc/.x.png.58m0qpf3.tmp'')
+        failed = type(exc)(
+            f"cannot write {dest}: no file can be made in its folder {directory} "
+            f"({exc.strerror or exc})"
+        )
+        failed.errno = exc.errno
+        raise failed from exc
 
 
 @contextmanager
