@@ -365,6 +365,55 @@ def test_every_writer_needing_a_calibration_says_to_pass_calib(result, tmp_path)
     assert not (tmp_path / "out").exists() and not list(tmp_path.iterdir())
 
 
+def test_a_bytes_path_is_refused_naming_the_argument(result, tmp_path):
+    """A bytes file name failed in pathlib with "argument should be a str object or an
+    os.PathLike object returning str, not <class 'bytes'>", naming no argument, where
+    Calibration.from_file said which: every reader and writer now says it in those words."""
+    from stereovision import io
+    from stereovision.matches import Matches
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    base = str(tmp_path / "x")
+    cal = result.calibration
+    calls = {
+        ".ply": [
+            lambda p: result.to_ply(p),
+            lambda p: export.write_cloud_ply(p, result),
+            lambda p: export.load_cloud(p),
+            lambda p: io.write_ply(p, np.zeros((2, 3), np.float32)),
+            lambda p: io.read_ply(p),
+        ],
+        ".pcd": [lambda p: export.write_pcd(p, result)],
+        ".npz": [lambda p: export.write_npz(p, result)],
+        ".png": [
+            lambda p: export.write_depth_png(p, result),
+            lambda p: export.write_disparity_png(p, result),
+            lambda p: io.imread(p),
+            lambda p: io.read_image(p),
+        ],
+        ".pfm": [lambda p: io.write_pfm(p, np.zeros((2, 2), np.float32)), io.read_pfm],
+        ".csv": [
+            lambda p: Matches.from_csv(p, (4, 4)),
+            lambda p: Matches(*(np.zeros(0, np.float32) for _ in range(5)), (4, 4)).save_csv(p),
+        ],
+        ".yaml": [cal.save, type(cal).load, type(cal).from_file],
+        ".json": [UncalibratedRectification.load],
+    }
+    for suffix, funcs in calls.items():
+        name = base + suffix
+        want = (
+            f"path: expected a str or os.PathLike file name, got the bytes {name!r}: "
+            "decode it first (os.fsdecode(path))"
+        )
+        for func in funcs:
+            with pytest.raises(TypeError) as err:
+                func(name.encode())
+            assert str(err.value) == want, (suffix, str(err.value))
+    with pytest.raises(TypeError, match=r"^directory: expected a str or os.PathLike file name"):
+        io.load_scene(base.encode())
+    assert not list(tmp_path.iterdir())
+
+
 def test_load_cloud_errors(tmp_path):
     fake = tmp_path / "fake.ply"
     fake.write_bytes(b"\x89PNG not a ply")

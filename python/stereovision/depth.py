@@ -32,6 +32,7 @@ from stereovision._validate import (
     _shown,
     as_bgr_uint8,
     as_gray_float,
+    as_path,
     check_pair,
     crop_or_pad_hint,
     figure_shown,
@@ -1027,6 +1028,7 @@ class DepthResult:
 
         if self.depth is None:
             raise ValueError(NO_DEPTH.format(what="point cloud"))
+        as_path(path)
         if Path(path).suffix.lower() != ".ply":
             raise ValueError(
                 f"{path}: to_ply writes a .ply file (export.write_pcd writes .pcd, "

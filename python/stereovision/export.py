@@ -38,6 +38,7 @@ import numpy.typing as npt
 from stereovision._validate import (
     NO_DEPTH,
     NOT_NUMBERS,
+    as_path,
     check_index_range,
     not_a_result,
     number_shown,
@@ -625,6 +626,7 @@ def load_cloud(
         Not a PLY / PCD / NPZ file (``"not a PLY file: ..."`` for a ``.ply`` that is not one), or
         a cloud without any finite point (``"empty point cloud: ..."``).
     """
+    as_path(path)
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"point cloud file not found: {p}")
@@ -827,6 +829,7 @@ def _png16_bytes(values: npt.NDArray[np.float64], what: str) -> bytes:
 
 
 def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
+    as_path(path)
     if Path(path).suffix.lower() != ".png":
         raise ValueError(f"{path}: a 16-bit {what} image is written as .png (lossless)")
     data = _png16_bytes(values, what)

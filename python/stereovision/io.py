@@ -572,6 +572,7 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         If ``path`` is a link that loops, or a FIFO or a device (replaced, the reader waiting
         on it got nothing).
     """
+    as_path(path)
     dest = _through_links(Path(path))
     _writable_destination(dest)
     fd, tmp = _temp_beside(dest, ".tmp")

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS
+from stereovision._validate import NOT_NUMBERS, as_path
 from stereovision.calibration import Calibration
 from stereovision.io import atomic_write
 
@@ -362,6 +362,7 @@ class Matches:
         # a folder was IsADirectoryError, and a binary file (a PNG given by mistake) a
         # UnicodeDecodeError naming no file: "'utf-8' codec can't decode byte 0x89 ...". A
         # pipe (a shell's <(...), /dev/stdin) is no regular file but is read as one.
+        as_path(path)
         if not Path(path).is_fifo():
             _existing_file(path, "matches CSV file")
         # utf-8-sig: a file saved again by a spreadsheet (Excel) starts with a BOM, which made

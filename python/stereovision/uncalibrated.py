@@ -45,6 +45,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     as_image_array,
+    as_path,
     number_shown,
     real_number,
     too_large_for_float,
@@ -565,6 +566,7 @@ class UncalibratedRectification:
         from stereovision._jsonout import json_ready
         from stereovision.io import atomic_write
 
+        as_path(path)
         p = Path(path)
         # strict JSON, as the package's other JSON: a NaN or infinite figure was written as
         # the bare NaN / Infinity that jq and JavaScript refuse; it is null, read back as NaN
@@ -596,6 +598,7 @@ class UncalibratedRectification:
             values cannot rectify a pair
             (NaN or singular homographies, sizes of 0 or less, an unknown model).
         """
+        as_path(path)
         p = Path(path)
         if p.is_dir():  # "not found" alone, of a folder that is there (the type kept: API)
             inside = p / "rectification.json"
