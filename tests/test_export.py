@@ -1077,7 +1077,7 @@ def test_depth_png_warning_and_suffix(tmp_path):
     16-bit image is refused under another suffix than .png."""
     import warnings
 
-    with pytest.warns(UserWarning, match="millimetres given") as rec:
+    with pytest.warns(UserWarning, match=r"4 beyond 65.535 m, .* \(depths are in metres\)") as rec:
         export.write_depth_png(tmp_path / "mm.png", np.full((2, 2), 1500.0))
     assert rec[0].filename == __file__
     with pytest.warns(UserWarning, match="none of its 4 values") as rec:
@@ -1309,7 +1309,26 @@ def test_disparity_png_warning_does_not_speak_of_millimetres(tmp_path):
     with pytest.warns(UserWarning) as rec:
         export.write_disparity_png(tmp_path / "d.png", np.full((2, 2), 300.0))
     assert str(rec[0].message) == (
-        "disparity: none of its 4 values fits 1..65535 at scale 256: the image is all 0"
+        "disparity: none of its 4 values fits 1..65535 at scale 256: 4 beyond 255.996, the most "
+        "a 16-bit PNG holds at this scale: the image is all 0"
+    )
+
+
+def test_depths_too_far_for_the_png_are_not_said_to_be_millimetres(tmp_path):
+    """Depths in metres past 65.535 m (a far scene, depth --max-disparity 1) were warned as
+    '(a depth in metres is expected; millimetres given?)': what the values are is said now."""
+    with pytest.warns(UserWarning) as rec:
+        export.encode_depth_png(np.array([[100.0, 70.0], [np.nan, -1.0]]))
+    assert str(rec[0].message) == (
+        "depth: none of its 2 values fits 1..65535 at scale 1000: 2 beyond 65.535 m, the most "
+        "a 16-bit PNG holds at this scale (depths are in metres): the image is all 0"
+    )
+    with pytest.warns(UserWarning) as rec:
+        export.write_depth_png(tmp_path / "z.png", np.array([[0.0001, 100.0]]))
+    assert str(rec[0].message) == (
+        "depth: none of its 2 values fits 1..65535 at scale 1000: 1 beyond 65.535 m, the most "
+        "a 16-bit PNG holds at this scale (depths are in metres); 1 rounding to 0 (under "
+        "0.0005): the image is all 0"
     )
 
 

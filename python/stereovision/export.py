@@ -896,11 +896,24 @@ def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.f
     # 0 means "none": values that round to 0 or do not fit 16 bits are dropped, not clipped, so
     # no pixel is written at a wrong distance.
     kept = (s >= 1) & (s <= 65535)
-    known = int(np.count_nonzero(np.isfinite(a) & (a > 0)))
+    positive = np.isfinite(a) & (a > 0)
+    known = int(np.count_nonzero(positive))
     if known and not kept.any():
+        # what is true of the values said, not a guess: depths of 66 m and more in metres (a
+        # far scene, a small --max-disparity) were "millimetres given?"
+        far = int(np.count_nonzero(positive & (s > 65535)))
+        why = []
+        if far:
+            unit = " m" if name == "depth" else ""
+            why.append(
+                f"{far} beyond {65535 / scale:g}{unit}, the most a 16-bit PNG holds at this scale"
+                + (" (depths are in metres)" if name == "depth" else "")
+            )
+        if known - far:
+            why.append(f"{known - far} rounding to 0 (under {0.5 / scale:g})")
         warnings.warn(
-            f"{name}: none of its {known} values fits 1..65535 at scale {scale:g}"
-            + (" (a depth in metres is expected; millimetres given?)" if name == "depth" else "")
+            f"{name}: none of its {known} values fits 1..65535 at scale {scale:g}: "
+            + "; ".join(why)
             + ": the image is all 0",
             UserWarning,
             stacklevel=3,
