@@ -177,6 +177,28 @@ def _check_runs(runs: object, name: str) -> None:
         raise ValueError(f"{name}: {_runs_rule(runs)}")
 
 
+def _run_count(text: str) -> int:
+    """argparse type of ``bench --runs``: a whole number from :data:`MIN_RUNS` to
+    :data:`stereovision.cli.MAX_RUNS`, refused by the parser in the form ``eval --runs`` is
+    ('stereovision bench: error: argument --runs: ...'), not as a bare 'stereovision: error:'."""
+    import argparse
+
+    from stereovision.cli import MAX_RUNS
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < MIN_RUNS:
+        raise argparse.ArgumentTypeError(
+            f"expected at least {MIN_RUNS} runs (evaluation.md: the median of >= {MIN_RUNS} "
+            f"runs), got {text!r}"
+        )
+    if value > MAX_RUNS:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_RUNS} runs, got {text!r}")
+    return value
+
+
 def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     """Time and score every case on one scene (see the module doc).
 
@@ -434,7 +456,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("scenes", nargs="*", help="scene folders (or folders containing scenes)")
     p.add_argument(
         "--runs",
-        type=int,
+        type=_run_count,
         default=DEFAULT_RUNS,
         help=f"timed runs per case, at least {MIN_RUNS} (default {DEFAULT_RUNS}), "
         f"at most {MAX_RUNS}",
