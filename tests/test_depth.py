@@ -119,6 +119,23 @@ def test_disparity_sigma_takes_a_single_bool_for_every_pixel() -> None:
     )
 
 
+def test_disparity_sigma_takes_a_nan_confidence_as_the_depth_kernel_does() -> None:
+    """disparity_sigma(NaN) was NaN, where depth_map's kernel counts a NaN confidence as 0:
+    the documented formula and the depth sigma it explains disagreed on that pixel."""
+    from stereovision.depth import _depth_rectified
+
+    conf = np.array([[np.nan, 0.0, 0.5, 1.0]], np.float32)
+    disp = np.full((1, 4), 10.0, np.float32)
+    calib = _rect_calib(4, 1)
+    for refined in (True, False):
+        sd = sv.depth.disparity_sigma(conf, refined=refined)
+        assert sd[0, 0] == sd[0, 1] == np.float32(0.405 if refined else 0.74)
+        depth, depth_sigma = _depth_rectified(disp, conf, calib, refined, None)
+        # sigma_Z = Z sigma_d / (d + doffs), from the kernel's own sigma_d
+        np.testing.assert_allclose(depth_sigma * 10.0 / depth, sd, rtol=1e-5)
+    assert float(sv.depth.disparity_sigma(np.nan)) == np.float32(0.405)
+
+
 def test_disparity_sigma_reads_an_object_array_of_numbers() -> None:
     """``np.array(values, dtype=object)`` of numbers gave their sigmas until today's dtype
     check refused it; one holding None is still refused, as None is."""

@@ -1069,7 +1069,8 @@ def disparity_sigma(
     Parameters
     ----------
     confidence : array_like
-        Confidence in ``[0, 1]`` (values outside are clipped).
+        Confidence in ``[0, 1]`` (values outside are clipped; NaN counts as 0, as in
+        :func:`depth_map`'s depth sigma).
     refined : bool
         Whether the map was refined (:mod:`stereovision.refine`).
     filled : array_like of bool, optional
@@ -1099,6 +1100,9 @@ def disparity_sigma(
         got = np.asarray(confidence).dtype
         raise ValueError(f"confidence: expected real numbers in [0, 1], got dtype {got}")
     c = np.clip(raw.astype(np.float32), 0.0, 1.0)
+    # NaN passed the clip and gave a NaN sigma, where the depth kernel (triangulation.rs) takes
+    # it as 0: the two gave different sigmas for one confidence
+    c = np.where(np.isnan(c), np.float32(0), c)
     out = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
     if filled is not None:
         mask = np.asarray(filled, bool)
