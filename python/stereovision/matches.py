@@ -146,8 +146,10 @@ class Matches:
         """The matches picked by a slice, an integer array or a boolean mask, as ``Matches``
         (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too, the
         per-match stats (``"mcgm"``'s ``channel``, ``"fused"``'s ``count`` and ``sources``)
-        picked with the matches. An integer gives that one match; beyond the matches it is an
-        IndexError, as is a boolean scalar."""
+        picked with the matches. The counters are the run's and stay as they were
+        (``"fused"``'s ``members`` still counts the matches returned by the run, ``n_matches``
+        likewise): ``len()`` of the selection is its own count. An integer gives that one
+        match; beyond the matches it is an IndexError, as is a boolean scalar."""
         if isinstance(index, (bool, np.bool_)) or (
             isinstance(index, np.ndarray) and index.ndim == 0 and index.dtype == bool
         ):
