@@ -520,6 +520,28 @@ def test_a_selection_of_matches_picks_their_per_match_stats() -> None:
     assert np.array_equal(m.stats["channel"], [0, 1, 2, 1, 0])  # the original is untouched
 
 
+def test_from_csv_refuses_a_finite_value_beyond_float32(tmp_path: Path) -> None:
+    """A score of 1e40 was read as inf with only NumPy's RuntimeWarning ('overflow encountered
+    in cast'); it is refused naming the line. inf and NaN as written stay as they are."""
+    import warnings
+
+    path = tmp_path / "m.csv"
+    path.write_text(
+        "x_left,y_left,x_right,y_right,score\n1,1,1,1,0.5\n\n2,2,1,2, 1e40\n3,3,3,3,inf\n"
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError) as err:
+            sv.Matches.from_csv(path, (10, 10))
+        assert str(err.value) == (
+            f"{path}: line 4: 1e40 is beyond float32's range (the matches are float32: it would "
+            "be read as inf)"
+        )
+        path.write_text("x_left,y_left,x_right,y_right,score\n1,1,1,1,inf\n1,1,1,1,nan\n")
+        score = sv.Matches.from_csv(path, (10, 10)).score
+    assert np.isposinf(score[0]) and np.isnan(score[1])
+
+
 def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     # 4 decimals lost up to 5e-5 px of the float32 sub-pixel positions, and nothing read the
     # file back.

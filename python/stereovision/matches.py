@@ -356,8 +356,9 @@ class Matches:
         ValueError
             If ``path`` is a folder (or another file that is neither regular nor a pipe) or
             not UTF-8 text (an image given by mistake), another header, a row without five
-            numbers, naming the file (and the row's line), or matches whose left position lies
-            outside ``image_shape`` (one given as ``(W, H)``).
+            numbers or with a finite number beyond float32's range, naming the file (and the
+            row's line), or matches whose left position lies outside ``image_shape`` (one given
+            as ``(W, H)``).
         """
         from stereovision.io import _existing_file
 
@@ -400,7 +401,17 @@ class Matches:
         a = a.reshape(len(lines), -1) if lines else np.zeros((0, 5))
         if a.ndim != 2 or a.shape[1] != 5:
             raise ValueError(f"{path}: expected 5 numbers per row")
-        xl, yl, xr, yr, score = (a[:, i].astype(np.float32) for i in range(5))
+        # the float32 cast made a finite 1e40 an inf with only NumPy's RuntimeWarning
+        with np.errstate(over="ignore"):
+            a32 = a.astype(np.float32)
+        big = np.isinf(a32) & np.isfinite(a)
+        if big.any():
+            row, col = (int(i[0]) for i in np.nonzero(big))
+            raise ValueError(
+                f"{path}: line {lines[row][0]}: {rows[row][col].strip()} is beyond float32's "
+                "range (the matches are float32: it would be read as inf)"
+            )
+        xl, yl, xr, yr, score = (a32[:, i] for i in range(5))
         m = cls(xl=xl, yl=yl, xr=xr, yr=yr, score=score, image_shape=image_shape)
         # The file does not hold the shape: one given as (W, H), as cv2 and image_size give it,
         # left every match past the height out of dispx/dispy without a word (tsukuba's MCGM
