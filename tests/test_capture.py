@@ -1012,6 +1012,33 @@ def test_interrupted_pair_save_leaves_no_temp_file(
     assert sorted(p.name for p in tmp_path.iterdir()) == []
 
 
+def test_a_folder_refusing_the_temporary_file_names_the_pairs_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """save_pair into a folder that refuses new files (/proc: ENOENT; a read-only card: EROFS)
+    said '[Errno 2] No such file or directory: '/proc/.left_0001.png.32467-0f59063e.tmp'', a
+    file the user never named; the pair's file and its folder are named, as io's writers do."""
+    import errno
+
+    img = _numbered(1)
+    real_open = os.open
+
+    def read_only(path: Any, flags: int, mode: int = 0o777) -> int:
+        if str(path).endswith(".tmp"):
+            raise OSError(errno.EROFS, "Read-only file system", str(path))
+        return real_open(path, flags, mode)
+
+    monkeypatch.setattr(os, "open", read_only)
+    with pytest.raises(OSError) as info:
+        save_pair(tmp_path, 1, img, img)
+    monkeypatch.undo()
+    assert str(info.value) == (
+        f"cannot write {tmp_path / 'left_0001.png'}: no file can be made in its folder "
+        f"{tmp_path} (Read-only file system)"
+    )
+    assert info.value.errno == errno.EROFS and not list(tmp_path.iterdir())
+
+
 def test_ctrl_c_never_leaves_half_a_pair(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Ctrl-C while a pair is saved: a signal is held until the pair is whole, an interrupt
     raised while the right image is written removes the left one. (The left image stayed

@@ -2451,9 +2451,17 @@ def _atomic_write_bytes(path: Path, data: bytes) -> None:
     written. The name is given by a hard link, which fails on an existing file (a rename
     replaced it: two captures into one folder overwrote each other's pairs); on a filesystem
     without hard links (FAT), by a rename after a check."""
+    from stereovision.io import temp_refused
+
     tmp = path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}.tmp")
     try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+        try:
+            flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+            fd = os.open(tmp, flags, 0o666)
+        except OSError as exc:
+            # the temporary file was named ('No such file or directory: '/proc/.left_0001.png
+            # .32467-0f59063e.tmp''), not the pair's file and its folder
+            raise temp_refused(path, exc) from exc
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()

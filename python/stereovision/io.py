@@ -519,29 +519,37 @@ def _writable_destination(dest: Path) -> Path:
     return directory
 
 
-def _temp_beside(dest: Path, suffix: str) -> tuple[int, str]:
-    """A new temporary file in ``dest``'s folder (``os.replace`` is atomic within a filesystem
-    only), open; a folder the user may not write is named, not the temporary file ('[Errno 13]
-    Permission denied: '.../.rig.yaml.k2j3abcd.tmp'')."""
+def temp_refused(dest: Path, exc: OSError) -> OSError:
+    """The error to raise when the temporary file of a write to ``dest`` cannot be made in its
+    folder: ``dest`` and the folder named, not the temporary file ('[Errno 13] Permission
+    denied: '.../.rig.yaml.k2j3abcd.tmp''), in ``exc``'s class and errno."""
     directory = dest.parent if str(dest.parent) else Path(".")
-    try:
-        return tempfile.mkstemp(prefix=f".{dest.name}.", suffix=suffix, dir=directory)
-    except PermissionError as exc:
+    if isinstance(exc, PermissionError):
         refused = PermissionError(
             f"cannot write {dest}: its folder {directory} is not writable (the new contents "
             "are made there, then put in place)"
         )
         refused.errno = errno.EACCES
-        raise refused from exc
+        return refused
+    # any other refusal of the folder (/proc: ENOENT, a read-only filesystem: EROFS) named
+    # the temporary file too ('No such file or directory: '/proc/.x.png.58m0qpf3.tmp'')
+    failed = type(exc)(
+        f"cannot write {dest}: no file can be made in its folder {directory} "
+        f"({exc.strerror or exc})"
+    )
+    failed.errno = exc.errno
+    return failed
+
+
+def _temp_beside(dest: Path, suffix: str) -> tuple[int, str]:
+    """A new temporary file in ``dest``'s folder (``os.replace`` is atomic within a filesystem
+    only), open; a folder that refuses it is named, not the temporary file
+    (:func:`temp_refused`)."""
+    directory = dest.parent if str(dest.parent) else Path(".")
+    try:
+        return tempfile.mkstemp(prefix=f".{dest.name}.", suffix=suffix, dir=directory)
     except OSError as exc:
-        # any other refusal of the folder (/proc: ENOENT, a read-only filesystem: EROFS) named
-        # the temporary file too ('No such file or directory: '/proc/.x.png.58m0qpf3.tmp'')
-        failed = type(exc)(
-            f"cannot write {dest}: no file can be made in its folder {directory} "
-            f"({exc.strerror or exc})"
-        )
-        failed.errno = exc.errno
-        raise failed from exc
+        raise temp_refused(dest, exc) from exc
 
 
 @contextmanager
