@@ -3387,3 +3387,34 @@ def test_a_jpg_scene_with_a_kitti_calib_without_its_size_is_sized_by_its_left_jp
     assert capsys.readouterr().out.startswith("1 processed, 0 skipped (done before), 0 failed")
     assert _summary(out)["pairs"]["s"]["status"] == "done"
     assert Calibration.from_file(scene / "calib.txt").image_size == (48, 32)
+
+
+def test_batch_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(tmp_path: Path) -> None:
+    """find_pairs and run_batch given a bytes folder or calibration name (or None) raised
+    pathlib's "argument should be a str object or an os.PathLike object returning str, not
+    <class 'bytes'>", naming no argument: they now say it as io's readers do, before any output
+    folder is made."""
+    from stereovision.batch import run_batch
+
+    name = str(tmp_path / "in")
+    out = tmp_path / "out"
+    cases = [
+        (lambda p: find_pairs(p), "root"),
+        (lambda p: find_pairs(tmp_path, p), "calib"),
+        (lambda p: run_batch(p, out), "input_dir"),
+        (lambda p: run_batch(tmp_path, p), "output_dir"),
+    ]
+    for call, arg in cases:
+        with pytest.raises(TypeError) as info:
+            call(name.encode())
+        assert str(info.value) == (
+            f"{arg}: expected a str or os.PathLike file name, got the bytes {name!r}: decode "
+            f"it first (os.fsdecode({arg}))"
+        )
+        if arg != "calib":  # calib=None is no calibration
+            with pytest.raises(TypeError) as info:
+                call(None)
+            assert str(info.value) == (
+                f"{arg}: expected a str or os.PathLike file name, got NoneType"
+            )
+    assert not list(tmp_path.iterdir())  # nothing made

@@ -4546,3 +4546,31 @@ def test_mutation_audit_a_one_channel_frame_is_delivered_as_bgr() -> None:
     grey = cv2.cvtColor(_numbered(0), cv2.COLOR_BGR2GRAY)
     assert fr.left.shape == fr.right.shape == (*grey.shape, 3)
     assert all((fr.left[:, :, c] == grey).all() for c in range(3))
+
+
+def test_capture_folder_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(
+    tmp_path: Path,
+) -> None:
+    """save_pair, next_pair_index, remove_stale_temps and capture given a bytes folder name (or
+    None) raised pathlib's "argument should be a str object or an os.PathLike object returning
+    str, not <class 'bytes'>", naming no argument: they now say it as io's readers do, and no
+    folder is made."""
+    name = str(tmp_path / "pairs")
+    img = np.zeros((4, 4), np.uint8)
+    cases = [
+        lambda d: save_pair(d, 1, img, img),
+        lambda d: next_pair_index(d),
+        lambda d: capmod.remove_stale_temps(d),
+        lambda d: capture(None, d, count=1),  # type: ignore[arg-type]
+    ]
+    for call in cases:
+        with pytest.raises(TypeError) as info:
+            call(name.encode())
+        assert str(info.value) == (
+            f"directory: expected a str or os.PathLike file name, got the bytes {name!r}: "
+            "decode it first (os.fsdecode(directory))"
+        )
+        with pytest.raises(TypeError) as info:
+            call(None)
+        assert str(info.value) == "directory: expected a str or os.PathLike file name, got NoneType"
+    assert not list(tmp_path.iterdir())  # no folder made

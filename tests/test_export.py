@@ -1628,3 +1628,35 @@ def test_mutation_audit_5_mesh_colours_and_export_pre_checks(result, tmp_path):
     with pytest.raises(TypeError, match=r"^result: expected a stereovision\.DepthResult, got str$"):
         export.export_result("depth.npz", tmp_path / "str", ("npz",))  # type: ignore[arg-type]
     assert not (tmp_path / "str").exists()
+
+
+def test_export_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(result, tmp_path):
+    """read_pcd, load_cloud, write_pcd, write_depth_png, export_result ... given a bytes name (or
+    None) raised pathlib's "argument should be a str object or an os.PathLike object returning
+    str, not <class 'bytes'>", naming no argument: they now say it as io's readers do, before
+    anything is written."""
+    name = str(tmp_path / "a.ply")
+    depth = np.ones((4, 4), np.float32)
+    cases = [
+        (lambda p: export.read_pcd(p), "path"),
+        (lambda p: export.read_npz(p), "path"),
+        (lambda p: export.load_cloud(p), "path"),
+        (lambda p: export.write_cloud_ply(p, result), "path"),
+        (lambda p: export.write_mesh_ply(p, None), "path"),
+        (lambda p: export.write_pcd(p, result), "path"),
+        (lambda p: export.write_npz(p, result), "path"),
+        (lambda p: export.write_depth_png(p, depth), "path"),
+        (lambda p: export.write_disparity_png(p, depth), "path"),
+        (lambda p: export.export_result(result, p, ("npz",)), "directory"),
+    ]
+    for call, arg in cases:
+        with pytest.raises(TypeError) as info:
+            call(name.encode())
+        assert str(info.value) == (
+            f"{arg}: expected a str or os.PathLike file name, got the bytes {name!r}: decode "
+            f"it first (os.fsdecode({arg}))"
+        )
+        with pytest.raises(TypeError) as info:
+            call(None)
+        assert str(info.value) == f"{arg}: expected a str or os.PathLike file name, got NoneType"
+    assert not list(tmp_path.iterdir())  # nothing written

@@ -266,7 +266,9 @@ def _scan(
     image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
     ``left`` one; named as their pair would be, after the pairs' names. Also the image size
     ``calib`` is read at when it holds none (:func:`_calib_size`), else None."""
-    r = Path(root)
+    from stereovision._validate import as_path
+
+    r = as_path(root, "root")
     if not r.exists():
         from stereovision.capture import mask_url_secrets
 
@@ -277,7 +279,7 @@ def _scan(
         )
     if not r.is_dir():
         raise NotADirectoryError(f"input is not a folder: {r}")
-    cal = Path(calib) if calib is not None else None
+    cal = as_path(calib, "calib") if calib is not None else None
     if cal is not None and not cal.exists():
         raise FileNotFoundError(f"calibration file not found: {cal}")
     found: list[PairJob] = []
@@ -1528,6 +1530,11 @@ def run_batch(
         interrupted; its ``result`` tells what was done. An interrupt before the summary is
         first written (while the input is searched) is raised as it came.
     """
+    from stereovision._validate import as_path
+
+    # pathlib's TypeError for a bytes name (or None) named no argument
+    as_path(input_dir, "input_dir")
+    as_path(output_dir, "output_dir")
     if workers is not None:
         from stereovision._validate import positive_whole
 

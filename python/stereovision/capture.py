@@ -57,6 +57,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     NOT_NUMBERS,
+    as_path,
     float_sized,
     positive_whole,
     renamed_keyword,
@@ -2511,7 +2512,7 @@ def remove_stale_temps(directory: PathLike) -> list[str]:
     list of str
         The file names removed, sorted.
     """
-    d = Path(directory)
+    d = as_path(directory, "directory")
     removed: list[str] = []
     if not d.is_dir():
         return removed
@@ -2530,7 +2531,7 @@ def remove_stale_temps(directory: PathLike) -> list[str]:
 
 def next_pair_index(directory: PathLike) -> int:
     """1 + the largest pair index already in ``directory`` (1 when none)."""
-    d = Path(directory)
+    d = as_path(directory, "directory")
     if not d.is_dir():
         return 1
     found = [int(m.group(2)) for p in d.iterdir() if (m := _PAIR_RE.match(p.name))]
@@ -2583,7 +2584,7 @@ def save_pair(
     # -1 made left_-001.png, a name next_pair_index does not read; a float failed on the format
     if not isinstance(index, (int, np.integer)) or isinstance(index, NOT_NUMBERS) or index < 0:
         raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
-    d = Path(directory)
+    d = as_path(directory, "directory")
     d.mkdir(parents=True, exist_ok=True)
     data = []
     for side, img in (("left", left), ("right", right)):
@@ -2943,7 +2944,7 @@ def capture(
         collector = ChessboardCollector(charuco.inner, min_distance, board=charuco)
     elif chessboard:
         collector = ChessboardCollector(parse_pattern(chessboard), min_distance)
-    out = Path(directory)
+    out = as_path(directory, "directory")
     # a file in the way, or a folder that cannot be written: said as such (it was "[Errno 17]
     # File exists" or "[Errno 2] No such file or directory")
     check_output_folder(out, "output folder")

@@ -170,12 +170,13 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     ValueError
         If the result has no calibration (no metric points).
     """
+    dest = as_path(path)
     _require_type(result, "DepthResult", "result")
     _require_metric(result)
     # A cloud=False result (stream's) has no points of its own: the cloud from its depth map.
     points, colors = result._cloud_points()
-    write_ply(path, points, colors)
-    return Path(path)
+    write_ply(dest, points, colors)
+    return dest
 
 
 def _mesh_rgb(rgb: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
@@ -222,6 +223,7 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     ValueError
         If the mesh has non-triangle faces, or colours outside 0-255 (0-1 for floats).
     """
+    dest = as_path(path)
     pts = np.asarray(mesh.points, dtype=np.float32)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     if faces.size % 4 or (faces.size and (faces.reshape(-1, 4)[:, 0] != 3).any()):
@@ -250,12 +252,12 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     face = np.empty(len(tris), dtype=np.dtype([("n", "u1"), ("i", "<i4", (3,))]))
     face["n"] = 3
     face["i"] = tris
-    with atomic_write(path) as fh:
+    with atomic_write(dest) as fh:
         fh.write(("\n".join(header) + "\n").encode("ascii"))
         # the records' bytes, not a copy of them (tobytes): a big mesh held its records twice
         fh.write(vert.view(np.uint8))
         fh.write(face.view(np.uint8))
-    return Path(path)
+    return dest
 
 
 # ----------------------------------------------------------------------------- PCD
@@ -322,6 +324,7 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
     ValueError
         If the result has no calibration.
     """
+    dest = as_path(path)
     _require_type(result, "DepthResult", "result")
     pts, cols = organised_points(result)
     h, w = pts.shape[:2]
@@ -337,10 +340,10 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
         "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
         f"WIDTH {w}\nHEIGHT {h}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {h * w}\nDATA binary\n"
     )
-    with atomic_write(path) as fh:
+    with atomic_write(dest) as fh:
         fh.write(header.encode("ascii"))
         fh.write(rec.view(np.uint8))  # the records' bytes, not a copy of them (tobytes)
-    return Path(path)
+    return dest
 
 
 def read_pcd(
@@ -371,7 +374,7 @@ def read_pcd(
     ValueError
         Not a PCD file, unsupported fields / compression, truncated data, or a folder.
     """
-    p = Path(path)
+    p = as_path(path)
     if not p.exists():
         raise FileNotFoundError(f"PCD file not found: {p}")
     if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
@@ -485,6 +488,7 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
     pathlib.Path
         ``path``.
     """
+    dest = as_path(path)
     _require_type(result, "DepthResult", "result")
     h, w = result.disparity.shape[:2]
     calib = result.calibration
@@ -516,9 +520,9 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
         # the range's lower end: without it a [8, 40] px search read back as [0, 40]
         min_disparity=np.float64(result.min_disparity),
     )
-    with atomic_write(path) as fh:
+    with atomic_write(dest) as fh:
         fh.write(bio.getvalue())
-    return Path(path)
+    return dest
 
 
 def read_npz(path: PathLike) -> dict[str, Any]:
@@ -545,7 +549,7 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     ValueError
         If the file is not an ``.npz`` bundle with ``depth`` and ``K``, or is a folder.
     """
-    p = Path(path)
+    p = as_path(path)
     if not p.exists():
         raise FileNotFoundError(f"npz file not found: {p}")
     if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
@@ -626,8 +630,7 @@ def load_cloud(
         Not a PLY / PCD / NPZ file (``"not a PLY file: ..."`` for a ``.ply`` that is not one), or
         a cloud without any finite point (``"empty point cloud: ..."``).
     """
-    as_path(path)
-    p = Path(path)
+    p = as_path(path)
     if not p.exists():
         raise FileNotFoundError(f"point cloud file not found: {p}")
     if not p.is_file():
@@ -829,13 +832,13 @@ def _png16_bytes(values: npt.NDArray[np.float64], what: str) -> bytes:
 
 
 def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
-    as_path(path)
-    if Path(path).suffix.lower() != ".png":
+    dest = as_path(path)
+    if dest.suffix.lower() != ".png":
         raise ValueError(f"{path}: a 16-bit {what} image is written as .png (lossless)")
     data = _png16_bytes(values, what)
-    with atomic_write(path) as fh:
+    with atomic_write(dest) as fh:
         fh.write(data)
-    return Path(path)
+    return dest
 
 
 def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> bytes:
@@ -1140,7 +1143,7 @@ def export_result(
             NO_DEPTH.format(what="depth") + f"; formats {metric} need one (npz and disp16 "
             "do not); nothing was written"
         )
-    out = Path(directory)
+    out = as_path(directory, "directory")
     for fmt in formats:  # a folder in the way, refused before the formats before it are written
         target = out / EXPORT_FORMATS[fmt]
         if target.is_dir():
