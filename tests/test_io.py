@@ -2150,6 +2150,22 @@ def test_read_pfm_one_value_short_is_truncated(tmp_path: Path) -> None:
     )
 
 
+def test_read_pfm_cut_right_after_its_scale_is_truncated(tmp_path: Path) -> None:
+    """A PFM cut right after its scale (its line feed gone with the data) was "not a PFM file
+    (bad header)"; it is truncated, as one cut after the line feed is."""
+    path = write_pfm(tmp_path / "d.pfm", np.ones((2, 3), np.float32))
+    for cut, got in ((b"Pf\n3 2\n-1.0", 0), (b"Pf\n3 2\n-1.0 ", 0), (b"Pf\n3 2\n-1.0\n", 0)):
+        path.write_bytes(cut)
+        with pytest.raises(ValueError) as info:
+            read_pfm(path)
+        assert str(info.value) == (
+            f"truncated PFM file {path}: expected 24 data bytes for 3x2x1, got {got}"
+        )
+    path.write_bytes(b"Pf\n3 2\n-1.")  # a scale cut short is read as far as it goes: "-1."
+    with pytest.raises(ValueError, match=r"^truncated PFM file"):
+        read_pfm(path)
+
+
 def test_scene_too_narrow_at_a_range_as_wide_as_the_images(tmp_path: Path) -> None:
     """Images exactly as wide as the scene's range cannot be matched over it (the range must be
     below the width); one pixel wider can."""

@@ -1138,8 +1138,9 @@ def _decode_16bit(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint16]
 
 # ------------------------------------------------------------------------------------------ PFM
 
-# the three header fields, up to the scale and the whitespace character after it
-_PFM_HEADER = re.compile(rb"^(P[Ff])\s+(\d+)\s+(\d+)\s+([-+]?[0-9.]+(?:[eE][-+]?\d+)?)(?=\s)")
+# the three header fields, up to the scale and the whitespace character after it (or the
+# file's end: a file cut there is truncated)
+_PFM_HEADER = re.compile(rb"^(P[Ff])\s+(\d+)\s+(\d+)\s+([-+]?[0-9.]+(?:[eE][-+]?\d+)?)(?=\s|\Z)")
 # the scale line's end as Windows tools (CRLF) and others (trailing spaces) write it
 _PFM_LINE_END = re.compile(rb"[ \t]*\r?\n")
 
@@ -1173,6 +1174,10 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     p = _existing_file(path, "PFM file")
     raw = p.read_bytes()
     m = _PFM_HEADER.match(raw[:256])
+    # a file ending right after its scale (cut before the line feed) is truncated, not "bad
+    # header"; a scale cut by the 256 bytes looked at is no header
+    if m is not None and m.end() == 256 < len(raw):
+        m = None
     if m is None:
         raise ValueError(f"not a PFM file (bad header): {p}")
     channels = 3 if m.group(1) == b"PF" else 1
@@ -1201,7 +1206,7 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     # to the file's end (a CR is taken as CRLF's: a CRLF file one byte short is truncated)
     if line_end is not None and len(raw) - count * 4 == m.end() + 1 and raw[m.end()] in b" \t":
         start = m.end() + 1
-    nbytes = len(raw) - start
+    nbytes = max(len(raw) - start, 0)
     if nbytes < count * 4:
         raise ValueError(
             f"truncated PFM file {p}: expected {count * 4} data bytes for {width}x{height}x"
