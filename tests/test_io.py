@@ -1313,6 +1313,21 @@ def test_read_ply_header_ends_at_the_end_header_line(tmp_path: Path) -> None:
         read_ply(tmp_path / "n.ply")
 
 
+def test_read_ply_first_line_is_ply_alone(tmp_path: Path) -> None:
+    """A file whose first line merely began with "ply" ('plyfoo', 'ply 2') was read as a PLY
+    file; the magic line is "ply" (a CR or trailing blanks allowed)."""
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    path = tmp_path / "c.ply"
+    for magic in (b"plyfoo", b"ply 2", b"ply_cloud"):
+        path.write_bytes(_ply("ascii", xyz, 1).replace(b"ply", magic, 1) + b"1 2 3\n")
+        with pytest.raises(ValueError) as err:
+            read_ply(path)
+        assert str(err.value) == f"not a PLY file: {path}"
+    for magic in (b"ply\r", b"ply "):
+        path.write_bytes(_ply("ascii", xyz, 1).replace(b"ply", magic, 1) + b"1 2 3\n")
+        np.testing.assert_array_equal(read_ply(path)[0], [[1.0, 2.0, 3.0]])
+
+
 # ------------------------------------------------- mutation audit 2: scenes, images, path helpers
 
 

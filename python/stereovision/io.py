@@ -1444,10 +1444,12 @@ def read_ply(
     """
     p = _existing_file(path, "PLY file")
     raw = p.read_bytes()
+    # the first line is "ply" (a CR, trailing blanks kept): "plyfoo" was read as a PLY file
+    magic = re.match(rb"ply[ \t\r]*\n", raw) is not None
     # the line that is "end_header", not the first "end_header" (a comment may hold one)
-    found = re.search(rb"(?m)^end_header[ \t\r]*$", raw) if raw.startswith(b"ply") else None
+    found = re.search(rb"(?m)^end_header[ \t\r]*$", raw) if magic else None
     end = found.start() if found else -1
-    if not raw.startswith(b"ply") or end < 0:
+    if not magic or end < 0:
         raise ValueError(f"not a PLY file: {p}")
     nl = raw.find(b"\n", end)
     if nl < 0:
