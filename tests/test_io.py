@@ -1254,10 +1254,11 @@ def test_read_ply_vertex_element_without_a_count_or_with_two_says_so(tmp_path: P
         with pytest.raises(ValueError) as err:
             read_ply(path)
         assert str(err.value) == f"PLY file {path}: {said}"
-    # the first element that is not vertex is still named as such
+    # a file of elements, none of them vertex, names those it holds
     path.write_bytes(_ply("ascii", xyz, 1).replace(b"vertex 1", b"face 1") + b"1 2 3\n")
-    with pytest.raises(ValueError, match=r"first element is 'face', expected vertex$"):
+    with pytest.raises(ValueError) as err:
         read_ply(path)
+    assert str(err.value) == f"PLY file {path}: no vertex element (elements: face)"
     # a bare element line, no name: it said "first element is [], expected vertex"
     path.write_bytes(_ply("ascii", xyz, 1).replace(b"element vertex 1", b"element") + b"1 2 3\n")
     with pytest.raises(ValueError) as err:
@@ -1311,6 +1312,42 @@ def test_read_ply_header_ends_at_the_end_header_line(tmp_path: Path) -> None:
     (tmp_path / "n.ply").write_bytes(b"ply\nformat ascii 1.0\ncomment end_header\n")
     with pytest.raises(ValueError, match="not a PLY file"):
         read_ply(tmp_path / "n.ply")
+
+
+def test_read_ply_skips_the_elements_before_the_vertices(tmp_path: Path) -> None:
+    """A legal PLY whose first element is not vertex (MeshLab writes a camera element first)
+    was refused ("first element is 'camera', expected vertex"): the rows of the elements before
+    the vertices are skipped, ASCII or binary; a binary list among them cannot be, and says so."""
+    camera = "element camera 1\nproperty float view_px\nproperty uchar flag\n"
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    pts = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], np.float32)
+    path = tmp_path / "c.ply"
+    ascii_head = _ply("ascii", xyz, 2).replace(
+        b"element vertex", camera.encode() + b"element vertex"
+    )
+    path.write_bytes(ascii_head + b"7.5 1\n1 2 3\n4 5 6\n")
+    np.testing.assert_array_equal(read_ply(path)[0], pts)
+    head = _ply("binary_little_endian", xyz, 2)
+    path.write_bytes(
+        head.replace(b"element vertex", camera.encode() + b"element vertex")
+        + np.array([7.5], "<f4").tobytes()
+        + b"\x01"
+        + pts.astype("<f4").tobytes()
+    )
+    np.testing.assert_array_equal(read_ply(path)[0], pts)
+    # a camera row and no vertex rows: truncated
+    path.write_bytes(ascii_head + b"7.5 1\n")
+    with pytest.raises(ValueError) as err:
+        read_ply(path)
+    assert str(err.value) == f"truncated PLY file {path}: expected 2 vertices"
+    listed = "element face 1\nproperty list uchar int vertex_indices\n"
+    path.write_bytes(head.replace(b"element vertex", listed.encode() + b"element vertex"))
+    with pytest.raises(ValueError) as err:
+        read_ply(path)
+    assert str(err.value) == (
+        f"PLY file {path}: element 'face' before vertex holds a list property (its binary rows "
+        "are not skipped)"
+    )
 
 
 def test_read_ply_first_line_is_ply_alone(tmp_path: Path) -> None:

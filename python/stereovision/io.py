@@ -1416,11 +1416,12 @@ def read_ply(
     ``diffuse_red, diffuse_green, diffuse_blue``).
 
     Reads the files :func:`write_ply` writes and other ASCII or binary (little- or big-endian)
-    PLY files whose first element is ``vertex`` with scalar properties (further elements are
-    ignored). Colours of a floating-point type are taken as 0-1 (as some tools write them) and
-    scaled to 0-255, or as 0-255 when any of them is above 1. Colours of a wider integer type
-    are taken as 0-255 when none is above 255, else as 16-bit 0-65535 (PDAL's ``ushort``
-    colours of a LAS cloud) and scaled to 0-255; negative ones as 0.
+    PLY files with a ``vertex`` element of scalar properties (elements after it are ignored,
+    the rows of those before it, MeshLab's ``camera``, skipped: in a binary file only elements
+    of scalar properties). Colours of a floating-point type are taken as 0-1 (as some tools
+    write them) and scaled to 0-255, or as 0-255 when any of them is above 1. Colours of a
+    wider integer type are taken as 0-255 when none is above 255, else as 16-bit 0-65535
+    (PDAL's ``ushort`` colours of a LAS cloud) and scaled to 0-255; negative ones as 0.
 
     Parameters
     ----------
@@ -1467,6 +1468,9 @@ def read_ply(
     order = ""
     count = -1
     props: list[tuple[str, str]] = []
+    # elements before the vertices (MeshLab writes its camera first): [name, rows, bytes a
+    # binary row takes, holds a list property], their rows skipped
+    before: list[list[Any]] = []
     in_vertex = False
     for line in header[1:]:
         tok = line.split()
@@ -1496,7 +1500,14 @@ def read_ply(
                     f"PLY file {p}: an element line names no element (expected vertex)"
                 )
             if not in_vertex:
-                raise ValueError(f"PLY file {p}: first element is {tok[1]!r}, expected vertex")
+                # a legal file whose first element is another (MeshLab's camera) was refused
+                rows = " ".join(tok[2:])
+                if len(tok) != 3 or not rows.isascii() or not rows.isdigit():
+                    raise ValueError(
+                        f"PLY file {p}: {tok[1]} count {rows!r} is not a whole number (>= 0)"
+                    )
+                before.append([tok[1], int(rows), 0, False])
+                continue
             # a vertex line without its one count was told off as "first element is
             # ['vertex'], expected vertex"
             if len(tok) == 2:
@@ -1514,6 +1525,16 @@ def read_ply(
             if any(tok[2] == name for name, _ in props):  # NumPy's "occurs more than once"
                 raise ValueError(f"PLY file {p}: vertex property {tok[2]!r} given twice")
             props.append((tok[2], tok[1]))
+        elif tok[0] == "property" and before and count < 0:
+            if len(tok) > 1 and tok[1] == "list":
+                before[-1][3] = True
+            elif len(tok) == 3 and tok[1] in _PLY_TYPES:
+                before[-1][2] += np.dtype(_PLY_TYPES[tok[1]]).itemsize
+            else:
+                raise ValueError(f"PLY file {p}: unsupported {before[-1][0]} property {line!r}")
+    if order and count < 0 and before:
+        elements = ", ".join(name for name, *_ in before)
+        raise ValueError(f"PLY file {p}: no vertex element (elements: {elements})")
     if not order or count < 0:
         raise ValueError(f"not a PLY file (no format or vertex element): {p}")
     names = [n for n, _ in props]
@@ -1522,12 +1543,24 @@ def read_ply(
     dtype = np.dtype([(n, order + _PLY_TYPES[t]) for n, t in props])
     start = nl + 1
     if order == "=":
+        # an element's row is a line, whatever its properties
+        for _ in range(sum(rows for _, rows, _, _ in before)):
+            start = raw.find(b"\n", start) + 1
+            if start == 0:
+                raise ValueError(f"truncated PLY file {p}: expected {count} vertices")
         rec = _ascii_ply_vertices(raw[start:], dtype, count, p)
-    elif len(raw) - start < count * dtype.itemsize:
-        raise ValueError(
-            f"truncated PLY file {p}: expected {count} vertices of {dtype.itemsize} bytes"
-        )
     else:
+        listed = [name for name, _, _, has_list in before if has_list]
+        if listed:
+            raise ValueError(
+                f"PLY file {p}: element {listed[0]!r} before vertex holds a list property (its "
+                "binary rows are not skipped)"
+            )
+        start += sum(rows * size for _, rows, size, _ in before)
+        if len(raw) - start < count * dtype.itemsize:
+            raise ValueError(
+                f"truncated PLY file {p}: expected {count} vertices of {dtype.itemsize} bytes"
+            )
         rec = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
     pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float32, copy=False)
     cols: npt.NDArray[np.uint8] | None = None
