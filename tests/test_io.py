@@ -2321,6 +2321,39 @@ def test_io_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(tmp_path:
     assert not list(tmp_path.iterdir())  # nothing written
 
 
+def test_an_empty_file_name_is_refused_not_taken_for_the_current_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """write_ply('', pts) said "cannot write .: it is a folder; give a file name", read_ply('')
+    "PLY file is not a regular file: .": Path('') is the current folder, no name the caller gave.
+    The file readers and writers of io, export and Calibration now say the name is empty."""
+    from stereovision import export
+
+    monkeypatch.chdir(tmp_path)
+    cloud = np.zeros((2, 3), np.float32)
+    depth = np.ones((2, 2), np.float32)
+    calib = Calibration(
+        np.eye(3), np.zeros(5), np.eye(3), np.zeros(5), np.eye(3), np.array([-0.1, 0, 0]), (4, 4)
+    )
+    for call in (
+        lambda: write_ply("", cloud),
+        lambda: read_ply(""),
+        lambda: write_pfm("", depth),
+        lambda: read_pfm(""),
+        lambda: imread(""),
+        lambda: export.read_pcd(""),
+        lambda: export.load_cloud(""),
+        lambda: export.write_depth_png("", depth),
+        lambda: export.read_depth_png(""),
+        lambda: calib.save(""),
+        lambda: Calibration.load(""),
+    ):
+        with pytest.raises(ValueError) as info:
+            call()
+        assert str(info.value) == "path: expected a file name, got ''"
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
 def test_read_ply_ascii_damaged_count_or_out_of_type_value_is_said(tmp_path: Path) -> None:
     """An ASCII PLY whose vertex count is damaged (99999999999 of one row) was a MemoryError of
     terabytes (the table and records allocated for the count), not "truncated"; a uchar colour

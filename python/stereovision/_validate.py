@@ -96,7 +96,7 @@ def path_given(obj: object) -> str | None:
     return None
 
 
-def as_path(path: object, name: str = "path") -> Path:
+def as_path(path: object, name: str = "path", *, file: bool = False) -> Path:
     """``path`` as a :class:`pathlib.Path`, or a TypeError naming the argument: pathlib's own
     "argument should be a str object or an os.PathLike object returning str, not <class
     'bytes'>" (or "... not 'NoneType'") named none, and a bytes name got no hint to decode it.
@@ -107,6 +107,8 @@ def as_path(path: object, name: str = "path") -> Path:
         What was given as a file or folder name (str or os.PathLike).
     name : str
         The argument's name, for the message.
+    file : bool
+        ``path`` names a file: an empty name is refused (``Path("")`` is the current folder).
 
     Returns
     -------
@@ -116,6 +118,8 @@ def as_path(path: object, name: str = "path") -> Path:
     ------
     TypeError
         If ``path`` is bytes (the library's paths are str or os.PathLike) or no name at all.
+    ValueError
+        If ``file`` and ``path`` is empty.
     """
     if isinstance(path, bytes):
         said = path_given(path)
@@ -127,6 +131,10 @@ def as_path(path: object, name: str = "path") -> Path:
     if isinstance(path, (str, os.PathLike)):
         fs = os.fspath(path)
         if isinstance(fs, str):
+            if file and not fs:
+                # Path("") is Path("."): a write said "cannot write .: it is a folder", a read
+                # "not a regular file: ."
+                raise ValueError(f"{name}: expected a file name, got ''")
             return Path(fs)
     raise TypeError(f"{name}: expected a str or os.PathLike file name, got {type(path).__name__}")
 

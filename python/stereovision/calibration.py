@@ -1285,7 +1285,7 @@ class Calibration:
         """
         from stereovision.io import atomic_write
 
-        p = as_path(path)
+        p = as_path(path, file=True)
         text = self._file_text(p)
         with atomic_write(p, "w") as fh:
             fh.write(text)
@@ -1438,7 +1438,7 @@ class Calibration:
 
     @staticmethod
     def _read_text(path: PathLike, name: str = "path") -> tuple[Path, str]:
-        p = as_path(path, name)
+        p = as_path(path, name, file=True)
         if not p.exists():
             # a link whose target moved: which file is missing is said, as imread says it
             from stereovision.io import _broken_link

@@ -170,7 +170,7 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     ValueError
         If the result has no calibration (no metric points).
     """
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     _require_type(result, "DepthResult", "result")
     _require_metric(result)
     # A cloud=False result (stream's) has no points of its own: the cloud from its depth map.
@@ -223,7 +223,7 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     ValueError
         If the mesh has non-triangle faces, or colours outside 0-255 (0-1 for floats).
     """
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     pts = np.asarray(mesh.points, dtype=np.float32)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     if faces.size % 4 or (faces.size and (faces.reshape(-1, 4)[:, 0] != 3).any()):
@@ -324,7 +324,7 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
     ValueError
         If the result has no calibration.
     """
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     _require_type(result, "DepthResult", "result")
     pts, cols = organised_points(result)
     h, w = pts.shape[:2]
@@ -374,7 +374,7 @@ def read_pcd(
     ValueError
         Not a PCD file, unsupported fields / compression, truncated data, or a folder.
     """
-    p = as_path(path)
+    p = as_path(path, file=True)
     if not p.exists():
         raise FileNotFoundError(f"PCD file not found: {p}")
     if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
@@ -488,7 +488,7 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
     pathlib.Path
         ``path``.
     """
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     _require_type(result, "DepthResult", "result")
     h, w = result.disparity.shape[:2]
     calib = result.calibration
@@ -549,7 +549,7 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     ValueError
         If the file is not an ``.npz`` bundle with ``depth`` and ``K``, or is a folder.
     """
-    p = as_path(path)
+    p = as_path(path, file=True)
     if not p.exists():
         raise FileNotFoundError(f"npz file not found: {p}")
     if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
@@ -630,7 +630,7 @@ def load_cloud(
         Not a PLY / PCD / NPZ file (``"not a PLY file: ..."`` for a ``.ply`` that is not one), or
         a cloud without any finite point (``"empty point cloud: ..."``).
     """
-    p = as_path(path)
+    p = as_path(path, file=True)
     if not p.exists():
         raise FileNotFoundError(f"point cloud file not found: {p}")
     if not p.is_file():
@@ -832,7 +832,7 @@ def _png16_bytes(values: npt.NDArray[np.float64], what: str) -> bytes:
 
 
 def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     if dest.suffix.lower() != ".png":
         raise ValueError(f"{path}: a 16-bit {what} image is written as .png (lossless)")
     data = _png16_bytes(values, what)

@@ -796,7 +796,7 @@ def _broken_link(link: Path) -> str:
 
 
 def _existing_file(path: PathLike, what: str) -> Path:
-    p = as_path(path)
+    p = as_path(path, file=True)
     if not p.exists():
         # a link whose target moved reads as no file at all: which one is missing is said
         gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
@@ -1245,7 +1245,7 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     TypeError
         If ``little_endian`` is not True or False.
     """
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     if not isinstance(little_endian, (bool, np.bool_)):
         # "no" was true: a little-endian file where the caller asked for the other order
         raise TypeError(f"little_endian: expected True or False, got {little_endian!r}")
@@ -1350,7 +1350,7 @@ def write_ply(
     TypeError
         If ``drop_invalid`` is not True or False.
     """
-    dest = as_path(path)
+    dest = as_path(path, file=True)
     if not isinstance(drop_invalid, (bool, np.bool_)):
         # "no" (true) dropped the NaN points the caller meant to keep, None kept them
         raise TypeError(f"drop_invalid: expected True or False, got {drop_invalid!r}")
