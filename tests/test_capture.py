@@ -4574,3 +4574,17 @@ def test_capture_folder_entry_points_refuse_a_bytes_or_no_path_naming_the_argume
             call(None)
         assert str(info.value) == "directory: expected a str or os.PathLike file name, got NoneType"
     assert not list(tmp_path.iterdir())  # no folder made
+
+
+def test_stereo_camera_refuses_a_bytes_source_naming_it(tmp_path: Path) -> None:
+    """StereoCamera(b'left.png', ...) took the bytes for a capture object of the caller's and
+    failed in "'bytes' object has no attribute 'isOpened'": it now says which side and to
+    decode it, as the library's other path arguments do."""
+    name = str(tmp_path / "left_%04d.png")
+    for left, right, side in ((name.encode(), name, "left"), (name, name.encode(), "right")):
+        with pytest.raises(TypeError) as info:
+            StereoCamera(left, right)
+        assert str(info.value) == (
+            f"{side}: expected a str or os.PathLike file name, got the bytes {name!r}: decode "
+            f"it first (os.fsdecode({side}))"
+        )

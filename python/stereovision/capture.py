@@ -1588,6 +1588,10 @@ class StereoCamera(PairSource):
     ) -> None:
         check_read_timeout(open_timeout, "open_timeout")
         self.sources = {"left": left, "right": right}
+        for side, src in self.sources.items():
+            if isinstance(src, bytes):
+                # taken for a capture object: "'bytes' object has no attribute 'isOpened'"
+                as_path(src, side)
         self.requested_size = parse_size(image_size, "image_size")
         # True was taken as 1 fps, and "30" gave math's TypeError
         float_sized(fps, "fps")  # 10**400: math.isfinite's OverflowError, naming nothing
