@@ -1493,10 +1493,11 @@ def test_check_warns_of_one_file_given_twice(
     data_dir: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``check LEFT LEFT`` said "rectification ok" without a word about the pair being one
-    file."""
+    file. It warns, and the verdict cannot tell (exit 3), not "rectification ok" (exit 0)."""
     left = data_dir / "middlebury2003" / "cones" / "left.png"
-    assert main(["check", str(left), str(left)]) == 0
-    err = capsys.readouterr().err
+    assert main(["check", str(left), str(left)]) == 3
+    out, err = capsys.readouterr()
+    assert out.startswith("rectification: cannot tell, the two images are identical")
     assert err == (
         f"stereovision: warning: {left} and {left} are the same file: every disparity comes "
         "out 0 (two views of the scene are needed)\n"

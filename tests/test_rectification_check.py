@@ -1182,3 +1182,40 @@ def test_align_rows_refuses_a_check_of_a_pair_of_another_size(data_dir: Path) ->
     # the pair it was made on is aligned as before
     aligned, used = align_rows(left, right, check)
     assert used is check and check_rectification(left, aligned).ok is True
+
+
+def test_one_image_twice_cannot_be_told_not_rectification_ok(data_dir: Path) -> None:
+    """check_rectification(L, L) matched every feature to itself on its own row and said
+    "rectification ok: median |dy| 0.00 px ... over 1253 matches" (the library, the stream,
+    the GUI; `check L L` exit 0, `rectify L L` wrote L as "already rectified"). Identical
+    images cannot tell: ok None with its own line; a blank pair keeps its texture advice."""
+    from stereovision.rectification_check import already_rectified
+
+    left = imread(data_dir / "middlebury2003" / "cones" / "left.png")[:150, :200]
+    res = check_rectification(left, left.copy())
+    assert res.ok is None and res.identical and res.matches == 0
+    assert res.summary() == (
+        "rectification: cannot tell, the two images are identical (the same file, or one "
+        "camera twice?)"
+    )
+    assert res.as_dict()["identical"] is True and res.as_dict()["ok"] is None
+    assert already_rectified(left, left) is None
+    # the pair itself, and a blank pair, as before
+    right = imread(data_dir / "middlebury2003" / "cones" / "right.png")[:150, :200]
+    assert check_rectification(left, right).identical is False
+    blank = np.zeros((150, 200), np.uint8)
+    assert "point the cameras at something textured" in check_rectification(blank, blank).summary()
+
+
+def test_cli_check_of_one_file_twice_cannot_tell(data_dir: Path, tmp_path: Path) -> None:
+    """`stereovision check L L` warned that the two are the same file, then printed
+    "rectification ok" and exited 0; now the cannot-tell line and exit 3."""
+    cones = data_dir / "middlebury2003" / "cones"
+    crop = tmp_path / "crop.png"
+    cv2.imwrite(str(crop), cv2.imread(str(cones / "left.png"))[:150, :200])
+    run = subprocess.run(
+        [*SV, "check", str(crop), str(crop), "--json"], capture_output=True, text=True, timeout=120
+    )
+    said = json.loads(run.stdout)
+    assert run.returncode == 3 and said["ok"] is None and said["identical"] is True
+    assert "are the same file" in run.stderr

@@ -1108,8 +1108,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         # not be judged, so there is nothing to correct either.
         if fix is not None:
             print(
-                f"stereovision: not corrected, nothing written to {fix}: too little texture "
-                "to tell the rows (give a textured pair)",
+                f"stereovision: not corrected, nothing written to {fix}: "
+                + (
+                    "the two images are identical (give the two cameras' views)"
+                    if res.identical
+                    else "too little texture to tell the rows (give a textured pair)"
+                ),
                 file=sys.stderr,
             )
         return EXIT_CANNOT_TELL

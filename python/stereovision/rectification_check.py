@@ -65,11 +65,14 @@ class RectificationCheck:
         Fitted change of the offset per 1000 px along x (a roll between the cameras) and y.
     ok : bool or None
         ``median_dy <= tolerance``; None when fewer than ``MIN_MATCHES`` matches were found
-        (too little texture to tell).
+        (too little texture to tell), or the two images are identical.
     tolerance : float
         The tolerance used (px).
     swapped : bool
         Most matches have a negative disparity: the left and right images look swapped.
+    identical : bool
+        The two images are the same pixels (one file or one camera twice): every feature
+        matches itself on its own row, so ``ok`` is None (cannot tell), not True.
     points : ndarray, float32 (N, 4)
         The matches the figures are over, ``[x_left, y_left, x_right, y_right]`` in the
         rectified pair (for :func:`draw_rectification_check`; not in :meth:`as_dict`).
@@ -92,6 +95,7 @@ class RectificationCheck:
     ok: bool | None
     tolerance: float
     swapped: bool = False
+    identical: bool = False
     points: npt.NDArray[np.float32] = field(
         default_factory=lambda: np.zeros((0, 4), np.float32), repr=False, compare=False
     )
@@ -134,6 +138,11 @@ class RectificationCheck:
         str
             The verdict (ok, NOT rectified, swapped, cannot tell) and the figures behind it.
         """
+        if self.identical:
+            return (
+                "rectification: cannot tell, the two images are identical (the same file, or "
+                "one camera twice?)"
+            )
         if self.ok is None:
             return (
                 f"rectification: cannot tell, only {self.matches} feature matches "
@@ -235,7 +244,8 @@ def check_rectification(
     Returns
     -------
     RectificationCheck
-        ``ok`` True / False, or None when the pair has too little texture to tell.
+        ``ok`` True / False, or None when the pair has too little texture to tell or its two
+        images are identical (``identical``).
 
     Raises
     ------
@@ -266,9 +276,17 @@ def check_rectification(
             f"left is {wl}x{hl} px, right is {wr}x{hr} px: the two images of a pair have one size"
         )
     h, w = gl.shape
+    tol = float(tolerance)
+    if gl.min() < gl.max() and np.array_equal(gl, gr):
+        # every feature matched itself at its own row: "rectification ok, median |dy| 0.00 px"
+        # of one image twice (the library, the stream and the GUI said nothing else); a blank
+        # pair (lens caps) is told to point the cameras at texture, as before
+        nan = float("nan")
+        return RectificationCheck(
+            0, nan, nan, nan, nan, nan, None, tol, identical=True, size=(w, h)
+        )
     pl, dl = _features(gl)
     pr, dr = _features(gr)
-    tol = float(tolerance)
     pairs = (
         _mutual_matches(dl, dr)
         if dl is not None and dr is not None and len(pl) >= 2 and len(pr) >= 2
