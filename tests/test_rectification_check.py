@@ -1219,3 +1219,23 @@ def test_cli_check_of_one_file_twice_cannot_tell(data_dir: Path, tmp_path: Path)
     said = json.loads(run.stdout)
     assert run.returncode == 3 and said["ok"] is None and said["identical"] is True
     assert "are the same file" in run.stderr
+
+
+def test_draw_rectification_check_refuses_a_check_of_a_pair_of_another_size(
+    data_dir: Path,
+) -> None:
+    """draw_rectification_check drew a full-size check over a half-size copy of the pair
+    without a word: 327 of cones' 523 left dots past the left image. It refuses, as align_rows
+    does, naming both sizes; the pair checked is drawn as before."""
+    from stereovision.rectification_check import draw_rectification_check
+
+    left, right = _pair(data_dir, "middlebury2003/cones")
+    check = check_rectification(left, right)
+    half = [cv2.resize(im, (225, 188), interpolation=cv2.INTER_AREA) for im in (left, right)]
+    with pytest.raises(
+        ValueError,
+        match=r"^check: made on a 450x375 px pair, the pair is 225x188 px: draw the pair that "
+        r"was checked$",
+    ):
+        draw_rectification_check(*half, check)
+    assert draw_rectification_check(left, right, check).shape[1:] == (900, 3)

@@ -440,7 +440,8 @@ def draw_rectification_check(
     Raises
     ------
     ValueError
-        Images that are not images, or of different sizes.
+        Images that are not images, of different sizes, or of another size than the pair
+        ``check`` was made on.
     """
     from stereovision._validate import _to_unit_float, as_bgr_uint8
 
@@ -462,6 +463,13 @@ def draw_rectification_check(
             f"left is {wl}x{hl} px, right is {wr}x{hr} px: the two images of a pair have one size"
         )
     h, w = lb.shape[:2]
+    if check.size is not None and check.size != (w, h):
+        # its dots are at the checked pair's pixels: a full-size check over a half-size copy
+        # put 327 of cones' 523 left dots past the left image, into the right one
+        raise ValueError(
+            f"check: made on a {check.size[0]}x{check.size[1]} px pair, the pair is {w}x{h} "
+            "px: draw the pair that was checked"
+        )
     canvas = np.concatenate([lb, rb], axis=1)
     # dimmed to 0.7 by a table: ``canvas * 0.7`` made a float64 copy of the whole picture
     # (576 MB for a 12 MP pair side by side), for the same grey levels
