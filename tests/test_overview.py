@@ -891,3 +891,31 @@ def test_a_map_of_another_size_than_the_disparity_is_named(name: str) -> None:
         r"map's shape \(120, 200\), got shape \(60, 100\)$",
     ):
         overview_image(result, "t")
+
+
+def test_a_left_image_of_another_size_than_the_disparity_is_named() -> None:
+    """A hand-made result's 100x60 left image beside a 200x120 disparity map was stretched to
+    the panel without a word (its pixels beside another place's disparities). The message
+    names both shapes, as for a depth or confidence map; a left image of the map's size, or
+    none, is drawn as before."""
+    from types import SimpleNamespace
+
+    disparity = np.tile(np.linspace(1.0, 40.0, 200, dtype=np.float32), (120, 1))
+    conf = np.ones_like(disparity)
+    small = SimpleNamespace(
+        disparity=disparity,
+        confidence=conf,
+        depth=None,
+        left_rectified=np.zeros((60, 100, 3), np.uint8),
+    )
+    with pytest.raises(
+        ValueError,
+        match=r"^result: expected a left image of the disparity map's shape \(120, 200\), got "
+        r"shape \(60, 100, 3\)$",
+    ):
+        overview_image(small, "t")
+    for left in (np.zeros((120, 200), np.uint8), None):
+        same = SimpleNamespace(
+            disparity=disparity, confidence=conf, depth=None, left_rectified=left
+        )
+        assert overview_image(same, "t").image.shape[2] == 3

@@ -314,7 +314,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     ValueError
         An unknown ``unit`` (the message names the allowed ones), a disparity map that is not
         ``(H, W)`` or has no pixel, a depth or confidence map of another shape, or a left image
-        that is not grey, BGR or BGRA, or not uint8.
+        that is not grey, BGR or BGRA, not uint8, or of another size.
     """
     from stereovision._validate import known_unit
     from stereovision.calibration import UNIT_TO_METRES
@@ -342,6 +342,13 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
             raise ValueError(
                 "result: expected a grey (H, W) or (H, W, 1), BGR or BGRA left image, got shape "
                 f"{left.shape}"
+            )
+        if left.shape[:2] != disparity.shape:
+            # a left image of another size was stretched to the panel without a word: its
+            # pixels beside another place's disparities
+            raise ValueError(
+                f"result: expected a left image of the disparity map's shape {disparity.shape}, "
+                f"got shape {left.shape}"
             )
         if left.dtype != np.uint8:
             # the panel is uint8: a uint16 image of 1000 was drawn as 232 (wrapped), a float
