@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ipaddress
 import json
 import os
 import re
@@ -2781,6 +2782,36 @@ def test_the_view_serves_on_an_ipv6_address() -> None:
     try:
         assert srv.url == f"http://[::1]:{srv.port}/"
         assert srv._httpd.server_address[0] == "::1"
+        assert _get(srv.url + "frame.jpg")[:2] == (503, "text/plain")
+    finally:
+        srv.close()
+
+
+def _link_local_address() -> str | None:
+    """A link-local IPv6 address of this machine with its interface (``fe80::1%eth0``)."""
+    try:
+        lines = Path("/proc/net/if_inet6").read_text().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        hexaddr, _, _, scope, _, name = line.split()
+        if scope == "20":  # link scope
+            words = [hexaddr[k : k + 4] for k in range(0, 32, 4)]
+            return f"{ipaddress.IPv6Address(':'.join(words))}%{name}"
+    return None
+
+
+def test_the_view_serves_on_a_link_local_address_with_its_interface() -> None:
+    """``--serve --host fe80::...%eth0`` (which ``gui --host`` serves on) was refused: bound
+    as (host, port) the address lost its interface, 'cannot serve the view on
+    [fe80::fc:ff:fe00:1%eth0]:0: Invalid argument'. It is bound with its scope id now."""
+    host = _link_local_address()
+    if host is None:
+        pytest.skip("no link-local IPv6 address here")
+    srv = FrameServer(host, 0)
+    try:
+        assert srv.url == f"http://[{host}]:{srv.port}/"
+        assert srv._httpd.server_address[3] != 0  # the interface's scope id
         assert _get(srv.url + "frame.jpg")[:2] == (503, "text/plain")
     finally:
         srv.close()

@@ -423,7 +423,14 @@ class FrameServer:
 
         try:
             server_class = _ViewServer6 if ":" in host else _ViewServer
-            self._httpd = server_class((host, port), Handler)
+            address: tuple[Any, ...] = (host, port)
+            if "%" in host:
+                # a link-local address with its interface (fe80::1%eth0, which gui --host
+                # serves on): bound as (host, port) it lost its scope, "Invalid argument";
+                # getaddrinfo gives the (host, port, flow, scope id) bind needs
+                info = socket.getaddrinfo(host, port, socket.AF_INET6, socket.SOCK_STREAM)
+                address = info[0][4]
+            self._httpd = server_class(address, Handler)
         except OSError as exc:
             # "[Errno 98] Address already in use" named neither the port nor the way out
             import errno
