@@ -1860,6 +1860,29 @@ def test_cli_an_output_link_is_checked_in_its_targets_folder(
     assert (tmp_path / "ro" / "rig.yaml").read_text() == "kept\n"
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_cli_an_output_fifo_is_refused_before_the_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """-o pipe.yaml, a FIFO (or a link to one): atomic_write refuses it, but only at the end,
+    after minutes of corner finding. Refused first, in atomic_write's words, the FIFO left."""
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    (tmp_path / "link.yaml").symlink_to("pipe.yaml")
+    for given in (fifo, tmp_path / "link.yaml"):
+        with pytest.raises(OSError) as info:
+            _calibrate_cli("-o", str(given))
+        assert str(info.value) == (
+            f"-o {given}: cannot write {fifo}: it is not a regular file (a FIFO or a device)"
+        )
+    assert sorted(os.listdir(tmp_path)) == ["link.yaml", "pipe.yaml"] and not fifo.is_file()
+
+
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:
     """A third mutation audit found unasserted: "9*6" read as 9x6, a square of exactly 100 m and
     1 nm taken (the refusal is outside them), names= of another length than the pairs refused by

@@ -2790,7 +2790,7 @@ def _check_output_file(
         If ``out``'s folder (a link's: its target's, where the file is written) or ``out``
         itself, when it exists, is not writable.
     OSError
-        If ``out`` is a link that loops.
+        If ``out`` is a link that loops, or a FIFO or a device (or a link to one).
     """
     if out.is_dir():
         raise ValueError(f"-o {given}: is a folder; give a calibration file name")
@@ -2798,6 +2798,11 @@ def _check_output_file(
 
     # a link is written through: the new file is made beside its target, not beside the link
     dest = _through_links(out)
+    if dest.exists() and not dest.is_file():
+        # a FIFO or a device, refused by atomic_write only after minutes of corner finding
+        raise OSError(
+            f"-o {given}: cannot write {dest}: it is not a regular file (a FIFO or a device)"
+        )
     folder = dest.parent if str(dest.parent) else Path(".")
     why = cannot_write_in(folder)
     if why:
