@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import replace
 from fractions import Fraction
@@ -324,6 +325,19 @@ def test_export_result_writes_all(result, tmp_path):
         assert len(pts) == len(result.points)
     with pytest.raises(ValueError, match="unknown export format"):
         export.export_result(result, tmp_path, ("obj",))
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_export_result_refuses_a_fifo_before_writing_anything(result, tmp_path):
+    """cloud.ply a FIFO: atomic_write refuses it, but at its format's turn, after depth.npz
+    was replaced. Refused before any file is written, the folder left as it was."""
+    (tmp_path / "depth.npz").write_bytes(b"kept")
+    os.mkfifo(tmp_path / "cloud.ply")
+    said = f"cannot write {tmp_path / 'cloud.ply'}: it is not a regular file (a FIFO or a device)"
+    with pytest.raises(OSError, match=f"^{re.escape(said)}$"):
+        export.export_result(result, tmp_path, ("npz", "ply"))
+    assert (tmp_path / "depth.npz").read_bytes() == b"kept"
+    assert sorted(os.listdir(tmp_path)) == ["cloud.ply", "depth.npz"]
 
 
 def test_no_calibration_no_cloud(result, tmp_path):

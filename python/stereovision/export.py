@@ -1096,7 +1096,7 @@ def export_result(
         If a folder stands where one of the files goes.
     OSError
         If a link stands there that loops or leads into a missing folder
-        (FileNotFoundError).
+        (FileNotFoundError), or a FIFO or a device (or a link to one).
 
     Notes
     -----
@@ -1150,9 +1150,10 @@ def export_result(
             raise IsADirectoryError(
                 f"cannot write {target}: it is a folder; move it away (nothing was written)"
             )
-        if target.is_symlink():
+        if target.is_symlink() or (target.exists() and not target.is_file()):
             # what atomic_write refuses of a link (one that loops, one into a missing folder)
-            # was found at its format's turn, after depth.npz and cloud.ply were replaced
+            # or of a FIFO was found at its format's turn, after depth.npz and cloud.ply were
+            # replaced
             _writable_destination(_through_links(target))
     make_folder(out)
     writers: dict[str, Callable[[Path, DepthResult], Path]] = {
