@@ -2154,6 +2154,31 @@ def test_a_folder_whose_calibration_is_a_fifo_says_so(tmp_path: Path) -> None:
         Calibration.from_file(tmp_path / "empty")
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_the_public_parsers_say_a_fifo_a_folder_or_a_link_to_nothing_as_imread_does(
+    tmp_path: Path,
+) -> None:
+    """parse_middlebury_calib and parse_kitti_calib said a FIFO and a folder "not found", a
+    file that is there, and a link whose target moved without the link: in imread's words now
+    (the FIFO not opened), a missing file as before."""
+    os.mkfifo(tmp_path / "pipe.txt")
+    (tmp_path / "gone.txt").symlink_to("moved.txt")
+    (tmp_path / "dir").mkdir()
+    for parse, who in ((parse_middlebury_calib, "Middlebury"), (parse_kitti_calib, "KITTI")):
+        for name in ("pipe.txt", "dir"):
+            with pytest.raises(ValueError) as info:
+                parse(tmp_path / name)
+            assert str(info.value) == f"{who} calibration is not a regular file: {tmp_path / name}"
+        with pytest.raises(FileNotFoundError) as gone:
+            parse(tmp_path / "gone.txt")
+        assert str(gone.value) == (
+            f"{who} calibration not found: {tmp_path / 'gone.txt'} (a link to moved.txt, which "
+            "does not exist)"
+        )
+        with pytest.raises(FileNotFoundError, match=f"^{who} calibration not found: .*none"):
+            parse(tmp_path / "none.txt")
+
+
 def test_a_calibration_link_to_nothing_names_its_target_in_a_folder_or_alone(
     tmp_path: Path,
 ) -> None:

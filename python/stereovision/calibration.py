@@ -2484,13 +2484,16 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     Raises
     ------
     FileNotFoundError
-        If the file does not exist.
+        If the file does not exist (a link to nothing: its target named).
     ValueError
-        If a line is not ``key=value``, a value does not parse, or a key is given twice.
+        If it is not a regular file (a folder, a FIFO), a line is not ``key=value``, a value
+        does not parse, or a key is given twice.
     """
-    p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"Middlebury calibration not found: {p}")
+    # a FIFO or a folder was "not found", a file that is there, and a link whose target moved
+    # said without the link: in imread's words (a FIFO is not opened: its read would block)
+    from stereovision.io import _existing_file
+
+    p = _existing_file(path, "Middlebury calibration")
     out: dict[str, Any] = {}
     first: dict[str, int] = {}  # the line each key was given on, for a second one
     # "-sig": a byte-order mark (Windows Notepad writes one) made line 1 "expected key=value,
@@ -2544,11 +2547,15 @@ def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
     Raises
     ------
     FileNotFoundError
-        If the file does not exist.
+        If the file does not exist (a link to nothing: its target named).
+    ValueError
+        If it is not a regular file (a folder, a FIFO).
     """
-    p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"KITTI calibration not found: {p}")
+    # a FIFO or a folder was "not found", a file that is there, and a link whose target moved
+    # said without the link: in imread's words (a FIFO is not opened: its read would block)
+    from stereovision.io import _existing_file
+
+    p = _existing_file(path, "KITTI calibration")
     text = p.read_text(encoding="utf-8", errors="replace")
     out: dict[str, F64] = {}
     key: str | None = None
