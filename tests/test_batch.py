@@ -3418,3 +3418,28 @@ def test_batch_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(tmp_pa
                 f"{arg}: expected a str or os.PathLike file name, got NoneType"
             )
     assert not list(tmp_path.iterdir())  # nothing made
+
+
+def test_a_calib_link_to_nothing_names_its_target_as_depth_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """batch --calib gone.yaml, a link whose target moved, said 'calibration file not found:
+    gone.yaml', the link unsaid (depth --calib names its target, db745a1): named now, in the
+    API and the CLI alike."""
+    from stereovision.cli import main
+
+    (tmp_path / "in").mkdir()
+    img = np.zeros((32, 48), np.uint8)
+    for side in ("left", "right"):
+        assert cv2.imwrite(str(tmp_path / "in" / f"{side}_0.png"), img)
+    gone = tmp_path / "gone.yaml"
+    gone.symlink_to("moved.yaml")
+    said = f"calibration file not found: {gone} (a link to moved.yaml, which does not exist)"
+    with pytest.raises(FileNotFoundError, match=f"^{re.escape(said)}$"):
+        find_pairs(tmp_path / "in", gone)
+    assert (
+        main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--calib", str(gone)])
+        == 2
+    )
+    assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+    assert not (tmp_path / "out").exists()

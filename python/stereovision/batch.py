@@ -281,7 +281,11 @@ def _scan(
         raise NotADirectoryError(f"input is not a folder: {r}")
     cal = as_path(calib, "calib") if calib is not None else None
     if cal is not None and not cal.exists():
-        raise FileNotFoundError(f"calibration file not found: {cal}")
+        # a link whose target moved: which file is missing is said, as depth --calib says it
+        from stereovision.io import _broken_link
+
+        gone = f" ({_broken_link(cal)})" if cal.is_symlink() else ""
+        raise FileNotFoundError(f"calibration file not found: {cal}{gone}")
     found: list[PairJob] = []
     unpaired: list[_Unpaired] = []
     cam_found: list[PairJob] = []  # in sibling camera folders
