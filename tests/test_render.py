@@ -759,6 +759,32 @@ def test_view_refuses_a_screenshot_folder_it_cannot_write_in(tmp_path):
         _check_screenshot_path("/proc/shot.png", bundled_data_dir() / "cones")
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfifo")
+def test_view_refuses_a_screenshot_fifo_before_any_work(result, tmp_path, monkeypatch):
+    """``view cloud.ply -o pipe.png``, a FIFO (or a link to one): atomic_write refuses it, but
+    only after the source was loaded and rendered (a scene: its depth map). Refused first, in
+    atomic_write's words, the FIFO left."""
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+
+    def no_work(*_args, **_kwargs):
+        raise AssertionError("the source was loaded before the -o check")
+
+    monkeypatch.setattr(render, "load_view_source", no_work)
+    fifo = tmp_path / "pipe.png"
+    os.mkfifo(fifo)
+    (tmp_path / "link.png").symlink_to("pipe.png")
+    for given in (fifo, tmp_path / "link.png"):
+        args = _view_args(tmp_path / "cloud.ply", given)
+        with pytest.raises(OSError) as info:
+            args.func(args)
+        assert str(info.value) == (
+            f"-o {given}: cannot write {fifo}: it is not a regular file (a FIFO or a device)"
+        )
+    assert fifo.exists() and not fifo.is_file()
+
+
 @pytest.mark.skipif(
     not sys.platform.startswith("linux") or Path("/tmp/.X11-unix/X99").exists(),
     reason="needs Linux with no X server at :99",

@@ -1589,6 +1589,8 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
         ``output`` is a folder, or its folder is a file.
     PermissionError
         No file can be made in the folder of ``output`` (the system's reason).
+    OSError
+        ``output`` is a FIFO or a device (or a link to one).
     """
     from stereovision.io import _through_links, cannot_write_in, refuse_an_input
 
@@ -1599,6 +1601,11 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
         raise IsADirectoryError(f"-o {out}: is a folder; give the screenshot a file name")
     # a link is written through: the new file is made beside its target, not beside the link
     dest = _through_links(out)
+    if dest.exists() and not dest.is_file():
+        # a FIFO or a device, refused by atomic_write only after the depth map and the render
+        raise OSError(
+            f"-o {out}: cannot write {dest}: it is not a regular file (a FIFO or a device)"
+        )
     parent = dest.parent
     if parent.exists() and not parent.is_dir():
         raise NotADirectoryError(f"-o {out}: {parent} is a file, not a folder")
