@@ -1674,3 +1674,23 @@ def test_export_entry_points_refuse_a_bytes_or_no_path_naming_the_argument(resul
             call(None)
         assert str(info.value) == f"{arg}: expected a str or os.PathLike file name, got NoneType"
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_mesh_ply_refuses_what_is_not_a_mesh(tmp_path):
+    """A DepthResult, which the cloud writers take, failed in write_mesh_ply with
+    "AttributeError: 'DepthResult' object has no attribute 'faces'"; it is a TypeError that
+    says how to make the mesh, and nothing is written."""
+    res = syn.depth_result()
+    with pytest.raises(
+        TypeError,
+        match=r"mesh: expected a pyvista.PolyData triangle mesh, got "
+        r"DepthResult: render.surface_mesh\(res\) makes its mesh",
+    ):
+        export.write_mesh_ply(tmp_path / "m.ply", res)
+    with pytest.raises(
+        TypeError,
+        match=r"^mesh: expected a pyvista.PolyData triangle mesh, got "
+        r"ndarray$",
+    ):
+        export.write_mesh_ply(tmp_path / "m.ply", np.zeros((3, 3)))
+    assert not (tmp_path / "m.ply").exists()

@@ -220,10 +220,23 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
 
     Raises
     ------
+    TypeError
+        If ``mesh`` is not a mesh (no points, faces and point data), e.g. a DepthResult.
     ValueError
         If the mesh has non-triangle faces, or colours outside 0-255 (0-1 for floats).
     """
     dest = as_path(path, file=True)
+    if not all(hasattr(mesh, a) for a in ("points", "faces", "point_data")):
+        # a DepthResult (which write_ply, write_pcd and write_npz take) failed with
+        # "AttributeError: 'DepthResult' object has no attribute 'faces'"
+        hint = (
+            ": render.surface_mesh(res) makes its mesh, write_cloud_ply(path, res) writes its cloud"
+            if isinstance(mesh, DepthResult)
+            else ""
+        )
+        raise TypeError(
+            f"mesh: expected a pyvista.PolyData triangle mesh, got {type(mesh).__name__}{hint}"
+        )
     pts = np.asarray(mesh.points, dtype=np.float32)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     if faces.size % 4 or (faces.size and (faces.reshape(-1, 4)[:, 0] != 3).any()):
