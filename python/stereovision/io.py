@@ -522,7 +522,21 @@ def _writable_destination(dest: Path) -> Path:
 def temp_refused(dest: Path, exc: OSError) -> OSError:
     """The error to raise when the temporary file of a write to ``dest`` cannot be made in its
     folder: ``dest`` and the folder named, not the temporary file ('[Errno 13] Permission
-    denied: '.../.rig.yaml.k2j3abcd.tmp''), in ``exc``'s class and errno."""
+    denied: '.../.rig.yaml.k2j3abcd.tmp''), in ``exc``'s class and errno.
+
+    Parameters
+    ----------
+    dest : pathlib.Path
+        The file being written (not its temporary file).
+    exc : OSError
+        What making the temporary file in ``dest``'s folder raised.
+
+    Returns
+    -------
+    OSError
+        An error of ``exc``'s class and errno naming ``dest`` and its folder (a
+        PermissionError: the folder is not writable).
+    """
     directory = dest.parent if str(dest.parent) else Path(".")
     if isinstance(exc, PermissionError):
         refused = PermissionError(
