@@ -2116,6 +2116,33 @@ def test_from_file_refuses_a_bytes_path_naming_the_argument(tmp_path):
     )
 
 
+def test_calib_parsers_and_save_ros_refuse_a_bytes_or_empty_name_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """parse_middlebury_calib, parse_kitti_calib and save_ros, missed when the other readers and
+    writers took _validate.as_path: a bytes name gave pathlib's TypeError ("argument should be
+    a str object or an os.PathLike object returning str, not <class 'bytes'>"), naming no
+    argument, and parse_middlebury_calib('') said "Middlebury calibration not found: ."."""
+    monkeypatch.chdir(tmp_path)
+    name = tmp_path / "calib.txt"
+    for call, arg in (
+        (lambda: parse_middlebury_calib(os.fsencode(name)), "path"),
+        (lambda: parse_kitti_calib(os.fsencode(name)), "path"),
+        (lambda: raw_calib().save_ros(os.fsencode(name)), "directory"),
+    ):
+        with pytest.raises(TypeError) as info:
+            call()
+        assert str(info.value) == (
+            f"{arg}: expected a str or os.PathLike file name, got the bytes {str(name)!r}: "
+            f"decode it first (os.fsdecode({arg}))"
+        )
+    for parse in (parse_middlebury_calib, parse_kitti_calib):
+        with pytest.raises(ValueError) as err:
+            parse("")
+        assert str(err.value) == "path: expected a file name, got ''"
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
 def test_rectify_gives_a_one_channel_image_back_in_its_shape() -> None:
     """An (H, W, 1) pair came back (H, W) from a raw rig's rectify (cv2.remap drops the channel
     axis) but (H, W, 1) from a rectified rig's, though rectify says same shapes as the inputs:

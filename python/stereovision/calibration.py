@@ -2369,7 +2369,7 @@ class Calibration:
         """
         from stereovision.io import write_together
 
-        d = Path(directory)
+        d = as_path(directory, "directory")  # bytes: pathlib's TypeError named no argument
         if d.exists() and not d.is_dir():
             raise ValueError(f"cannot write ROS camera_info into {d}: it is a file, not a folder")
         texts = self.to_ros(alpha, names)
