@@ -2624,3 +2624,19 @@ def test_too_few_pairs_says_why_each_pair_was_rejected() -> None:
         r"right; c: board not found in either image\)$",
     ):
         calibrate([board, board, blank], [blank] * 3, square_size=1.0, names=["a", "b", "c"])
+
+
+def test_report_save_and_write_refuse_a_bytes_name_naming_it(tmp_path: Path) -> None:
+    """CalibrationReport.save(b'r.json') and write(b'out') gave pathlib's TypeError ("argument
+    should be a str object or an os.PathLike object returning str, not <class 'bytes'>"),
+    naming no argument, where Calibration.save names it; refused before anything is made."""
+    rep = calmod.CalibrationReport.__new__(calmod.CalibrationReport)  # the name is checked first
+    name = tmp_path / "out"
+    for call, arg in ((rep.save, "path"), (rep.write, "directory")):
+        with pytest.raises(TypeError) as info:
+            call(os.fsencode(name))
+        assert str(info.value) == (
+            f"{arg}: expected a str or os.PathLike file name, got the bytes {str(name)!r}: "
+            f"decode it first (os.fsdecode({arg}))"
+        )
+    assert not list(tmp_path.iterdir())

@@ -59,7 +59,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, whole_value
+from stereovision._validate import NOT_NUMBERS, as_path, whole_value
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
@@ -775,7 +775,7 @@ class CalibrationReport:
         """
         from stereovision.io import atomic_write
 
-        p = Path(path)
+        p = as_path(path, file=True)  # bytes: pathlib's TypeError named no argument
         suffix = p.suffix.lower()
         data = self.as_dict()
         if suffix == ".json":
@@ -804,7 +804,7 @@ class CalibrationReport:
         """
         from stereovision.io import atomic_write
 
-        d = Path(directory)
+        d = as_path(directory, "directory")  # as save
         d.mkdir(parents=True, exist_ok=True)
         page = _render_html(self)
         paths = {"html": d / "report.html", "yaml": d / "report.yaml", "json": d / "report.json"}
