@@ -2404,3 +2404,16 @@ def test_read_ply_takes_a_comment_in_utf8(tmp_path: Path) -> None:
     f.write_bytes(("ply\nformat ascii 1.0\n" + body.replace(" x", " é") + "1 2 3\n").encode())
     with pytest.raises(ValueError, match=r"^not a PLY file \(non-ASCII header\): "):
         read_ply(f)
+
+
+def test_make_folder_refuses_a_bytes_name_naming_it(tmp_path: Path) -> None:
+    """make_folder(b'/x/new') gave pathlib's TypeError ("argument should be a str object or an
+    os.PathLike object returning str, not <class 'bytes'>"), naming no argument."""
+    new = tmp_path / "new"
+    with pytest.raises(TypeError) as info:
+        make_folder(os.fsencode(new))
+    assert str(info.value) == (
+        f"path: expected a str or os.PathLike file name, got the bytes {str(new)!r}: "
+        "decode it first (os.fsdecode(path))"
+    )
+    assert not new.exists()

@@ -1723,6 +1723,27 @@ def test_median_depth_leaves_out_points_at_zero():
     assert render.median_depth(render.point_cloud(pts)) == 2.5
 
 
+def test_write_render_and_render_outputs_refuse_a_bytes_folder_naming_it(result, tmp_path):
+    """write_render(img, b'/x/out') gave pathlib's TypeError ("argument should be a str object
+    or an os.PathLike object returning str, not <class 'bytes'>"), naming no argument, and
+    render_outputs only after the render (nothing to render: no error at all)."""
+    from dataclasses import replace
+
+    out = tmp_path / "out"
+    nothing = replace(result, depth=None, calibration=None)
+    for call in (
+        lambda: render.write_render(np.zeros((4, 6, 3), np.uint8), os.fsencode(out)),
+        lambda: render.render_outputs(nothing, os.fsencode(out)),
+    ):
+        with pytest.raises(TypeError) as info:
+            call()
+        assert str(info.value) == (
+            f"out_dir: expected a str or os.PathLike file name, got the bytes {str(out)!r}: "
+            "decode it first (os.fsdecode(out_dir))"
+        )
+    assert not out.exists()
+
+
 def test_write_render_creates_nested_folders(tmp_path):
     img = np.zeros((4, 6, 3), np.uint8)
     img[..., 2] = 200  # blue in RGB

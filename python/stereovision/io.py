@@ -104,7 +104,7 @@ def make_folder(path: PathLike) -> Path:
     NotADirectoryError
         If ``path`` or a folder above it is a file, a FIFO, or a link to nothing or in a loop.
     """
-    folder = Path(path)
+    folder = as_path(path)  # bytes: pathlib's TypeError named no argument
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS
+from stereovision._validate import NOT_NUMBERS, as_path
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.depth import DepthResult
@@ -1356,6 +1356,8 @@ def render_outputs(result: DepthResult, out_dir: str | os.PathLike[str]) -> dict
     dict
         ``{"render.png": path}``, or ``{}`` when there is nothing to render.
     """
+    # a bytes name was pathlib's TypeError naming no argument, and after the render
+    as_path(out_dir, "out_dir")
     # a depth_map(cloud=False) result has no points but a depth map to build them from
     if result.depth is None or result.calibration is None or not np.isfinite(result.depth).any():
         return {}
@@ -1409,7 +1411,7 @@ def write_render(image: npt.NDArray[np.uint8], out_dir: str | os.PathLike[str]) 
     ok, buf = cv2.imencode(".png", np.ascontiguousarray(img[..., ::-1]))
     if not ok:
         raise OSError("could not encode render.png")
-    out = Path(out_dir)
+    out = as_path(out_dir, "out_dir")  # bytes: pathlib's TypeError named no argument
     out.mkdir(parents=True, exist_ok=True)
     path = out / "render.png"
     with atomic_write(path) as fh:
