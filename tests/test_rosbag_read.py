@@ -2466,3 +2466,21 @@ def test_the_bag_entry_points_refuse_a_bytes_or_no_path_naming_it(tmp_path: Path
             call(None)
         assert str(info.value) == "path: expected a str or os.PathLike file name, got NoneType"
     assert not list(tmp_path.iterdir())  # no bag folder made
+
+
+def test_an_empty_bag_name_is_refused_not_the_current_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """BagCamera(''), bag_topics(''), BagWriter('') took Path(''), the current folder, for the
+    bag ("'.' is not a readable ROS 1 or ROS 2 bag", "bag folder already exists: ."; a bag
+    folder run in was read) and is_bag('') said True in a ROS 2 bag folder: '' names none."""
+    from stereovision.rosbag import BagWriter, bag_topics, is_bag
+
+    (tmp_path / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    monkeypatch.chdir(tmp_path)
+    assert is_bag(".") and not is_bag("")
+    for call in (lambda: BagCamera(""), lambda: bag_topics(""), lambda: BagWriter("")):
+        with pytest.raises(ValueError) as info:
+            call()
+        assert str(info.value) == "path: expected a bag file or folder name, got ''"
+    assert [p.name for p in tmp_path.iterdir()] == ["metadata.yaml"]

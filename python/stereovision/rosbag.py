@@ -175,6 +175,16 @@ def _frame_name(value: object, name: str) -> str:
     return value
 
 
+def _bag_path(path: str | os.PathLike[str]) -> Path:
+    """``path`` as a Path (:func:`stereovision._validate.as_path`), an empty name refused: Path('')
+    is the current folder, which was taken for the bag (read if it was one, else "'.' is not a
+    readable ROS 1 or ROS 2 bag")."""
+    p = as_path(path)
+    if not os.fspath(path):
+        raise ValueError("path: expected a bag file or folder name, got ''")
+    return p
+
+
 def _topic_prefix(prefix: object) -> str:
     """``prefix`` as the bag's topic namespace (``"/stereo"``, ``""`` for none), or an error
     naming it: a part ROS 2 does not take in a topic name (``my-rig``, ``stereo cam``,
@@ -268,7 +278,7 @@ ros2_static_transform>`.
         scan_frame_id: str = "base_footprint",
         tf: bool = True,
     ) -> None:
-        self.path = as_path(path)
+        self.path = _bag_path(path)
         # checked before the folder is made: a bad keyword left an empty bag folder behind
         self.prefix = _topic_prefix(prefix)
         self.frame_id = _frame_name(frame_id, "frame_id")
@@ -980,7 +990,7 @@ def bag_topics(path: str | os.PathLike[str]) -> str:
     ImportError
         Without the ``rosbags`` package.
     """
-    p = as_path(path)
+    p = _bag_path(path)
     if p.is_file() and (p.parent / "metadata.yaml").is_file():
         p = p.parent  # a file of a ROS 2 bag, as BagCamera takes it
     try:
@@ -1087,6 +1097,8 @@ def is_bag(path: str | os.PathLike[str]) -> bool:
     (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it), one of its files, or a
     ``.db3`` / ``.mcap`` file alone (a recorder that left no metadata.yaml)?"""
     p = as_path(path)
+    if not os.fspath(path):
+        return False  # '' is no name: the current folder was asked about
     # a bag's storage file alone is read (its recorder left no metadata.yaml): `info` took
     # it for a calibration file
     if p.is_file() and (p.suffix in (".bag", ".db3", ".mcap") or p.name.endswith(".bag.active")):
@@ -1322,7 +1334,7 @@ class BagCamera(PairSource):
     ) -> None:
         from stereovision.capture import parse_size
 
-        self.path = as_path(path)
+        self.path = _bag_path(path)
         if not self.path.exists():
             raise FileNotFoundError(f"bag not found: {self.path}")
         if self.path.is_file() and (self.path.parent / "metadata.yaml").is_file():
