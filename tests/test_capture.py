@@ -4588,3 +4588,18 @@ def test_stereo_camera_refuses_a_bytes_source_naming_it(tmp_path: Path) -> None:
             f"{side}: expected a str or os.PathLike file name, got the bytes {name!r}: decode "
             f"it first (os.fsdecode({side}))"
         )
+
+
+def test_stereo_camera_refuses_a_source_of_no_kind_naming_it(tmp_path: Path) -> None:
+    """StereoCamera(None, ...) (a setting left out), a float or a bytearray was taken for a
+    capture object of the caller's and failed in "'NoneType' object has no attribute
+    'isOpened'", naming neither the side nor what it takes; refused before anything is opened."""
+    name = str(tmp_path / "left_%04d.png")
+    for bad, kind in ((None, "NoneType"), (1.5, "float"), (bytearray(b"x"), "bytearray")):
+        for left, right, side in ((bad, name, "left"), (name, bad, "right"), (bad, bad, "left")):
+            with pytest.raises(TypeError) as info:
+                StereoCamera(left, right)
+            assert str(info.value) == (
+                f"{side} source: expected a device index, a path or a capture object "
+                f"(cv2.VideoCapture's methods), got {kind}"
+            )

@@ -1592,6 +1592,14 @@ class StereoCamera(PairSource):
             if isinstance(src, bytes):
                 # taken for a capture object: "'bytes' object has no attribute 'isOpened'"
                 as_path(src, side)
+            if not isinstance(src, (str, os.PathLike, int, np.integer, np.bool_)) and not hasattr(
+                src, "isOpened"
+            ):
+                # None (a setting left out) too: "'NoneType' object has no attribute 'isOpened'"
+                raise TypeError(
+                    f"{side} source: expected a device index, a path or a capture object "
+                    f"(cv2.VideoCapture's methods), got {type(src).__name__}"
+                )
         self.requested_size = parse_size(image_size, "image_size")
         # True was taken as 1 fps, and "30" gave math's TypeError
         float_sized(fps, "fps")  # 10**400: math.isfinite's OverflowError, naming nothing
