@@ -2417,3 +2417,26 @@ def test_make_folder_refuses_a_bytes_name_naming_it(tmp_path: Path) -> None:
         "decode it first (os.fsdecode(path))"
     )
     assert not new.exists()
+
+
+def test_read_ply_reads_past_an_empty_list_element_before_the_vertices(tmp_path: Path) -> None:
+    """A binary PLY with "element face 0" (a list property) before its vertices was refused
+    ("element 'face' before vertex holds a list property (its binary rows are not skipped)"),
+    though an element of no rows has no bytes to skip; one with rows still says so."""
+    head = (
+        "ply\nformat binary_little_endian 1.0\nelement face {}\n"
+        "property list uchar int vertex_indices\nelement vertex 1\nproperty float x\n"
+        "property float y\nproperty float z\nend_header\n"
+    )
+    empty = tmp_path / "empty.ply"
+    empty.write_bytes(head.format(0).encode() + np.array([1, 2, 3], "<f4").tobytes())
+    pts, cols = read_ply(empty)
+    assert pts.tolist() == [[1.0, 2.0, 3.0]] and cols is None
+    one = tmp_path / "one.ply"
+    one.write_bytes(head.format(1).encode() + b"\x00" + np.array([1, 2, 3], "<f4").tobytes())
+    with pytest.raises(ValueError) as info:
+        read_ply(one)
+    assert str(info.value) == (
+        f"PLY file {one}: element 'face' before vertex holds a list property (its binary rows "
+        "are not skipped)"
+    )

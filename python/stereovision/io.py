@@ -1564,7 +1564,8 @@ def read_ply(
                 raise ValueError(f"truncated PLY file {p}: expected {count} vertices")
         rec = _ascii_ply_vertices(raw[start:], dtype, count, p)
     else:
-        listed = [name for name, _, _, has_list in before if has_list]
+        # an element of no rows has nothing to skip (an empty face list written first)
+        listed = [name for name, rows, _, has_list in before if has_list and rows]
         if listed:
             raise ValueError(
                 f"PLY file {p}: element {listed[0]!r} before vertex holds a list property (its "
