@@ -820,7 +820,8 @@ def test_matches_from_csv_refuses_an_image_shape_its_matches_lie_outside(tmp_pat
         f"{path}: 1 of the 3 matches lie outside image_shape (80, 30) (left positions up to "
         "x 70, y 20); image_shape is the left image's (H, W): (30, 80)?"
     )
-    with pytest.raises(ValueError, match=r"2 of the 3 matches .*\(H, W\)$"):
+    # (10, 5) is no swap of the matches' shape: read with a warning (the next test)
+    with pytest.warns(UserWarning, match=r"^\S+: 2 of the 3 matches lie outside image_shape"):
         sv.Matches.from_csv(path, (10, 5))
     back = sv.Matches.from_csv(path, (30, 80))  # a NaN position is no position: read as before
     np.testing.assert_array_equal(back.to_array(), m.to_array())
@@ -829,19 +830,42 @@ def test_matches_from_csv_refuses_an_image_shape_its_matches_lie_outside(tmp_pat
 def test_matches_from_csv_suggests_the_swap_only_when_every_match_fits_it(tmp_path: Path) -> None:
     """With one match outside (80, 30) and another outside (30, 80), each shape's error asked
     "image_shape is the left image's (H, W): (30, 80)?" and "(80, 30)?": the other, which
-    refused the file in its turn. The swap is suggested only when all the matches fit it."""
+    refused the file in its turn. Neither shape is a swap: each reads the file, with a warning
+    naming the match outside it."""
     m = sv.Matches(
         xl=[70.0, 5.0], yl=[20.0, 50.0], xr=[66.0, 1.0], yr=[20.0, 50.0], score=[1.0, 0.5],
         image_shape=(80, 80),
     )  # fmt: skip
     path = m.save_csv(tmp_path / "m.csv")
     for shape, where in (((80, 30), "x 70, y 20"), ((30, 80), "x 5, y 50")):
-        with pytest.raises(ValueError) as err:
-            sv.Matches.from_csv(path, shape)
-        assert str(err.value) == (
+        with pytest.warns(UserWarning) as caught:
+            back = sv.Matches.from_csv(path, shape)
+        assert [str(w.message) for w in caught] == [
             f"{path}: 1 of the 2 matches lie outside image_shape {shape} (left positions up to "
-            f"{where}); image_shape is the left image's (H, W)"
+            f"{where}): kept in the arrays, left out of dispx and dispy"
+        ]
+        np.testing.assert_array_equal(back.to_array(), m.to_array())
+
+
+def test_matches_from_csv_reads_a_file_with_a_stray_point_and_warns(tmp_path: Path) -> None:
+    """One point of a third-party file at x -0.6 (rounds to -1) refused the whole file ("1 of
+    the 3 matches lie outside image_shape (8, 10)"), though the shape is right: the file is
+    read, the point kept in the arrays and left out of dispx/dispy, with one warning."""
+    path = tmp_path / "m.csv"
+    path.write_text("x_left,y_left,x_right,y_right,score\n-0.6,2,-3,2,1\n4,5,1,5,1\n9,7,5,7,0.5\n")
+    with pytest.warns(UserWarning) as caught:
+        m = sv.Matches.from_csv(path, (8, 10))
+    assert [(str(w.message), w.filename) for w in caught] == [
+        (
+            f"{path}: 1 of the 3 matches lie outside image_shape (8, 10) (left positions up to "
+            "x -0.6, y 2): kept in the arrays, left out of dispx and dispy",
+            __file__,
         )
+    ]
+    np.testing.assert_array_equal(m.xl, np.float32([-0.6, 4, 9]))
+    dispx = m.dispx
+    assert np.count_nonzero(np.isfinite(dispx)) == 2
+    assert (dispx[5, 4], dispx[7, 9]) == (3.0, 4.0)
 
 
 def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_path: Path) -> None:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path
+from stereovision._validate import NOT_NUMBERS, as_path, user_stacklevel
 from stereovision.calibration import Calibration
 from stereovision.io import atomic_write
 
@@ -357,8 +357,15 @@ class Matches:
             If ``path`` is a folder (or another file that is neither regular nor a pipe) or
             not UTF-8 text (an image given by mistake), another header, a row without five
             numbers or with a finite number beyond float32's range, naming the file (and the
-            row's line), or matches whose left position lies outside ``image_shape`` (one given
-            as ``(W, H)``).
+            row's line), or an ``image_shape`` evidently given as ``(W, H)``: some matches' left
+            positions lie outside it and all fit ``(W, H)``.
+
+        Warns
+        -----
+        UserWarning
+            If some matches' left positions lie outside ``image_shape`` otherwise (the count
+            and the largest position): they are kept in the arrays and left out of
+            :attr:`dispx` and :attr:`dispy`.
         """
         from stereovision.io import _existing_file
 
@@ -422,14 +429,22 @@ class Matches:
             fin = np.isfinite(rx) & np.isfinite(ry)
             out = fin & ((rx < 0) | (rx >= w) | (ry < 0) | (ry >= h))
         if out.any():
-            # all the matches, not only those outside: (80, 30) and (30, 80) each suggested
-            # the other when one match lay outside each
-            inside_swapped = not np.any(fin & ((rx < 0) | (rx >= h) | (ry < 0) | (ry >= w)))
-            hint = f": ({w}, {h})?" if inside_swapped else ""
-            raise ValueError(
+            said = (
                 f"{path}: {int(out.sum())} of the {len(m)} matches lie outside image_shape "
                 f"{(h, w)} (left positions up to x {float(np.nanmax(m.xl[out])):g}, y "
-                f"{float(np.nanmax(m.yl[out])):g}); image_shape is the left image's (H, W)"
-                f"{hint}"
+                f"{float(np.nanmax(m.yl[out])):g})"
+            )
+            # Refused only when the shape is evidently swapped: every match fits (W, H) (all
+            # of them, not only those outside: (80, 30) and (30, 80) each suggested the other).
+            # A stray point of another tool's file (x -0.6) refused the whole file: it is read,
+            # the point kept in the arrays and left out of dispx/dispy, as _raster does.
+            if not np.any(fin & ((rx < 0) | (rx >= h) | (ry < 0) | (ry >= w))):
+                raise ValueError(f"{said}; image_shape is the left image's (H, W): ({w}, {h})?")
+            import warnings
+
+            warnings.warn(
+                f"{said}: kept in the arrays, left out of dispx and dispy",
+                UserWarning,
+                stacklevel=user_stacklevel(),
             )
         return m
