@@ -474,6 +474,18 @@ try:
                     call()
                 except (ValueError, MemoryError) as e:
                     print(f"{{type(e).__name__}}: {{e}}")
+    elif case == "mismatch_before_copies":
+        # the pair kernels without the 32-bit size limit: a 16 GiB view as left, a small right
+        grey = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
+        right = np.zeros((6, 8), np.float32)
+        for call in (
+            lambda: _core.sgm_disparity(grey, right, 0, 16, 10, 120, 0.0, 10, 1, 0, 8),
+            lambda: _core.gabor_newton_step(grey, right, grey),
+        ):
+            try:
+                call()
+            except (ValueError, MemoryError) as e:
+                print(f"{{type(e).__name__}}: {{e}}")
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -592,6 +604,20 @@ def test_pair_kernels_refuse_a_huge_or_mismatched_pair_before_copying_it() -> No
         "(width, height)"
     )
     assert out.stdout.splitlines() == [too_large] * 5 + [differ] * 5, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_sgm_and_newton_step_refuse_a_mismatched_pair_before_copying_it() -> None:
+    """f6745d9f's siblings: sgm_disparity and gabor_newton_step copied a broadcast 65536 x 65536
+    ``left`` before refusing a ``right`` of another shape: "MemoryError: out of memory: a copy
+    of left needs 16.00 GiB" under ``ulimit -v`` (the memory taken without one)."""
+    out = _under_address_limit("mismatch_before_copies", 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    differ = (
+        "ValueError: left and right images differ in size: left (65536, 65536), right (8, 6) "
+        "(width, height)"
+    )
+    assert out.stdout.splitlines() == [differ] * 2, out.stdout
 
 
 @pytest.mark.parametrize("channels", [2, 5])

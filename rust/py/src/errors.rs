@@ -38,16 +38,11 @@ pub fn check_size(w: usize, h: usize, max_pixels: usize, name: &str, noun: &str)
 /// kernel refused its size or a `right` of another shape. The words are the kernel's; an empty
 /// image is left to the copy's own check.
 pub fn check_pair_size(left: (usize, usize), right: (usize, usize)) -> PyResult<()> {
-    let ((lh, lw), (rh, rw)) = (left, right);
-    if lh * lw == 0 || rh * rw == 0 {
+    let (lh, lw) = left;
+    if lh * lw == 0 || right.0 * right.1 == 0 {
         return Ok(());
     }
-    if left != right {
-        return Err(to_pyerr(CoreError::SizeMismatch {
-            left: (lw, lh),
-            right: (rw, rh),
-        }));
-    }
+    check_pair_shapes(left, right)?;
     check_size(
         lw,
         lh,
@@ -55,6 +50,21 @@ pub fn check_pair_size(left: (usize, usize), right: (usize, usize)) -> PyResult<
         "left",
         "image",
     )
+}
+
+/// A pair's shapes (`(H, W)` each) alone, for the kernels without the 32-bit size limit
+/// (`sgm_disparity`, `gabor_newton_step`): a broadcast `left` was copied (16 GiB) before a
+/// `right` of another shape was refused. The kernel's words; an empty image is left to the
+/// copy's own check.
+pub fn check_pair_shapes(left: (usize, usize), right: (usize, usize)) -> PyResult<()> {
+    let ((lh, lw), (rh, rw)) = (left, right);
+    if lh * lw == 0 || rh * rw == 0 || left == right {
+        return Ok(());
+    }
+    Err(to_pyerr(CoreError::SizeMismatch {
+        left: (lw, lh),
+        right: (rw, rh),
+    }))
 }
 
 /// `MemoryError` for a copy of `n` values of `T` the binding could not allocate.

@@ -224,6 +224,8 @@ pub fn gabor_newton_step<'py>(
             "disp: map is {map_dim:?} (rows, columns), the images are {img_dim:?}"
         )));
     }
+    // right's shape too before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_shapes(img_dim, right.as_array().dim())?;
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let d = image_from_numpy(&disp, "disp")?;

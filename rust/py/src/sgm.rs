@@ -28,6 +28,8 @@ pub fn sgm_disparity<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    // both shapes before either copy (a broadcast left was copied first)
+    crate::errors::check_pair_shapes(left.as_array().dim(), right.as_array().dim())?;
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
     let (w, h) = (l.view().width, l.view().height);
