@@ -868,6 +868,19 @@ def test_matches_from_csv_reads_a_file_with_a_stray_point_and_warns(tmp_path: Pa
     assert (dispx[5, 4], dispx[7, 9]) == (3.0, 4.0)
 
 
+def test_matches_from_csv_warns_of_an_infinite_position(tmp_path: Path) -> None:
+    """A row's "inf" position was left out of dispx without a word, where 1e30 was said."""
+    path = tmp_path / "m.csv"
+    path.write_text("x_left,y_left,x_right,y_right,score\ninf,2,1,2,1\n4,5,1,5,1\n")
+    with pytest.warns(UserWarning) as caught:
+        m = sv.Matches.from_csv(path, (8, 10))
+    assert [str(w.message) for w in caught] == [
+        f"{path}: 1 of the 2 matches lie outside image_shape (8, 10) (left positions up to "
+        "x inf, y 2): kept in the arrays, left out of dispx and dispy"
+    ]
+    assert len(m) == 2 and np.count_nonzero(np.isfinite(m.dispx)) == 1
+
+
 def test_matches_from_csv_names_a_binary_file_a_folder_and_a_missing_file(tmp_path: Path) -> None:
     """An image given as the matches' CSV was a UnicodeDecodeError naming no file ("'utf-8'
     codec can't decode byte 0x89 in position 0"), a folder an IsADirectoryError: each now

@@ -426,7 +426,8 @@ class Matches:
         h, w = m.image_shape
         rx, ry = np.rint(m.xl), np.rint(m.yl)
         with np.errstate(invalid="ignore"):
-            fin = np.isfinite(rx) & np.isfinite(ry)
+            # NaN is no position; an infinite one (a row's "inf") lies outside, as 1e30 does
+            fin = ~np.isnan(rx) & ~np.isnan(ry)
             out = fin & ((rx < 0) | (rx >= w) | (ry < 0) | (ry >= h))
         if out.any():
             said = (
