@@ -2440,3 +2440,38 @@ def test_read_ply_reads_past_an_empty_list_element_before_the_vertices(tmp_path:
         f"PLY file {one}: element 'face' before vertex holds a list property (its binary rows "
         "are not skipped)"
     )
+
+
+def test_atomic_write_and_keep_previous_take_a_long_legal_name(tmp_path: Path) -> None:
+    """A 250-byte name (NAME_MAX is 255) is written: the temporary '.NAME.xxxxxxxx.tmp' and the
+    kept 'NAME.previous.EXT' are cut to fit, where both failed with 'File name too long'."""
+    from stereovision.io import atomic_write, keep_previous
+
+    dest = tmp_path / ("é" * 60 + "a" * 125 + ".yaml")  # 250 bytes in UTF-8
+    assert len(os.fsencode(dest.name)) == 250
+    with atomic_write(dest) as fh:
+        fh.write(b"old")
+    assert dest.read_bytes() == b"old"
+    kept = keep_previous(dest, b"new")
+    assert kept is not None and kept.read_bytes() == b"old"
+    assert kept.name.endswith(".previous.yaml") and len(os.fsencode(kept.name)) <= 255
+    assert keep_previous(dest, b"newer") == kept  # already kept byte for byte: not copied again
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([dest.name, kept.name])
+
+
+def test_keep_previous_and_save_csv_refuse_a_bytes_or_empty_name_in_as_paths_words(
+    tmp_path: Path,
+) -> None:
+    """keep_previous(b'/x') said pathlib's 'argument should be a str object ...', naming no
+    argument, and keep_previous('') / Matches.save_csv('') took '' for the current folder
+    ('cannot write .: it is a folder'): both in as_path's words now."""
+    from stereovision.io import keep_previous
+    from stereovision.matches import Matches
+
+    with pytest.raises(TypeError, match=r"^path: expected a str or os\.PathLike file name, got"):
+        keep_previous(b"/x")
+    with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
+        keep_previous("")
+    z = np.zeros(2, np.float32)
+    with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
+        Matches(z, z, z, z, z, (8, 10)).save_csv("")

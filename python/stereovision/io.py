@@ -436,7 +436,7 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     """
     import shutil
 
-    p = Path(path)
+    p = as_path(path, file=True)
     if not p.is_file():
         return None
     if new is not None and p.stat().st_size == len(new) and p.read_bytes() == new:
@@ -445,7 +445,10 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     # cloud.ply of any size aside this way
     n = 1
     while True:
-        kept = p.with_name(f"{p.stem}.previous{'' if n == 1 else f'.{n}'}{p.suffix}")
+        tail = f".previous{'' if n == 1 else f'.{n}'}{p.suffix}"
+        # the stem is cut when NAME.previous.EXT would pass NAME_MAX ("File name too long"
+        # refused the write of a legal 250-byte name)
+        kept = p.with_name(_fit_name(p.stem, _NAME_MAX - len(os.fsencode(tail))) + tail)
         # a link is taken, not followed: a dangling one had the copy made at its target
         # (elsewhere), one to NAME.EXT itself passed for the copy of the file about to be
         # replaced, and a looping one failed after the work; none is a copy this made
@@ -555,13 +558,27 @@ def temp_refused(dest: Path, exc: OSError) -> OSError:
     return failed
 
 
+#: Longest file name (bytes) of Linux's and macOS's filesystems, NAME_MAX.
+_NAME_MAX = 255
+
+
+def _fit_name(name: str, room: int) -> str:
+    """``name`` cut to at most ``room`` bytes in the filesystem's encoding (whole characters)."""
+    while len(os.fsencode(name)) > room:
+        name = name[:-1]
+    return name
+
+
 def _temp_beside(dest: Path, suffix: str) -> tuple[int, str]:
     """A new temporary file in ``dest``'s folder (``os.replace`` is atomic within a filesystem
     only), open; a folder that refuses it is named, not the temporary file
     (:func:`temp_refused`)."""
     directory = dest.parent if str(dest.parent) else Path(".")
+    # '.NAME.' + mkstemp's 8 random characters + suffix: a legal name of 241+ bytes made a
+    # temporary name past NAME_MAX, and the write failed ("File name too long"); it is cut
+    name = _fit_name(dest.name, _NAME_MAX - 2 - 8 - len(suffix))
     try:
-        return tempfile.mkstemp(prefix=f".{dest.name}.", suffix=suffix, dir=directory)
+        return tempfile.mkstemp(prefix=f".{name}.", suffix=suffix, dir=directory)
     except OSError as exc:
         raise temp_refused(dest, exc) from exc
 
@@ -594,8 +611,7 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         If ``path`` is a link that loops, or a FIFO or a device (replaced, the reader waiting
         on it got nothing).
     """
-    as_path(path)
-    dest = _through_links(Path(path))
+    dest = _through_links(as_path(path, file=True))
     _writable_destination(dest)
     fd, tmp = _temp_beside(dest, ".tmp")
     try:
