@@ -1878,7 +1878,7 @@ def test_cli_an_output_fifo_is_refused_before_the_work(
         with pytest.raises(OSError) as info:
             _calibrate_cli("-o", str(given))
         assert str(info.value) == (
-            f"-o {given}: cannot write {fifo}: it is not a regular file (a FIFO or a device)"
+            f"-o {given}: cannot write {fifo}: it is not a regular file (a FIFO)"
         )
     assert sorted(os.listdir(tmp_path)) == ["link.yaml", "pipe.yaml"] and not fifo.is_file()
 

@@ -333,7 +333,7 @@ def test_export_result_refuses_a_fifo_before_writing_anything(result, tmp_path):
     was replaced. Refused before any file is written, the folder left as it was."""
     (tmp_path / "depth.npz").write_bytes(b"kept")
     os.mkfifo(tmp_path / "cloud.ply")
-    said = f"cannot write {tmp_path / 'cloud.ply'}: it is not a regular file (a FIFO or a device)"
+    said = f"cannot write {tmp_path / 'cloud.ply'}: it is not a regular file (a FIFO)"
     with pytest.raises(OSError, match=f"^{re.escape(said)}$"):
         export.export_result(result, tmp_path, ("npz", "ply"))
     assert (tmp_path / "depth.npz").read_bytes() == b"kept"

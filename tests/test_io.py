@@ -1757,14 +1757,17 @@ def test_a_fifo_destination_is_refused_not_replaced_by_a_file(
     fifo = tmp_path / "pipe.png"
     os.mkfifo(fifo)
     (tmp_path / "link.png").symlink_to("pipe.png")
-    said = f"cannot write {fifo}: it is not a regular file (a FIFO or a device)"
-    for dest in (fifo, tmp_path / "link.png"):
+    said = f"cannot write {fifo}: it is not a regular file (a FIFO)"
+    link = tmp_path / "link.png"
+    # the link is named, the name the user gave (not its target alone)
+    said_link = f"cannot write {link}: it is a link to {fifo}, not a regular file (a FIFO)"
+    for dest, words in ((fifo, said), (link, said_link)):
         with pytest.raises(OSError) as refused, atomic_write(dest) as fh:
             fh.write(b"x")
-        assert str(refused.value) == said
+        assert str(refused.value) == words
         with pytest.raises(OSError) as together:
             write_together([(tmp_path / "a.yaml", b"1"), (dest, b"2")])
-        assert str(together.value) == said
+        assert str(together.value) == words
     assert main(["board", "-o", str(fifo), "--square", "20", "--unit", "mm"]) == 2
     assert capsys.readouterr().err == f"stereovision: error: {said}\n"
     assert sorted(os.listdir(tmp_path)) == ["link.png", "pipe.png"]  # nothing written
@@ -2475,3 +2478,24 @@ def test_keep_previous_and_save_csv_refuse_a_bytes_or_empty_name_in_as_paths_wor
     z = np.zeros(2, np.float32)
     with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
         Matches(z, z, z, z, z, (8, 10)).save_csv("")
+
+
+@pytest.mark.skipif(os.name != "posix", reason="Unix sockets")
+def test_a_socket_destination_is_refused_as_a_socket(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Unix socket (a ROS node's, a daemon's) under the output name was called "a FIFO or a
+    device"; it is said to be a socket, and /dev/null a character device."""
+    import socket
+
+    from stereovision.io import atomic_write
+
+    monkeypatch.chdir(tmp_path)  # a relative name: a socket's path is limited to ~108 bytes
+    with socket.socket(socket.AF_UNIX) as sock:
+        sock.bind("out.png")
+        with pytest.raises(OSError) as refused, atomic_write("out.png") as fh:
+            fh.write(b"x")
+    assert str(refused.value) == "cannot write out.png: it is not a regular file (a socket)"
+    if Path("/dev/null").exists():
+        with pytest.raises(OSError, match=r"\(a character device\)$"), atomic_write("/dev/null"):
+            pass

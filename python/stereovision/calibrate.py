@@ -2794,14 +2794,14 @@ def _check_output_file(
     """
     if out.is_dir():
         raise ValueError(f"-o {given}: is a folder; give a calibration file name")
-    from stereovision.io import _through_links, cannot_write_in
+    from stereovision.io import _special_kind, _through_links, cannot_write_in
 
     # a link is written through: the new file is made beside its target, not beside the link
     dest = _through_links(out)
     if dest.exists() and not dest.is_file():
         # a FIFO or a device, refused by atomic_write only after minutes of corner finding
         raise OSError(
-            f"-o {given}: cannot write {dest}: it is not a regular file (a FIFO or a device)"
+            f"-o {given}: cannot write {dest}: it is not a regular file ({_special_kind(dest)})"
         )
     folder = dest.parent if str(dest.parent) else Path(".")
     why = cannot_write_in(folder)

@@ -1167,7 +1167,7 @@ def export_result(
             # what atomic_write refuses of a link (one that loops, one into a missing folder)
             # or of a FIFO was found at its format's turn, after depth.npz and cloud.ply were
             # replaced
-            _writable_destination(_through_links(target))
+            _writable_destination(_through_links(target), target)
     make_folder(out)
     writers: dict[str, Callable[[Path, DepthResult], Path]] = {
         "ply": write_cloud_ply,

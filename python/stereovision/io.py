@@ -506,15 +506,41 @@ def _one_file(a: Path, b: Path) -> bool:
         return False
 
 
-def _writable_destination(dest: Path) -> Path:
+def _special_kind(path: Path) -> str:
+    """What ``path``, there but not a regular file nor a folder, is: ``"a FIFO"``, ``"a
+    socket"``, ``"a character device"`` or ``"a block device"`` (a socket was called "a FIFO or
+    a device")."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return "not a file"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode):
+        return "a character device"
+    if stat.S_ISBLK(mode):
+        return "a block device"
+    return "not a regular file"
+
+
+def _writable_destination(dest: Path, given: Path | None = None) -> Path:
     """``dest``'s folder, after refusing a ``dest`` that is a folder or a folder that is missing
-    or a file (the errors :func:`atomic_write` documents)."""
+    or a file (the errors :func:`atomic_write` documents). ``given``: the name the user gave,
+    when ``dest`` is its link's target (:func:`_through_links`), named with it."""
     directory = dest.parent if str(dest.parent) else Path(".")
     if dest.is_dir():
         raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
     if dest.exists() and not dest.is_file():
-        # a FIFO (a reader waiting on it) or a device was replaced by a regular file unsaid
-        raise OSError(f"cannot write {dest}: it is not a regular file (a FIFO or a device)")
+        # a FIFO (a reader waiting on it) or a device was replaced by a regular file unsaid;
+        # a link to one was refused naming the target alone, not the name given
+        kind = _special_kind(dest)
+        if given is not None and given != dest and given.is_symlink():
+            raise OSError(
+                f"cannot write {given}: it is a link to {dest}, not a regular file ({kind})"
+            )
+        raise OSError(f"cannot write {dest}: it is not a regular file ({kind})")
     if directory.exists() and not directory.is_dir():
         raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
     if not directory.is_dir():
@@ -608,11 +634,12 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     IsADirectoryError, NotADirectoryError
         If ``path`` is a folder, or its directory is a file.
     OSError
-        If ``path`` is a link that loops, or a FIFO or a device (replaced, the reader waiting
-        on it got nothing).
+        If ``path`` is a link that loops, or a FIFO, a socket or a device (replaced, the reader
+        waiting on it got nothing), or a link to one.
     """
-    dest = _through_links(as_path(path, file=True))
-    _writable_destination(dest)
+    given = as_path(path, file=True)
+    dest = _through_links(given)
+    _writable_destination(dest, given)
     fd, tmp = _temp_beside(dest, ".tmp")
     try:
         encoding = None if "b" in mode else "utf-8"
@@ -664,8 +691,8 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
     # a link is written through (its target replaced, the link kept), as open(path, "w") does
     given = [dest for dest, _ in files]
     files = [(_through_links(dest), data) for dest, data in files]
-    for dest, _ in files:
-        _writable_destination(dest)
+    for (dest, _), gave in zip(files, given, strict=True):
+        _writable_destination(dest, gave)
     # written through links, right.yaml -> left.yaml put the right camera over the left one
     for i, (dest, _) in enumerate(files):
         for j in range(i):

@@ -1594,7 +1594,7 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
     OSError
         ``output`` is a FIFO or a device (or a link to one).
     """
-    from stereovision.io import _through_links, cannot_write_in, refuse_an_input
+    from stereovision.io import _special_kind, _through_links, cannot_write_in, refuse_an_input
 
     out = Path(output)
     if out.suffix.lower() not in SCREENSHOT_SUFFIXES:
@@ -1606,7 +1606,7 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
     if dest.exists() and not dest.is_file():
         # a FIFO or a device, refused by atomic_write only after the depth map and the render
         raise OSError(
-            f"-o {out}: cannot write {dest}: it is not a regular file (a FIFO or a device)"
+            f"-o {out}: cannot write {dest}: it is not a regular file ({_special_kind(dest)})"
         )
     parent = dest.parent
     if parent.exists() and not parent.is_dir():
