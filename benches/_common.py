@@ -5,7 +5,6 @@ The benches run as scripts (``python benches/bench_x.py``), so this folder is on
 
 from __future__ import annotations
 
-import argparse
 import math
 import statistics
 import time
@@ -15,29 +14,17 @@ from typing import TypeVar
 
 import numpy as np
 
+from stereovision.bench import MIN_RUNS, _run_count
 from stereovision.evaluate import count_at_precision, sparse_metrics
 from stereovision.matches import Matches
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
-#: evaluation.md "Speed": the median of at least this many timed runs.
-MIN_RUNS = 5
+#: argparse ``type`` of a bench's ``--runs`` / ``--repeats``: ``stereovision bench --runs``'s
+#: rule, kept in one place (a copy here had no upper bound: ``--runs 1000000000`` ran on)
+timed_runs = _run_count
 
 T = TypeVar("T")
-
-
-def timed_runs(text: str) -> int:
-    """argparse ``type`` of a bench's ``--runs`` / ``--repeats``: an integer of at least
-    :data:`MIN_RUNS` (the median of fewer runs is noise on the shared 2-core machines)."""
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if n < MIN_RUNS:
-        raise argparse.ArgumentTypeError(
-            f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {n}"
-        )
-    return n
 
 
 def gt_scenes() -> list[str]:

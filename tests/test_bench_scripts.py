@@ -59,7 +59,7 @@ def _help(script: str) -> str:
 def test_timing_scripts_refuse_fewer_than_five_runs(script: str, option: str) -> None:
     done = _run(script, option, "4")
     assert done.returncode == 2
-    assert f"{option}: " in done.stderr and "at least 5" in done.stderr and "got 4" in done.stderr
+    assert f"{option}: " in done.stderr and "at least 5" in done.stderr and "got '4'" in done.stderr
 
 
 @pytest.mark.parametrize("script", ["mcgm_dump.py", "dump_grey.py"])
@@ -286,3 +286,22 @@ def test_docs_pictures_gui_offers_a_save_folder(
     assert app.state.save_dir == "scenes/saved"  # as the README tells it, not /tmp/sv-...
     assert app.state.save_dir_title.startswith(str(tmp_path.resolve() / "scenes" / "saved"))
     assert app.state.save_hint == SAVE_HINT
+
+
+def test_the_benches_runs_option_is_stereovision_benchs(monkeypatch: pytest.MonkeyPatch) -> None:
+    """benches/_common.timed_runs copied bench's --runs rule without its upper bound: a bench's
+    ``--runs 1000000000`` was taken (and ran on for days). It is that rule itself now."""
+    import argparse
+
+    from stereovision.bench import _run_count
+    from stereovision.cli import MAX_RUNS
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import _common
+
+    assert _common.timed_runs is _run_count
+    assert _common.timed_runs("5") == 5
+    with pytest.raises(argparse.ArgumentTypeError, match=f"^expected at most {MAX_RUNS} runs"):
+        _common.timed_runs("1000000000")
+    with pytest.raises(argparse.ArgumentTypeError, match=r"^expected at least 5 runs"):
+        _common.timed_runs("4")
