@@ -2274,3 +2274,20 @@ def test_view_window_of_a_wide_scene_shows_all_of_it(monkeypatch):
     blue = (rgb[..., 2] > 150) & (rgb[..., 0] < 60) & (rgb[..., 1] < 60)
     assert red.sum() > 50 and blue.sum() > 50, (red.sum(), blue.sum())
     assert seen["size"] == render.VIEW_WINDOW_SIZE == (1024, 768)
+
+
+def test_the_depth_bar_labels_stay_readable_over_huge_and_tiny_ranges() -> None:
+    """The bar's label format: a cloud reaching 1e30 m had labels of 31 digits and more, a
+    nanometre range's were all '0.000000000', and +-1e308 raised OverflowError; significant
+    digits there now, the usual ranges' decimals unchanged."""
+    from stereovision.render import _bar_label_format
+
+    assert _bar_label_format(0.5, 30.0) == "%.2f"
+    assert _bar_label_format(4e-3, 6e-3) == "%.4f"
+    assert _bar_label_format(5.0, 5.0) == "%.2f"
+    assert _bar_label_format(1.0, 1e30) % 1e30 == "1e+30"
+    assert _bar_label_format(-1.7e308, 1.7e308) == "%.3g"
+    tiny = _bar_label_format(1e-12, 2e-12)
+    assert [tiny % v for v in (1e-12, 1.25e-12, 1.5e-12)] == ["1e-12", "1.25e-12", "1.5e-12"]
+    far = _bar_label_format(1e10, 1e10 + 1)
+    assert far % (1e10 + 0.25) == "10000000000.25"

@@ -1031,10 +1031,18 @@ def _turbo_table(lo: float, hi: float) -> Any:
 def _bar_label_format(lo: float, hi: float) -> str:
     """The scale bar's label format over ``lo..hi`` metres: two decimals, more where its five
     labels (a quarter of the range apart) would need them to differ (a stereo microscope's
-    cloud 4-6 mm ahead was labelled "0.00 0.00 0.01 0.01 0.01")."""
-    step = (hi - lo) / 4
-    decimals = 2 if not step > 0 else min(9, max(2, math.ceil(-math.log10(step))))
-    return f"%.{decimals}f"
+    cloud 4-6 mm ahead was labelled "0.00 0.00 0.01 0.01 0.01"). Past a million metres or
+    under a nanometre step, significant digits (``%g``): a far cloud's labels were hundreds of
+    digits long, a tiny range's all "0.000000000", and +-1e308 an OverflowError."""
+    step = hi / 4 - lo / 4  # (hi - lo) / 4 overflowed to inf for +-1e308
+    if not step > 0 or not math.isfinite(step):
+        return "%.2f"
+    big = max(abs(lo), abs(hi))
+    decimals = max(2, math.ceil(-math.log10(step)))
+    if decimals <= 9 and big < 1e6:
+        return f"%.{decimals}f"
+    # enough significant digits for labels a step apart to differ (17 hold any double)
+    return f"%.{min(17, max(3, math.ceil(math.log10(big / step)) + 2))}g"
 
 
 def add_geometry(plotter: pv.Plotter, geometry: pv.PolyData) -> Any:
