@@ -2810,7 +2810,7 @@ def test_the_view_serves_on_a_link_local_address_with_its_interface() -> None:
         pytest.skip("no link-local IPv6 address here")
     srv = FrameServer(host, 0)
     try:
-        assert srv.url == f"http://[{host}]:{srv.port}/"
+        assert srv.url == f"http://[{host.replace('%', '%25')}]:{srv.port}/"  # RFC 6874
         assert srv._httpd.server_address[3] != 0  # the interface's scope id
         assert _get(srv.url + "frame.jpg")[:2] == (503, "text/plain")
     finally:
@@ -3289,3 +3289,16 @@ def test_serve_or_host_with_no_display_is_refused_before_any_open(
         f"stereovision: error: {said} the live view, which --no-display turns off; give one or "
         "the other\n"
     )
+
+
+def test_a_scoped_ipv6_hosts_url_escapes_its_zone() -> None:
+    """--host fe80::1%eth0 (a link-local address, its interface named) was printed as
+    'http://[fe80::1%eth0]:8765/', '%et' an invalid escape to a strict URL parser; the zone's
+    '%' is '%25' (RFC 6874), in stream --serve's URL and gui's alike."""
+    from stereovision.gui import url_for
+    from stereovision.stream import _host_port
+
+    assert _host_port("fe80::1%eth0", 8765) == "[fe80::1%25eth0]:8765"
+    assert url_for("fe80::1%eth0", 8080) == "http://[fe80::1%25eth0]:8080/"
+    assert _host_port("::1", 8765) == "[::1]:8765"  # unscoped: unchanged
+    assert _host_port("127.0.0.1", 8765) == "127.0.0.1:8765"

@@ -322,8 +322,12 @@ class _ViewServer6(_ViewServer):
 
 
 def _host_port(host: str, port: int) -> str:
-    """``host:port`` as a URL says it: an IPv6 address in brackets (``[::1]:8765``)."""
-    return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
+    """``host:port`` as a URL says it: an IPv6 address in brackets (``[::1]:8765``), its zone's
+    ``%`` escaped (RFC 6874: ``[fe80::1%25eth0]:8765``; a bare ``%eth0`` is an invalid escape
+    to a strict URL parser; urllib and curl take both)."""
+    if ":" not in host:
+        return f"{host}:{port}"
+    return f"[{host.replace('%', '%25')}]:{port}"
 
 
 class FrameServer:
