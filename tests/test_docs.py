@@ -1097,3 +1097,13 @@ def test_the_docs_settings_are_the_codes_defaults() -> None:
         text = " ".join(page.read_text().split())
         unsaid += [f"{name}: {p!r}" for p in phrases if p not in text]
     assert not unsaid, f"the docs do not say the code's defaults: {unsaid}"
+
+
+def test_the_readme_shows_every_match_method() -> None:
+    """README's sv.match lines left out method="best" (the Hopfield channel's reference, which
+    sv.match accepts): every one of match.METHODS has its line."""
+    from stereovision.match import METHODS
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    shown = set(re.findall(r'sv\.match\(left, right, method="(\w+)"\)', text))
+    assert shown == set(METHODS)
