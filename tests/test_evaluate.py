@@ -861,3 +861,19 @@ def test_sparse_metrics_dict_gives_the_coverage_not_the_count() -> None:
     gt = np.full((8, 8), 2.0)
     s = sparse_metrics([0.0, 1.0, 7.0], [0.0, 1.0, 7.0], [-2.0, -1.0, 5.0], gt).as_dict()
     assert (s["count"], s["coverage"], s["precision@1.0"]) == (3, 2, 100.0)
+
+
+def test_table1_text_keeps_its_columns_for_a_far_point() -> None:
+    """A validated member at ~0 px disparity triangulates to 3e38 m: its row was printed with
+    39-digit numbers, the columns out of line, and the summary likewise; the exponent form is
+    used from a million up (and where a column is too narrow), the usual rows unchanged."""
+    est = np.full((2, 2), 10.0)
+    est[0, 0], est[0, 1], est[1, 0] = 3e38, 426500.0, 12.5
+    text = table1_report(est, np.full((2, 2), 10.0), n_points=4).format().splitlines()
+    head = text[1]
+    for row in text[3:7]:  # every row as wide as the heading, its columns under it
+        assert len(row) == len(head), row
+    assert text[3].split()[3:6] == ["3.000e+38", "10.000", "+3.0e+38"]
+    assert text[4].split()[3:6] == ["4.265e+05", "10.000", "+4.3e+05"]
+    assert text[5].split()[3:9] == ["12.500", "10.000", "+2.500", "41.010", "32.808", "+8.202"]
+    assert text[-1] == "RMSE: 1.500e+38 m (4.921e+38 ft) = 1.50e+39 % of the mean distance"

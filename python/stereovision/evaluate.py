@@ -456,21 +456,43 @@ class Table1Report:
         for i, (x, y, e, g) in enumerate(
             zip(self.x, self.y, self.estimated, self.ground_truth, strict=True), start=1
         ):
+            ft = _FT_PER_M
             lines.append(
-                f"{i:>3} {x:>5} {y:>5} {e:>9.3f} {g:>9.3f} {e - g:>+8.3f} "
-                f"{e * _FT_PER_M:>9.3f} {g * _FT_PER_M:>9.3f} {(e - g) * _FT_PER_M:>+8.3f}"
+                f"{i:>3} {x:>5} {y:>5} {_cell(e, 9)} {_cell(g, 9)} {_cell(e - g, 8, '+')} "
+                f"{_cell(e * ft, 9)} {_cell(g * ft, 9)} {_cell((e - g) * ft, 8, '+')}"
             )
         lines += [
             "-" * len(head),
-            f"points: {self.n_points}   mean distance: {self.mean_distance:.3f} m "
-            f"({self.mean_distance * _FT_PER_M:.3f} ft)",
-            f"average error: {self.mean_error:+.3f} m ({self.mean_error * _FT_PER_M:+.3f} ft)   "
-            f"mean |error|: {self.mean_abs_error:.3f} m "
-            f"({self.mean_abs_error * _FT_PER_M:.3f} ft)",
-            f"RMSE: {self.rmse:.3f} m ({self.rmse * _FT_PER_M:.3f} ft) = "
-            f"{self.rmse_pct:.2f} % of the mean distance",
+            f"points: {self.n_points}   mean distance: {_num(self.mean_distance)} m "
+            f"({_num(self.mean_distance * _FT_PER_M)} ft)",
+            f"average error: {_num(self.mean_error, '+')} m "
+            f"({_num(self.mean_error * _FT_PER_M, '+')} ft)   "
+            f"mean |error|: {_num(self.mean_abs_error)} m "
+            f"({_num(self.mean_abs_error * _FT_PER_M)} ft)",
+            f"RMSE: {_num(self.rmse)} m ({_num(self.rmse * _FT_PER_M)} ft) = "
+            f"{_num(self.rmse_pct, decimals=2)} % of the mean distance",
         ]
         return "\n".join(lines)
+
+
+def _num(value: float, sign: str = "", decimals: int = 3) -> str:
+    """``value`` with ``decimals`` decimals, in exponent form from a million up: a point
+    triangulated from a disparity of ~0 px (a far validated member, 3e38 m) was printed with
+    39 digits, in the table and in its mean, |error| and RMSE."""
+    if math.isfinite(value) and abs(value) >= 1e6:
+        return f"{value:{sign}.{decimals}e}"
+    return f"{value:{sign}.{decimals}f}"
+
+
+def _cell(value: float, width: int, sign: str = "") -> str:
+    """``value`` in a table column ``width`` wide: 3 decimals, or as many digits of the
+    exponent form as fit (426500.000 m had pushed the row's other columns out of line)."""
+    text = f"{value:{sign}{width}.3f}"
+    digits = 3
+    while len(text) > width and digits >= 0:
+        text = f"{value:{sign}{width}.{digits}e}"
+        digits -= 1
+    return text
 
 
 @renamed_keyword("depth_est", "depth")
