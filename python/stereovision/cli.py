@@ -1728,6 +1728,67 @@ def scene_failed_line(folder: Path, error: BaseException) -> str:
     return f"failed {said if said.startswith(f'{folder}: ') else f'{folder}: {said}'}"
 
 
+def _eval_summary(rows: list[dict[str, Any]], timed: bool) -> None:
+    """Print ``eval``'s lines after its table: the mean bad-2.0 line, then per scene the time
+    line (``timed``: ``--runs`` given), the depth line and the Table-1 reports."""
+    # the table's columns, SGBM-3WAY + fill included (the reference a dense map must beat)
+    columns = {
+        "ours": "ours",
+        "ours+fill": "ours+fill",
+        "bm": "StereoBM",
+        "sgbm": "SGBM-3WAY",
+        "sgbm+fill": "SGBM+fill",
+    }
+    mean = {
+        name: float(np.mean([r[k]["bad_2.0"] for r in rows]))
+        for k, name in columns.items()
+        if all(k in r for r in rows)
+    }
+    # a scene StereoBM cannot run on drops StereoBM's mean for the run: say so rather than leave
+    # the run's other scenes' figures out without a word
+    bm_missing = sum("sgbm" in r and "bm" not in r for r in rows)
+    bm_note = (
+        f"; StereoBM: no mean (no figures for {bm_missing} of {len(rows)} scenes)"
+        if 0 < bm_missing < len(rows)
+        else ""
+    )
+    print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()) + bm_note)
+    for r in rows:
+        if timed:  # asked for: the medians, as --json has them
+            print(_eval_time_line(r))
+        if "depth" in r:
+            dm = r["depth"]
+            line = (
+                f"{r['scene']}: depth over our {dm['n']} pixels:"
+                f" median |dZ|/Z {dm['median_rel']:.2f} %, off >5 % {dm['share_off_5']:.1f} %"
+                if dm["n"]
+                else f"{r['scene']}: depth: none of our pixels has a GT depth"
+            )
+            if "sgbm_depth" in r:
+                s = r["sgbm_depth"]
+                line += (
+                    f"; SGBM-3WAY over {s['n']}: {s['median_rel']:.2f} %, {s['share_off_5']:.1f} %"
+                    if s["n"]
+                    else "; SGBM-3WAY: none of its pixels has a GT depth"
+                )
+            print(line)
+            if "_table1_text" in r:
+                print(r["_table1_text"])
+        if "members_depth" in r:
+            m = r["members_depth"]
+            line = f"{r['scene']}: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)" + (
+                f" with GT depth: {m['n']}, RMSE {m['rmse_pct']:.2f} % of the mean depth,"
+                f" median |dZ|/Z {m['median_rel']:.2f} %"
+                if m["n"]
+                else ": none has a GT depth"
+            )
+            if "sgbm_depth" in r and r["sgbm_depth"]["n"]:  # else said on the depth line
+                line += f"; SGBM-3WAY's RMSE {r['sgbm_depth']['rmse_pct']:.2f} %"
+            print(line)
+            if "_members_table1_text" in r:
+                print(r["_members_table1_text"])
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
     from tqdm import tqdm
@@ -1771,53 +1832,60 @@ def cmd_eval(args: argparse.Namespace) -> int:
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     failed: list[str] = []
     skipped = 0
-    for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
-        try:
-            scene = load_scene(d)
-            # a GT map with no known pixel (all +inf) is no ground truth either: its figures
-            # would all be NaN (and NaN in the --json line, which is not JSON)
-            why = (
-                "no ground truth (gt_disp.pfm)"
-                if scene.gt is None
-                else None
-                if np.isfinite(scene.gt).any()
-                else "no ground truth: gt_disp.pfm has no known (finite) pixel"
-            )
-            if why is not None:
-                if len(dirs) == 1:
-                    raise CliError(f"{d}: {why} to evaluate against")
-                tqdm.write(f"skipped {d}: {why}", file=sys.stderr)
-                skipped += 1
-                continue
-            narrow = scene_too_narrow(scene)
-            if narrow:
-                # the range is evaluation.md's, never the caller's: "disparity range 16 is not
-                # smaller than the image width 8" named a range nobody gave
-                raise ValueError(f"{d}: {narrow}")
-            row = _eval_scene(scene, args.method, not args.no_opencv, args.runs or 1)
-        except BUG_ERRORS:  # RuntimeErrors, but a bug of ours: not one damaged scene of many
-            raise
-        except (ValueError, OSError, RuntimeError) as e:
-            if len(dirs) == 1:
+    try:
+        for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
+            try:
+                scene = load_scene(d)
+                # a GT map with no known pixel (all +inf) is no ground truth either: its figures
+                # would all be NaN (and NaN in the --json line, which is not JSON)
+                why = (
+                    "no ground truth (gt_disp.pfm)"
+                    if scene.gt is None
+                    else None
+                    if np.isfinite(scene.gt).any()
+                    else "no ground truth: gt_disp.pfm has no known (finite) pixel"
+                )
+                if why is not None:
+                    if len(dirs) == 1:
+                        raise CliError(f"{d}: {why} to evaluate against")
+                    tqdm.write(f"skipped {d}: {why}", file=sys.stderr)
+                    skipped += 1
+                    continue
+                narrow = scene_too_narrow(scene)
+                if narrow:
+                    # the range is evaluation.md's, never the caller's: "disparity range 16 is not
+                    # smaller than the image width 8" named a range nobody gave
+                    raise ValueError(f"{d}: {narrow}")
+                row = _eval_scene(scene, args.method, not args.no_opencv, args.runs or 1)
+            except BUG_ERRORS:  # RuntimeErrors, but a bug of ours: not one damaged scene of many
                 raise
-            # one damaged scene of many: say so and go on (the exit status says it at the end)
-            failed.append(str(d))
-            tqdm.write(scene_failed_line(d, e), file=sys.stderr)
-            continue
-        rows.append(row)
-        if "sgbm" in row and "bm" not in row:  # StereoBM cannot run on it: say why it is blank
-            no_bm = bm_reference_refusal(scene.max_disparity, scene.left.shape)
-            tqdm.write(f"{d}: no StereoBM figures: {no_bm}", file=sys.stderr)
-        if args.json:
-            print(json_line({k: v for k, v in row.items() if not k.startswith("_")}))
-            continue
-        if len(rows) == 1:  # the header over the first row: none over an error alone
-            tqdm.write(header)
-            tqdm.write(sub)
-        cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
-        for key in ("bm", "sgbm", "sgbm+fill"):
-            cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
-        tqdm.write(f"{row['scene']:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+            except (ValueError, OSError, RuntimeError) as e:
+                if len(dirs) == 1:
+                    raise
+                # one damaged scene of many: say so and go on (the exit status says it at the end)
+                failed.append(str(d))
+                tqdm.write(scene_failed_line(d, e), file=sys.stderr)
+                continue
+            rows.append(row)
+            if "sgbm" in row and "bm" not in row:  # StereoBM cannot run on it: say why it is blank
+                no_bm = bm_reference_refusal(scene.max_disparity, scene.left.shape)
+                tqdm.write(f"{d}: no StereoBM figures: {no_bm}", file=sys.stderr)
+            if args.json:
+                print(json_line({k: v for k, v in row.items() if not k.startswith("_")}))
+                continue
+            if len(rows) == 1:  # the header over the first row: none over an error alone
+                tqdm.write(header)
+                tqdm.write(sub)
+            cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
+            for key in ("bm", "sgbm", "sgbm+fill"):
+                cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
+            tqdm.write(f"{row['scene']:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (Terminated): the scenes evaluated are kept
+        # the mean, time and depth lines come after the loop: the medians of the scenes timed
+        # were lost (bench keeps its scenes' timing likewise)
+        if not args.json and rows:  # --json printed each scene's line as it went
+            _eval_summary(rows, args.runs is not None)
+        raise
     status = 0
     if failed:
         print(f"stereovision: {len(failed)} of {len(dirs)} scenes failed (above)", file=sys.stderr)
@@ -1826,62 +1894,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
         raise CliError(f"none of the {len(dirs)} scenes has ground truth to evaluate against")
     if args.json or not rows:
         return status
-    # the table's columns, SGBM-3WAY + fill included (the reference a dense map must beat)
-    columns = {
-        "ours": "ours",
-        "ours+fill": "ours+fill",
-        "bm": "StereoBM",
-        "sgbm": "SGBM-3WAY",
-        "sgbm+fill": "SGBM+fill",
-    }
-    mean = {
-        name: float(np.mean([r[k]["bad_2.0"] for r in rows]))
-        for k, name in columns.items()
-        if all(k in r for r in rows)
-    }
-    # a scene StereoBM cannot run on drops StereoBM's mean for the run: say so rather than leave
-    # the run's other scenes' figures out without a word
-    bm_missing = sum("sgbm" in r and "bm" not in r for r in rows)
-    bm_note = (
-        f"; StereoBM: no mean (no figures for {bm_missing} of {len(rows)} scenes)"
-        if 0 < bm_missing < len(rows)
-        else ""
-    )
-    print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()) + bm_note)
-    for r in rows:
-        if args.runs is not None:  # asked for: the medians, as --json has them
-            print(_eval_time_line(r))
-        if "depth" in r:
-            dm = r["depth"]
-            line = (
-                f"{r['scene']}: depth over our {dm['n']} pixels:"
-                f" median |dZ|/Z {dm['median_rel']:.2f} %, off >5 % {dm['share_off_5']:.1f} %"
-                if dm["n"]
-                else f"{r['scene']}: depth: none of our pixels has a GT depth"
-            )
-            if "sgbm_depth" in r:
-                s = r["sgbm_depth"]
-                line += (
-                    f"; SGBM-3WAY over {s['n']}: {s['median_rel']:.2f} %, {s['share_off_5']:.1f} %"
-                    if s["n"]
-                    else "; SGBM-3WAY: none of its pixels has a GT depth"
-                )
-            print(line)
-            if "_table1_text" in r:
-                print(r["_table1_text"])
-        if "members_depth" in r:
-            m = r["members_depth"]
-            line = f"{r['scene']}: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)" + (
-                f" with GT depth: {m['n']}, RMSE {m['rmse_pct']:.2f} % of the mean depth,"
-                f" median |dZ|/Z {m['median_rel']:.2f} %"
-                if m["n"]
-                else ": none has a GT depth"
-            )
-            if "sgbm_depth" in r and r["sgbm_depth"]["n"]:  # else said on the depth line
-                line += f"; SGBM-3WAY's RMSE {r['sgbm_depth']['rmse_pct']:.2f} %"
-            print(line)
-            if "_members_table1_text" in r:
-                print(r["_members_table1_text"])
+    _eval_summary(rows, args.runs is not None)
     return status
 
 
