@@ -607,6 +607,32 @@ def test_depth_metrics_refuses_a_bool_map() -> None:
         depth_metrics(np.ones((2, 2), bool), np.ones((2, 2)))
 
 
+def test_depth_metrics_names_a_whole_result_passed_for_a_depth_map() -> None:
+    # depth_metrics(res, zgt) said "depth maps must be real arrays, got object and float32",
+    # where dense_metrics and table1_report name the result and the array meant
+    import stereovision as sv
+
+    res = sv.DepthResult(
+        disparity=np.ones((2, 2), np.float32),
+        confidence=np.ones((2, 2), np.float32),
+        depth=np.ones((2, 2), np.float32),
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fused",
+        max_disparity=16,
+        calibration=None,
+        depth_sigma=None,
+    )
+    with pytest.raises(
+        TypeError, match=r"^depth: got a DepthResult; pass its array, result\.depth$"
+    ):
+        depth_metrics(res, np.ones((2, 2)))
+    with pytest.raises(TypeError, match=r"^gt: got a DepthResult; pass its array, result\.depth$"):
+        depth_metrics(np.ones((2, 2)), res)
+    assert depth_metrics(res.depth, np.ones((2, 2))).n == 4
+
+
 def test_dense_metrics_refuses_a_mask_of_another_shape() -> None:
     # a one-row mask was broadcast over every row, without a word
     gt = np.ones((2, 3))

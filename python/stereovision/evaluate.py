@@ -311,7 +311,14 @@ def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     ------
     ValueError
         On mismatched shapes or non-real input.
+    TypeError
+        If a whole ``DepthResult`` is given for a map (its ``depth`` is meant).
     """
+    from stereovision._validate import not_a_result
+
+    # a whole result was "depth maps must be real arrays, got object and float32"
+    not_a_result(depth, "depth", "depth")
+    not_a_result(gt, "gt", "depth")
     e = np.asarray(depth)
     g = np.asarray(gt)
     if e.dtype.kind not in "iuf" or g.dtype.kind not in "iuf":
