@@ -665,3 +665,12 @@ def test_bench_of_one_scene_on_a_terminal_says_it_is_timing(
     monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
     assert main(["bench", str(scene)]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_bench_table_names_a_scene_with_a_newline_escaped() -> None:
+    # a scene named with a newline cut its table row in two
+    from stereovision.bench import BenchCase, format_table
+
+    case = BenchCase("fam/o\nk", "SGBM-3WAY", "opencv", 60, 40, 16, 5, 2.0, 1.0, {})
+    lines = format_table([case]).splitlines()
+    assert len(lines) == 2 and lines[1].startswith("fam/o\\nk ")

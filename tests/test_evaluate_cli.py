@@ -504,3 +504,35 @@ def test_eval_interrupted_prints_the_summary_of_the_scenes_it_evaluated(
     ), lines
     assert len(lines) == 5
     assert cap.err.strip().splitlines()[-1] == "stereovision: interrupted"
+
+
+def test_eval_lines_name_a_scene_folder_with_a_newline_escaped(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene folder named with a newline cut eval's per-scene lines in two: 'skipped a',
+    then 'b: no ground truth (gt_disp.pfm)' (and the table row, the failed and time lines
+    alike). Each names it escaped now, as batch's lines do (a\\nb), on one line."""
+    import cv2
+
+    from stereovision.io import read_pfm, write_pfm
+
+    src = data_dir / "middlebury2001" / "tsukuba"
+    nogt, good, bad = tmp_path / "a\nb", tmp_path / "o\nk", tmp_path / "x\ny"
+    for scene in (nogt, good, bad):
+        scene.mkdir()
+        for name in ("left.png", "right.png"):
+            assert cv2.imwrite(str(scene / name), cv2.imread(str(src / name))[100:140])
+    write_pfm(good / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[100:140].copy())
+    write_pfm(bad / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[100:140].copy())
+    (bad / "left.png").write_bytes(b"not a png")
+    args = ["eval", "--method", "fast", "--no-opencv", "--runs", "1", str(tmp_path)]
+    assert main(args) == 1
+    cap = capsys.readouterr()
+    out, err = cap.out.splitlines(), cap.err.splitlines()
+    root = tmp_path.name
+    assert out[2].startswith(f"{root}/o\\nk ") and out[3].startswith("mean bad-2.0: ours ")
+    assert out[4].startswith(f"{root}/o\\nk: time, one run, no warm-up: ours ")
+    assert len(out) == 5, out
+    assert err[0] == f"skipped {tmp_path}/a\\nb: no ground truth (gt_disp.pfm)"
+    assert err[1].startswith(f"failed {tmp_path}/x\\ny: ") and "left.png" in err[1], err
+    assert err[2] == "stereovision: 1 of 3 scenes failed (above)" and len(err) == 3

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from stereovision._jsonout import json_line
-from stereovision._validate import BUG_ERRORS, NOT_NUMBERS
+from stereovision._validate import BUG_ERRORS, NOT_NUMBERS, escaped
 
 __all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table", "sparse_name"]
 
@@ -310,7 +310,7 @@ def format_table(cases: Sequence[BenchCase]) -> str:
     last = None
     for c in cases:
         head = (
-            f"{c.scene:34s} {c.width:4d}x{c.height:<4d} {c.max_disparity:4d}"
+            f"{escaped(c.scene):34s} {c.width:4d}x{c.height:<4d} {c.max_disparity:4d}"
             if c.scene != last
             else " " * 49
         )
@@ -343,12 +343,14 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
             raise ValueError(_no_scene_under(Path(d), d, half))
         # as eval: half a scene among scenes was left out without a word
         for folder, reason in half:
-            print(f"stereovision: skipped {folder}: {reason}", file=sys.stderr)
+            print(f"stereovision: skipped {escaped(str(folder))}: {reason}", file=sys.stderr)
         dirs.extend(found)
     # as eval: a scene named twice (its folder and one holding it) was timed twice
     dirs, dropped = distinct_scenes(dirs)
     for s in dropped:
-        print(f"stereovision: {s} given more than once: benched once", file=sys.stderr)
+        print(
+            f"stereovision: {escaped(str(s))} given more than once: benched once", file=sys.stderr
+        )
     return dirs
 
 
@@ -398,7 +400,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if len(dirs) == 1 and not args.json and sys.stderr.isatty():
         # the bar counts scenes, so one scene had none: 10-30 s of timing without a word
         print(
-            f"{dirs[0]}: timing every case, a warm-up and {args.runs} rounds "
+            f"{escaped(str(dirs[0]))}: timing every case, a warm-up and {args.runs} rounds "
             "(the table follows) ...",
             file=sys.stderr,
             flush=True,
@@ -428,7 +430,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
             # bench_scene left StereoBM out (too low for its block): say why
             no_bm = baselines.bm_reference_refusal(scene.max_disparity, scene.left.shape)
             if no_bm is not None:
-                tqdm.write(f"{d}: no StereoBM figures: {no_bm}", file=sys.stderr)
+                tqdm.write(f"{escaped(str(d))}: no StereoBM figures: {no_bm}", file=sys.stderr)
             if args.json:
                 for c in cases:
                     print(json_line(c.as_dict()), flush=True)

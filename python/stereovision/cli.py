@@ -32,6 +32,8 @@ from stereovision._jsonout import json_line
 from stereovision._validate import (
     BUG_ERRORS,
     advice_for,
+    escape_paths,
+    escaped,
     figure_shown,
     first_line,
     float32_reach,
@@ -1710,7 +1712,7 @@ def _eval_time_line(row: dict[str, Any]) -> str:
     """
     runs = row["runs"]
     how = "one run, no warm-up" if runs == 1 else f"median of {runs} runs after a warm-up"
-    line = f"{row['scene']}: time, {how}: ours {row['ours_ms']:.1f} ms"
+    line = f"{escaped(row['scene'])}: time, {how}: ours {row['ours_ms']:.1f} ms"
     if "bm_ms" in row:  # none on a scene StereoBM cannot run on
         line += f", StereoBM {row['bm_ms']:.1f} ms"
     if "sgbm_ms" in row:
@@ -1724,8 +1726,9 @@ def _eval_time_line(row: dict[str, Any]) -> str:
 def scene_failed_line(folder: Path, error: BaseException) -> str:
     """The line saying one damaged scene of many (``eval``, ``bench``) failed, its folder named
     once: a message that names it already (a scene too narrow for its range) is kept as is."""
-    said = str(error)
-    return f"failed {said if said.startswith(f'{folder}: ') else f'{folder}: {said}'}"
+    # a folder named with a newline cut the line in two (batch escapes its pairs' names)
+    said, shown = escape_paths(str(error), [folder]), escaped(str(folder))
+    return f"failed {said if said.startswith(f'{shown}: ') else f'{shown}: {said}'}"
 
 
 def _eval_summary(rows: list[dict[str, Any]], timed: bool) -> None:
@@ -1754,15 +1757,16 @@ def _eval_summary(rows: list[dict[str, Any]], timed: bool) -> None:
     )
     print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()) + bm_note)
     for r in rows:
+        name = escaped(r["scene"])  # a newline in it cut the line in two
         if timed:  # asked for: the medians, as --json has them
             print(_eval_time_line(r))
         if "depth" in r:
             dm = r["depth"]
             line = (
-                f"{r['scene']}: depth over our {dm['n']} pixels:"
+                f"{name}: depth over our {dm['n']} pixels:"
                 f" median |dZ|/Z {dm['median_rel']:.2f} %, off >5 % {dm['share_off_5']:.1f} %"
                 if dm["n"]
-                else f"{r['scene']}: depth: none of our pixels has a GT depth"
+                else f"{name}: depth: none of our pixels has a GT depth"
             )
             if "sgbm_depth" in r:
                 s = r["sgbm_depth"]
@@ -1776,7 +1780,7 @@ def _eval_summary(rows: list[dict[str, Any]], timed: bool) -> None:
                 print(r["_table1_text"])
         if "members_depth" in r:
             m = r["members_depth"]
-            line = f"{r['scene']}: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)" + (
+            line = f"{name}: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)" + (
                 f" with GT depth: {m['n']}, RMSE {m['rmse_pct']:.2f} % of the mean depth,"
                 f" median |dZ|/Z {m['median_rel']:.2f} %"
                 if m["n"]
@@ -1814,13 +1818,15 @@ def cmd_eval(args: argparse.Namespace) -> int:
             raise CliError(_no_scene_under(p, d, half))
         # half a scene among scenes was left out without a word (batch says it is unpaired)
         for folder, reason in half:
-            print(f"stereovision: skipped {folder}: {reason}", file=sys.stderr)
+            print(f"stereovision: skipped {escaped(str(folder))}: {reason}", file=sys.stderr)
         dirs.extend(found)
     # a scene named twice (its folder and a folder holding it) is evaluated once: twice, it
     # counted twice in the mean line
     dirs, dropped = distinct_scenes(dirs)
     for s in dropped:
-        print(f"stereovision: {s} given more than once: evaluated once", file=sys.stderr)
+        print(
+            f"stereovision: {escaped(str(s))} given more than once: evaluated once", file=sys.stderr
+        )
     rows = []
     header = (
         f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
@@ -1848,7 +1854,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 if why is not None:
                     if len(dirs) == 1:
                         raise CliError(f"{d}: {why} to evaluate against")
-                    tqdm.write(f"skipped {d}: {why}", file=sys.stderr)
+                    tqdm.write(f"skipped {escaped(str(d))}: {why}", file=sys.stderr)
                     skipped += 1
                     continue
                 narrow = scene_too_narrow(scene)
@@ -1869,7 +1875,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             rows.append(row)
             if "sgbm" in row and "bm" not in row:  # StereoBM cannot run on it: say why it is blank
                 no_bm = bm_reference_refusal(scene.max_disparity, scene.left.shape)
-                tqdm.write(f"{d}: no StereoBM figures: {no_bm}", file=sys.stderr)
+                tqdm.write(f"{escaped(str(d))}: no StereoBM figures: {no_bm}", file=sys.stderr)
             if args.json:
                 print(json_line({k: v for k, v in row.items() if not k.startswith("_")}))
                 continue
@@ -1879,7 +1885,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
             cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
             for key in ("bm", "sgbm", "sgbm+fill"):
                 cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
-            tqdm.write(f"{row['scene']:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+            name = escaped(row["scene"])  # one line, as the other lines name it
+            tqdm.write(f"{name:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (Terminated): the scenes evaluated are kept
         # the mean, time and depth lines come after the loop: the medians of the scenes timed
         # were lost (bench keeps its scenes' timing likewise)
