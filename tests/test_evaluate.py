@@ -633,6 +633,32 @@ def test_depth_metrics_names_a_whole_result_passed_for_a_depth_map() -> None:
     assert depth_metrics(res.depth, np.ones((2, 2))).n == 4
 
 
+def test_sparse_metrics_names_an_argument_that_is_no_array_of_numbers() -> None:
+    # NumPy's words named nothing: a Matches given for xl was "setting an array element with
+    # a sequence. The requested array would exceed the maximum number of dimension of 64"
+    from stereovision.matches import Matches
+
+    gt = np.ones((4, 6))
+    m = Matches(
+        xl=np.array([1.0]),
+        yl=np.array([1.0]),
+        xr=np.array([0.0]),
+        yr=np.array([1.0]),
+        score=np.array([0.9]),
+        image_shape=(4, 6),
+    )
+    with pytest.raises(
+        ValueError,
+        match=r"^xl: expected a 1-D array of numbers, got Matches: pass its arrays, m\.xl, m\.yl",
+    ):
+        sparse_metrics(m, m.yl, m.xr, gt)
+    with pytest.raises(ValueError, match=r"^xr: expected a 1-D array of numbers, got list$"):
+        sparse_metrics(m.xl, m.yl, ["a"], gt)
+    with pytest.raises(ValueError, match=r"^score: expected a 1-D array of numbers, got list$"):
+        count_at_precision(m.xl, m.yl, m.xr, ["high"], gt, 90.0)
+    assert sparse_metrics(m.xl, m.yl, m.xr, gt).count == 1
+
+
 def test_dense_metrics_refuses_a_mask_of_another_shape() -> None:
     # a one-row mask was broadcast over every row, without a word
     gt = np.ones((2, 3))

@@ -641,6 +641,22 @@ class SparseMetrics:
         return out
 
 
+def _coordinates(values: object, name: str) -> npt.NDArray[np.float64]:
+    """``values`` (match positions or scores) as float64, refused naming ``name``.
+
+    NumPy's words named nothing: a Matches given for xl was "setting an array element with a
+    sequence. The requested array would exceed the maximum number of dimension of 64", a
+    string "could not convert string to float: 'a'".
+    """
+    try:
+        return np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        hint = ": pass its arrays, m.xl, m.yl, m.xr" if type(values).__name__ == "Matches" else ""
+        raise ValueError(
+            f"{name}: expected a 1-D array of numbers, got {type(values).__name__}{hint}"
+        ) from None
+
+
 def sparse_metrics(
     xl: npt.ArrayLike, yl: npt.ArrayLike, xr: npt.ArrayLike, gt: npt.ArrayLike
 ) -> SparseMetrics:
@@ -664,10 +680,11 @@ def sparse_metrics(
     Raises
     ------
     ValueError
-        If ``xl``, ``yl``, ``xr`` are not 1-D of equal length or ``gt`` is not 2-D.
+        If ``xl``, ``yl``, ``xr`` are not 1-D arrays of numbers of equal length or ``gt`` is
+        not 2-D.
     """
     g = _real_2d(gt, "gt")
-    arrs = [np.asarray(a, dtype=np.float64) for a in (xl, yl, xr)]
+    arrs = [_coordinates(a, n) for a, n in ((xl, "xl"), (yl, "yl"), (xr, "xr"))]
     if any(a.ndim != 1 for a in arrs) or len({a.shape for a in arrs}) != 1:
         raise ValueError(
             f"xl, yl, xr: expected 1-D arrays of equal length, got shapes {[a.shape for a in arrs]}"
@@ -741,7 +758,9 @@ def count_at_precision(
             f"tolerance: expected a positive finite number of pixels, got {number_shown(tolerance)}"
         )
     g = _real_2d(gt, "gt")
-    x, y, x2, s = (np.asarray(a, dtype=np.float64) for a in (xl, yl, xr, score))
+    x, y, x2, s = (
+        _coordinates(a, n) for a, n in ((xl, "xl"), (yl, "yl"), (xr, "xr"), (score, "score"))
+    )
     if any(a.ndim != 1 for a in (x, y, x2, s)) or len({a.shape for a in (x, y, x2, s)}) != 1:
         raise ValueError(
             "xl, yl, xr, score: expected 1-D arrays of equal length, got shapes "
