@@ -91,7 +91,9 @@ def plot_bad2_panels(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    valid = np.isfinite(gt) & (gt > 0)
+    # evaluation.md's known GT (finite; a 0 px GT counts, as in dense_metrics): "& gt > 0" left
+    # a hole on a 0 px pixel out of the title's bad-2.0
+    valid = np.isfinite(gt)
     vmax = float(np.nanmax(gt[valid]))
     fig, axes = plt.subplots(2, 3, figsize=figsize)
     axes[0, 0].imshow(left if left.ndim == 2 else left[..., ::-1], cmap="gray")

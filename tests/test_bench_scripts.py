@@ -305,3 +305,36 @@ def test_the_benches_runs_option_is_stereovision_benchs(monkeypatch: pytest.Monk
         _common.timed_runs("1000000000")
     with pytest.raises(argparse.ArgumentTypeError, match=r"^expected at least 5 runs"):
         _common.timed_runs("4")
+
+
+def test_plot_bad2_panels_counts_a_gt_of_zero_as_known(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The README panels' bad-2.0 left out GT pixels of 0 px (known: evaluation.md's unknown
+    is inf or NaN, and dense_metrics counts them), so a hole there was no error in the
+    panel's title: 0.00 % where dense_metrics says 50.00 %."""
+    import matplotlib.figure
+    import matplotlib.pyplot as plt
+
+    from stereovision.evaluate import dense_metrics
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import _common
+
+    titles: list[str] = []
+    close = plt.close
+
+    def keep_titles(fig: Any) -> None:
+        titles.extend(ax.get_title() for ax in fig.axes)
+        close(fig)
+
+    monkeypatch.setattr(plt, "close", keep_titles)
+    # the picture itself is not looked at: its layout and PNG were most of the test's time
+    monkeypatch.setattr(matplotlib.figure.Figure, "tight_layout", lambda self: None)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda self, *a, **k: None)
+    gt = np.array([[0.0, 0.0, 3.0, 4.0]], np.float32)
+    d = np.array([[np.nan, 0.5, 3.0, 4.0]], np.float32)
+    maps = {name: d for name in ("a", "b", "c", "d")}
+    _common.plot_bad2_panels("t", np.zeros((1, 4), np.uint8), gt, maps, tmp_path / "p.png", (4, 3))
+    assert dense_metrics(d, gt).bad[2.0] == 25.0
+    assert titles[2] == "a: bad-2.0 25.00 %", titles
