@@ -1849,3 +1849,18 @@ def test_mutation_audit_grid_sides_past_a_float_and_at_4096_cells() -> None:
     assert grid.data.shape == (4096, 4096)
     with pytest.raises(ValueError, match=r"^resolution: a 4097 x 1 grid is over 4096 cells"):
         occupancy_grid(box, plane, resolution=0.1, forward=(0, 409.7), lateral=(-0.1, 0))
+
+
+def test_laser_scan_names_a_calib_that_is_no_calibration(tmp_path: Path) -> None:
+    from stereovision.ground import laser_scan
+
+    rows = np.mgrid[0 : SIZE[1], 0 : SIZE[0]][0]
+    plane = fit_ground_plane(np.where(rows > 180, 10.0, np.nan) * (rows - 179.5) / 40, RIG)
+    assert plane is not None
+    pts = np.zeros((10, 3))
+    # a path was AttributeError "'str' object has no attribute 'rectified'"
+    path = str(tmp_path / "calib.txt")
+    with pytest.raises(TypeError, match=r"^calib: got the path .*Calibration\.from_file"):
+        laser_scan(pts, plane, path)
+    with pytest.raises(TypeError, match=r"^calib: expected a stereovision\.Calibration, got dict$"):
+        laser_scan(pts, plane, {"K1": 1})

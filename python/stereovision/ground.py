@@ -1243,8 +1243,13 @@ def laser_scan(
         For points not of shape ``(..., 3)``, no angles (no ``calib`` and no ``angle_min`` /
         ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or over 100000
         beams, a bad height band or range (``range_max`` infinite too), or ``min_points < 1``.
+    TypeError
+        If ``plane`` is not a :class:`GroundPlane`, or ``calib`` is given and is not a
+        :class:`~stereovision.Calibration` (a path: read it with ``Calibration.from_file``).
     """
     _require_type(plane, "GroundPlane", "plane")
+    if calib is not None:  # a path or a dict was AttributeError "'str' object has no attribute"
+        _require_type(calib, "Calibration", "calib")
     from stereovision._validate import positive_finite
 
     pts = np.asarray(points, np.float64)
