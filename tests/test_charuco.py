@@ -24,6 +24,7 @@ from stereovision.charuco import (
     MIN_CORNERS,
     CharucoBoard,
     board_png,
+    corners_span_plane,
     dictionary_name,
     find_charuco_corners,
     render_charuco,
@@ -1362,3 +1363,20 @@ def test_render_charuco_names_a_background_that_is_no_grey_level(background: obj
     for grey in (0, 255, 60.0):
         img = render_charuco(board, K1, D1, *pose, background=grey, supersample=1)
         assert img[0, 0] == round(grey)
+
+
+@pytest.mark.parametrize("given", ["10x7", None, (10, 7)])
+def test_board_functions_name_a_board_that_is_no_charuco_board(given: object) -> None:
+    # a pattern string or None was AttributeError "'str' object has no attribute 'resolved'"
+    # (or 'image', 'object_points') from deep inside
+    want = rf"^board: expected a stereovision\.charuco\.CharucoBoard, got {type(given).__name__}$"
+    img = np.full((48, 64), 128, np.uint8)
+    K = np.array([[60.0, 0, 32], [0, 60, 24], [0, 0, 1]])
+    calls = [
+        lambda: find_charuco_corners(img, given),
+        lambda: corners_span_plane(given, np.arange(3)),
+        lambda: render_charuco(given, K, np.zeros(5), np.zeros(3), np.array([0, 0, 1.0])),
+    ]
+    for call in calls:
+        with pytest.raises(TypeError, match=want):
+            call()

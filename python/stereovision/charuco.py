@@ -108,6 +108,16 @@ def _dictionary(name: str) -> Any:
     return cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, name))
 
 
+def _require_board(board: object) -> None:
+    """A TypeError naming ``board`` when it is no :class:`CharucoBoard` (calibrate's words): a
+    pattern string or None failed deep inside, AttributeError "'str' object has no attribute
+    'resolved'"."""
+    if not isinstance(board, CharucoBoard):
+        raise TypeError(
+            f"board: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
+        )
+
+
 @dataclass(frozen=True)
 class CharucoBoard:
     """A ChArUco board's geometry and marker dictionary.
@@ -555,7 +565,15 @@ def corners_span_plane(board: CharucoBoard, ids: npt.NDArray[np.int64]) -> bool:
     bool
         True for at least three corners spanning the board's plane (a homography or pose can
         be fitted to them); False for fewer, or all on one row, column or diagonal.
+
+    Raises
+    ------
+    TypeError
+        If ``board`` is not a :class:`CharucoBoard`.
+    ValueError
+        If an id is not a whole corner id of the board (:meth:`CharucoBoard.object_points`).
     """
+    _require_board(board)
     pts = board.object_points(ids)[:, :2].astype(np.float64)
     if len(pts) < 3:
         return False
@@ -588,9 +606,15 @@ def find_charuco_corners(
         ``ids`` (``(N,)`` ``int64``, ascending) and ``corners`` (``(N, 2)`` ``float64`` pixel
         ``(x, y)``), or None when fewer than :data:`MIN_CORNERS` corners are found or they all
         lie on one line of the board.
+
+    Raises
+    ------
+    TypeError
+        If ``board`` is not a :class:`CharucoBoard`.
     """
     from stereovision._validate import as_gray_uint8
 
+    _require_board(board)
     gray = as_gray_uint8(image, "image")
     if not board.resolved:
         resolved = board.resolve(gray)
@@ -662,7 +686,10 @@ def render_charuco(
         A board whose dictionary is not known, ``pixels_per_square`` outside 10 to 2000, a
         ``background`` that is no grey level from 0 to 255, or a camera, pose, size,
         ``supersample`` or ``model`` :func:`~stereovision.synthetic.render_plane` refuses.
+    TypeError
+        If ``board`` is not a :class:`CharucoBoard`.
     """
+    _require_board(board)
     p = int_in_range(pixels_per_square, "pixels_per_square", 10, 2000)
     # a grey level of the uint8 image: 300 and -5 were clipped to 255 and 0, True was 1 and
     # "60" 60, each without a word
