@@ -763,3 +763,36 @@ def test_a_middlebury_calib_txt_gives_depth_and_points_by_its_own_numbers(
     ok = np.isfinite(want)
     ref = cv2.reprojectImageTo3D(np.nan_to_num(d, nan=-1e3, posinf=-1e3).astype(np.float32), c.Q)
     np.testing.assert_allclose(pts[ok], ref[ok] / 1000.0, rtol=1e-5)
+
+
+def test_an_infinite_pixel_is_nan_and_triangulates_without_a_warning() -> None:
+    # without distortion the point came back inf (flagged False, where the docstring says NaN)
+    # and triangulate warned "invalid value encountered in matmul" on it
+    K = np.array([[600.0, 0.0, 321.5], [0.0, 603.0, 238.2], [0.0, 0.0, 1.0]])
+    c = Calibration(K, np.zeros(5), K, np.zeros(5), np.eye(3), np.array([-0.1, 0, 0]), SIZE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pts = np.array([[np.inf, 5.0], [321.5, -np.inf]])
+        xy, ok = undistort_normalized(pts, K, np.zeros(5))
+        assert ok.tolist() == [False, False] and np.isnan(xy).all()
+        res = triangulate([[np.inf, 240.0], [331.5, 238.2]], [[300.0, 240.0], [321.5, 238.2]], c)
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all() and res.XL[1].tolist() == pytest.approx([0.1, 0, 6.0])
+
+
+@pytest.mark.parametrize(
+    ("K", "D", "says"),
+    [
+        (np.eye(2), np.zeros(5), "K: expected a 3 x 3 camera matrix"),
+        (np.zeros((3, 3)), np.zeros(5), "positive focal lengths, got shape (3, 3)"),
+        (np.diag([600.0, np.nan, 1.0]), np.zeros(5), "K: expected a 3 x 3 camera matrix"),
+        (np.diag([600.0, 600.0, 1.0]), [np.nan, 0, 0, 0], "D: expected finite coefficients"),
+    ],
+)
+def test_undistortion_names_a_camera_that_is_none(K: np.ndarray, D: object, says: str) -> None:
+    # a (2, 2) K was IndexError, a zero focal length inf points with a RuntimeWarning, a NaN
+    # in K or D NaN points: nothing named the argument
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=re.escape(says)):
+            undistort_normalized([[300.0, 200.0]], K, D)

@@ -130,14 +130,24 @@ def undistort_normalized(
     Raises
     ------
     ValueError
-        On a bad shape or non-zero tilt coefficients.
+        On a bad shape, a ``K`` that is no 3 x 3 camera matrix (non-finite, or a focal length
+        not positive), non-finite or non-zero tilt coefficients.
     """
     p = _points(pts, "pts")
     Km = np.asarray(K, dtype=np.float64)
+    # a (2, 2) K was NumPy's IndexError, a zero focal length a RuntimeWarning and every point
+    # inf, a NaN coefficient every point NaN: each without naming what was wrong
+    if Km.shape != (3, 3) or not np.isfinite(Km).all() or not (Km[0, 0] > 0 and Km[1, 1] > 0):
+        raise ValueError(
+            f"K: expected a 3 x 3 camera matrix of finite numbers with positive focal lengths, "
+            f"got shape {Km.shape}" + (f": {Km.tolist()}" if Km.size <= 9 else "")
+        )
     d = np.zeros(14)
     dist = np.asarray(D, dtype=np.float64).ravel()
     if dist.size not in (0, 4, 5, 8, 12, 14):
         raise ValueError(f"D: expected 4, 5, 8, 12 or 14 coefficients, got {dist.size}")
+    if not np.isfinite(dist).all():
+        raise ValueError(f"D: expected finite coefficients, got {dist.tolist()}")
     d[: dist.size] = dist
     if d[12] != 0 or d[13] != 0:
         raise ValueError(
@@ -145,11 +155,17 @@ def undistort_normalized(
         )
     k1, k2, p1, p2, k3, k4, k5, k6, s1, s2, s3, s4 = d[:12]
     fx, fy, cx, cy, skew = Km[0, 0], Km[1, 1], Km[0, 2], Km[1, 2], Km[0, 1]
-    yd = (p[:, 1] - cy) / fy
-    xd = (p[:, 0] - cx - skew * yd) / fx
+    with np.errstate(invalid="ignore"):  # an infinite y times a zero skew: no point, NaN
+        yd = (p[:, 1] - cy) / fy
+        xd = (p[:, 0] - cx - skew * yd) / fx
     x, y = xd.copy(), yd.copy()
     if not np.any(d):
-        return np.stack([x, y], axis=1), np.isfinite(x) & np.isfinite(y)
+        ok = np.isfinite(x) & np.isfinite(y)
+        # NaN where not converged, as below: an infinite pixel came back as inf (flagged
+        # False), and triangulate's products with it warned "invalid value encountered"
+        x[~ok] = np.nan
+        y[~ok] = np.nan
+        return np.stack([x, y], axis=1), ok
     converged = np.zeros(len(x), dtype=bool)
     active = np.isfinite(x) & np.isfinite(y)
     with np.errstate(all="ignore"):
