@@ -1864,3 +1864,24 @@ def test_laser_scan_names_a_calib_that_is_no_calibration(tmp_path: Path) -> None
         laser_scan(pts, plane, path)
     with pytest.raises(TypeError, match=r"^calib: expected a stereovision\.Calibration, got dict$"):
         laser_scan(pts, plane, {"K1": 1})
+
+
+def test_support_refuses_a_result_and_complex_values_as_the_fit_does() -> None:
+    rows = np.mgrid[0 : SIZE[1], 0 : SIZE[0]][0]
+    floor = np.where(rows > 180, 10.0, np.nan) * (rows - 179.5) / 40
+    plane = fit_ground_plane(floor, RIG)
+    assert plane is not None
+
+    class DepthResult:  # the check goes by the name, as for fit_ground_plane
+        disparity = floor
+
+    # "float() argument must be a string or a real number, not 'DepthResult'"
+    want = "disparity: got a DepthResult; pass its array, result.disparity"
+    for call in (lambda d: fit_ground_plane(d, RIG), lambda d: plane.support(d, RIG)):
+        with pytest.raises(TypeError, match=re.escape(want)):
+            call(DepthResult())
+    # complex values lost their imaginary part with NumPy's ComplexWarning: a share of 1.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"^disparity: expected a real map, got complex"):
+            plane.support(floor.astype(complex), RIG)

@@ -229,8 +229,11 @@ class GroundPlane:
         Raises
         ------
         ValueError
-            If ``disparity`` is not 2-D, or its size is not the calibration's and the plane's, or
-            ``inlier_px`` is not a positive number.
+            If ``disparity`` is not a real 2-D map, or its size is not the calibration's and the
+            plane's, or ``inlier_px`` is not a positive number.
+        TypeError
+            If ``disparity`` is a whole ``DepthResult`` (pass ``result.disparity``) or ``calib``
+            is not a :class:`~stereovision.Calibration`.
         """
         _require_type(calib, "Calibration", "calib")
         from stereovision._validate import positive_finite
@@ -241,9 +244,9 @@ class GroundPlane:
             if inlier_px is None
             else positive_finite(inlier_px, "inlier_px")
         )
-        disp = np.asarray(disparity, np.float64)
-        if disp.ndim != 2:
-            raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
+        # a DepthResult was "float() argument must be ... not 'DepthResult'", complex values
+        # lost their imaginary part with NumPy's ComplexWarning: fit_ground_plane's checks
+        disp = _disparity_map(disparity)
         w0, h0 = calib.image_size
         if disp.shape != (h0, w0) or disp.shape != self.inliers.shape:
             # another size: the plane's (u, v) coefficients mean other pixels there
@@ -609,16 +612,9 @@ def _fit_ground(
     """:func:`fit_ground_plane`'s plane, and when there is none the line saying why
     (:func:`_no_floor_line`); "" with a plane."""
     _require_type(calib, "Calibration", "calib")
-    from stereovision._validate import check_index_range, not_a_result, positive_finite
+    from stereovision._validate import positive_finite
 
-    not_a_result(disparity, "disparity", "disparity")
-    if np.iscomplexobj(disparity):  # NumPy would drop the imaginary part with a warning
-        raise ValueError("disparity: expected a real map, got complex values")
-    if isinstance(disparity, np.ndarray) and disparity.ndim == 2:  # before the float64 copy
-        check_index_range(disparity.shape, "disparity", "map")
-    disp = np.asarray(disparity, np.float64)
-    if disp.ndim != 2:
-        raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
+    disp = _disparity_map(disparity)
     w0, h0 = calib.image_size
     if disp.shape != (h0, w0):
         raise ValueError(
@@ -741,6 +737,23 @@ def _fit_ground(
         below_share=below,
     )
     return plane, ""
+
+
+def _disparity_map(disparity: npt.ArrayLike) -> F64:
+    """``disparity`` as a float64 ``(H, W)`` map, after the checks of what is none: a whole
+    ``DepthResult`` (TypeError naming ``result.disparity``), complex values, a map past the
+    kernels' 32-bit indices (before the copy), another number of dimensions."""
+    from stereovision._validate import check_index_range, not_a_result
+
+    not_a_result(disparity, "disparity", "disparity")
+    if np.iscomplexobj(disparity):  # NumPy would drop the imaginary part with a warning
+        raise ValueError("disparity: expected a real map, got complex values")
+    if isinstance(disparity, np.ndarray) and disparity.ndim == 2:  # before the float64 copy
+        check_index_range(disparity.shape, "disparity", "map")
+    disp = np.asarray(disparity, np.float64)
+    if disp.ndim != 2:
+        raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
+    return disp
 
 
 def _no_floor_line(disparity: npt.ArrayLike, calib: Calibration) -> str:
