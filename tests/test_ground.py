@@ -1885,3 +1885,26 @@ def test_support_refuses_a_result_and_complex_values_as_the_fit_does() -> None:
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=r"^disparity: expected a real map, got complex"):
             plane.support(floor.astype(complex), RIG)
+
+
+def test_point_functions_name_a_whole_result() -> None:
+    from stereovision.ground import laser_scan, obstacle_mask, occupancy_grid
+
+    rows = np.mgrid[0 : SIZE[1], 0 : SIZE[0]][0]
+    plane = fit_ground_plane(np.where(rows > 180, 10.0, np.nan) * (rows - 179.5) / 40, RIG)
+    assert plane is not None
+
+    class DepthResult:  # the check goes by the name
+        disparity = np.zeros((2, 2))
+
+    # each was "float() argument must be a string or a real number, not 'DepthResult'" but
+    # obstacle_mask, which said what to pass
+    image = "points: got a DepthResult; pass its array, result.point_image()"
+    for call, says in [
+        (lambda r: obstacle_mask(r, plane), image),
+        (lambda r: occupancy_grid(r, plane), image),
+        (lambda r: laser_scan(r, plane, RIG), image),
+        (lambda r: plane.height_of(r), "points: got a DepthResult; pass its array, result.points"),
+    ]:
+        with pytest.raises(TypeError, match=re.escape(says)):
+            call(DepthResult())

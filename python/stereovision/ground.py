@@ -193,6 +193,9 @@ class GroundPlane:
         ndarray, float64
             ``(...)`` heights, metres.
         """
+        from stereovision._validate import not_a_result
+
+        not_a_result(points, "points", "points")  # "float() argument must be ..."
         pts = np.asarray(points, np.float64)
         if pts.ndim == 0 or pts.shape[-1] != 3:
             raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
@@ -1046,8 +1049,10 @@ def occupancy_grid(
         numbers or empty, a grid over 4096 cells a side, or a bad height band.
     """
     _require_type(plane, "GroundPlane", "plane")
-    from stereovision._validate import positive_finite
+    from stereovision._validate import not_a_result, positive_finite
 
+    # a whole DepthResult was "float() argument must be ... not 'DepthResult'"
+    not_a_result(points, "points", "point_image()")
     pts = np.asarray(points, np.float64)
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
@@ -1263,8 +1268,10 @@ def laser_scan(
     _require_type(plane, "GroundPlane", "plane")
     if calib is not None:  # a path or a dict was AttributeError "'str' object has no attribute"
         _require_type(calib, "Calibration", "calib")
-    from stereovision._validate import positive_finite
+    from stereovision._validate import not_a_result, positive_finite
 
+    # a whole DepthResult was "float() argument must be ... not 'DepthResult'"
+    not_a_result(points, "points", "point_image()")
     pts = np.asarray(points, np.float64)
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
