@@ -1908,3 +1908,26 @@ def test_point_functions_name_a_whole_result() -> None:
     ]:
         with pytest.raises(TypeError, match=re.escape(says)):
             call(DepthResult())
+
+
+def test_a_scan_from_0_to_2_pi_sees_the_right_side() -> None:
+    """A scan given as 0 to 2 pi (REP 103 allows any start) lost every point to the right of
+    the optical axis (arctan2's negative angles fell before beam 0): the obstacle 0.5 rad to
+    the right was unseen (NaN); it is now in the beam at 2 pi - 0.5, as at -0.5 in a scan from
+    -pi to pi."""
+    from stereovision.ground import laser_scan
+
+    plane, _ = _level_floor()
+    right = [(r * math.cos(-0.5), r * math.sin(-0.5), 0.5) for r in (2.0, 2.5, 3.0)]
+    left = [(r * math.cos(0.25), r * math.sin(0.25), 0.5) for r in (1.0, 1.5, 4.0)]
+    pts = _camera_points(right + left)
+    inc = 0.25
+    full = laser_scan(pts, plane, angle_min=0.0, angle_max=2 * math.pi - inc, angle_increment=inc)
+    half = laser_scan(pts, plane, angle_min=-math.pi, angle_max=math.pi, angle_increment=inc)
+    n = len(full.ranges)
+    assert full.ranges[1] == pytest.approx(4.0) and half.ranges[round(math.pi / inc) + 1] == (
+        pytest.approx(4.0)
+    )
+    assert full.ranges[n - 2] == pytest.approx(3.0), full.ranges  # 2 pi - 0.5
+    assert half.ranges[round((math.pi - 0.5) / inc)] == pytest.approx(3.0)
+    assert np.count_nonzero(np.isfinite(full.ranges)) == 2
