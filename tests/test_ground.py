@@ -1931,3 +1931,22 @@ def test_a_scan_from_0_to_2_pi_sees_the_right_side() -> None:
     assert full.ranges[n - 2] == pytest.approx(3.0), full.ranges  # 2 pi - 0.5
     assert half.ranges[round((math.pi - 0.5) / inc)] == pytest.approx(3.0)
     assert np.count_nonzero(np.isfinite(full.ranges)) == 2
+
+
+@pytest.mark.parametrize("name", ["run #3", "lab: 2", "*x", "[a]", 'say "hi"', "é\tb", "map"])
+def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: str) -> None:
+    """map.yaml's 'image: run #3.png' read as 'run' (YAML took the rest for a comment), and
+    'lab: 2.png', '*x.png', '[a].png' were no YAML at all: map_server could not load the map.
+    A name that is not plain is written quoted; 'map' stays 'image: map.png'."""
+    import yaml
+
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    png, yml = grid.save(tmp_path, name=name)
+    text = yml.read_text(encoding="utf-8")
+    fields = yaml.safe_load(text)
+    assert fields["image"] == png.name == f"{name}.png" and png.is_file()
+    assert fields["resolution"] == 0.05 and fields["origin"] == [0.0, -0.05, 0.0]
+    if name == "map":
+        assert text.startswith("image: map.png\n")

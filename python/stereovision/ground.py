@@ -952,6 +952,9 @@ class OccupancyGrid:
             If a file could not be written; the previous pair is then intact (should putting a
             previous file back fail too, its copy is kept and named in the exception's notes).
         """
+        import json
+        import re
+
         import cv2
 
         # a stem with a folder in it ("../x") wrote outside ``directory``
@@ -965,8 +968,13 @@ class OccupancyGrid:
             raise RuntimeError("could not encode the occupancy grid as PNG")
         # float(): a NumPy scalar's repr is "np.float64(0.05)", which map_server cannot read
         res, x0, y0 = (float(v) for v in (self.resolution, *self.origin))
+        # quoted unless plain: 'image: run #3.png' read as 'run' (the rest a comment), and
+        # 'lab: 2.png', '*x.png' or '[a].png' were no YAML at all; JSON's string is YAML's
+        image = png.name
+        if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9._-]*", image):
+            image = json.dumps(image, ensure_ascii=False)
         text = (
-            f"image: {png.name}\nmode: trinary\nresolution: {res!r}\n"
+            f"image: {image}\nmode: trinary\nresolution: {res!r}\n"
             f"origin: [{x0!r}, {y0!r}, 0.0]\nnegate: 0\n"
             "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
         )
