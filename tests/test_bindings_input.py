@@ -1236,3 +1236,20 @@ def test_mcgm_prior_slots_are_their_own(name: str, crop: tuple[np.ndarray, np.nd
     gl, gr = (as_gray_float(a) for a in crop)
     with pytest.raises(ValueError, match=f"^invalid parameter `{name}`"):
         _core.mcgm_match(gl, gr, {"max_disparity": 32, name: -1.0})
+
+
+@pytest.mark.parametrize(
+    ("d_min", "d_max", "said"),
+    [
+        (float("nan"), 10.0, "invalid parameter `d_min`: must be finite, got NaN"),
+        (0.0, float("inf"), "invalid parameter `d_max`: must be finite, got inf"),
+        (5.0, 5.0, "invalid parameter `d_max`: must be > d_min (5), got 5"),
+    ],
+)
+def test_refine_disparity_names_the_bound_it_refuses(d_min: float, d_max: float, said: str) -> None:
+    """``refine_disparity`` said "invalid parameter `range`: need finite d_min < d_max, got NaN,
+    10": no argument of that name; each bound is named now, in ``gabor_disparity``'s words."""
+    a = np.random.default_rng(0).random((8, 12), dtype=np.float32)
+    with pytest.raises(ValueError) as err:
+        _core.refine_disparity(a, a, a, a, d_min, d_max, *REFINE_ARGS[2:])
+    assert str(err.value) == said

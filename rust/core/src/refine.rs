@@ -986,10 +986,17 @@ fn refine_disparity_hot(
     // The warp holds columns in i32.
     crate::image::check_index_range(w, h)?;
     check_map_pair(disp, conf, w, h)?;
-    if !(d_min.is_finite() && d_max.is_finite() && d_max > d_min) {
+    // Each bound by its own name, in GaborParams::validate's words ("`range`: need finite
+    // d_min < d_max, got NaN, 10" named no argument the caller passed).
+    for (name, v) in [("d_min", d_min), ("d_max", d_max)] {
+        if !v.is_finite() {
+            return Err(CoreError::param(name, format!("must be finite, got {v}")));
+        }
+    }
+    if d_max <= d_min {
         return Err(CoreError::param(
-            "range",
-            format!("need finite d_min < d_max, got {d_min}, {d_max}"),
+            "d_max",
+            format!("must be > d_min ({d_min}), got {d_max}"),
         ));
     }
     let taps = gaussian_taps(p.win_sigma, p.win_radius);
