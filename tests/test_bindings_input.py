@@ -1253,3 +1253,51 @@ def test_refine_disparity_names_the_bound_it_refuses(d_min: float, d_max: float,
     with pytest.raises(ValueError) as err:
         _core.refine_disparity(a, a, a, a, d_min, d_max, *REFINE_ARGS[2:])
     assert str(err.value) == said
+
+
+@pytest.mark.parametrize(
+    ("call", "said"),
+    [
+        (
+            lambda a: _core.gabor_lr_check(a, a, 1e39),
+            "invalid parameter `tol`: expected a number within float32's range, the kernel's "
+            "precision, got 1e+39",
+        ),
+        (
+            lambda a: _core.depth_rectified(a, a, 1e-50, 0.0, 1.0, 0.0, 0.1, 1.0),
+            "invalid parameter `fb`: 1e-50 is 0 in float32, the kernel's precision (give 0, or "
+            "a magnitude of at least 1e-45)",
+        ),
+        (
+            lambda a: _core.gabor_responses(a, freq=10**400),
+            "invalid parameter `freq`: expected a number within float32's range, the kernel's "
+            f"precision, got {10**400}",
+        ),
+        (
+            lambda a: _core.hopfield_match(a, a, {"compat_theta": -1e39}),
+            "invalid parameter `compat_theta`: expected a number within float32's range, the "
+            "kernel's precision, got -1e+39",
+        ),
+    ],
+)
+def test_a_float_argument_float32_cannot_hold_is_named(
+    call: Callable[[np.ndarray], object], said: str
+) -> None:
+    """The bindings cut a float argument to float32 before any check: ``tol=1e39`` became inf
+    and passed every pixel without a word, ``fb=1e-50`` was "must be > 0, got 0", 10**400 a
+    bare OverflowError naming nothing. Such a value is refused naming the argument and the
+    value given; NaN and inf still reach the kernels' own checks."""
+    a = np.random.default_rng(0).random((8, 12), dtype=np.float32)
+    with pytest.raises(ValueError) as err:
+        call(a)
+    assert str(err.value) == said
+
+
+def test_a_float_argument_that_is_no_number_names_it() -> None:
+    """A str for a float argument was NumPy's bare "must be real number, not str"."""
+    a = np.zeros((8, 12), np.float32)
+    with pytest.raises(TypeError) as err:
+        _core.gabor_responses(a, freq="0.25")  # type: ignore[arg-type]
+    assert str(err.value) == "invalid parameter `freq`: must be real number, not str"
+    ok = _core.gabor_lr_check(a, a, np.float64(2))  # NumPy scalars and ints still taken
+    assert ok.shape == (8, 12) and _core.gabor_lr_check(a, a, 2).shape == (8, 12)

@@ -33,7 +33,7 @@ pub fn side_fill<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
     lab: &Bound<'py, PyAny>,
-    tau: f32,
+    #[pyo3(from_py_with = tau_f32)] tau: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let lab: PyReadonlyArray3<'py, f32> = crate::convert::array_arg(lab, "lab")?;
@@ -64,8 +64,8 @@ pub fn fattened<'py>(
     disp: &Bound<'py, PyAny>,
     guide: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = radius_arg)] radius: usize,
-    ratio: f32,
-    jump: f32,
+    #[pyo3(from_py_with = ratio_f32)] ratio: f32,
+    #[pyo3(from_py_with = jump_f32)] jump: f32,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let guide: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(guide, "guide")?;
@@ -99,4 +99,10 @@ pub fn fattened<'py>(
 
 crate::named_ints! {
     radius_arg: usize = "radius";
+}
+
+crate::named_floats! {
+    tau_f32: f32 = "tau";
+    ratio_f32: f32 = "ratio";
+    jump_f32: f32 = "jump";
 }

@@ -94,22 +94,22 @@ pub fn gabor_disparity<'py>(
     py: Python<'py>,
     left: &Bound<'py, PyAny>,
     right: &Bound<'py, PyAny>,
-    d_min: f32,
-    d_max: f32,
-    freq: f32,
+    #[pyo3(from_py_with = d_min_f32)] d_min: f32,
+    #[pyo3(from_py_with = d_max_f32)] d_max: f32,
+    #[pyo3(from_py_with = freq_f32)] freq: f32,
     orientations_deg: Option<Vec<f32>>,
-    bandwidth_oct: f32,
-    aspect: f32,
+    #[pyo3(from_py_with = bandwidth_oct_f32)] bandwidth_oct: f32,
+    #[pyo3(from_py_with = aspect_f32)] aspect: f32,
     #[pyo3(from_py_with = n_levels_arg)] n_levels: Option<usize>,
     #[pyo3(from_py_with = iters_per_level_arg)] iters_per_level: usize,
-    amp_rel_thresh: f32,
-    stability_tau: f32,
-    smooth_sigma: Option<f32>,
-    conf_min: f32,
+    #[pyo3(from_py_with = amp_rel_thresh_f32)] amp_rel_thresh: f32,
+    #[pyo3(from_py_with = stability_tau_f32)] stability_tau: f32,
+    #[pyo3(from_py_with = smooth_sigma_opt_f32)] smooth_sigma: Option<f32>,
+    #[pyo3(from_py_with = conf_min_f32)] conf_min: f32,
     #[pyo3(from_py_with = research_radius_arg)] research_radius: usize,
     #[pyo3(from_py_with = search_pool_radius_arg)] search_pool_radius: usize,
     lr_check: bool,
-    lr_tol: f32,
+    #[pyo3(from_py_with = lr_tol_f32)] lr_tol: f32,
     #[pyo3(from_py_with = lr_coarse_levels_arg)] lr_coarse_levels: usize,
     #[pyo3(from_py_with = iters_finest_arg)] iters_finest: usize,
     research_finest: bool,
@@ -117,7 +117,7 @@ pub fn gabor_disparity<'py>(
     #[pyo3(from_py_with = fine_levels_arg)] fine_levels: usize,
     lr_light: bool,
     #[pyo3(from_py_with = speckle_size_arg)] speckle_size: usize,
-    speckle_range: f32,
+    #[pyo3(from_py_with = speckle_range_f32)] speckle_range: f32,
 ) -> PyResult<Pair<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
@@ -168,10 +168,10 @@ pub fn gabor_disparity<'py>(
 pub fn gabor_responses<'py>(
     py: Python<'py>,
     img: &Bound<'py, PyAny>,
-    freq: f32,
-    theta_deg: f32,
-    bandwidth_oct: f32,
-    aspect: f32,
+    #[pyo3(from_py_with = freq_f32)] freq: f32,
+    #[pyo3(from_py_with = theta_deg_f32)] theta_deg: f32,
+    #[pyo3(from_py_with = bandwidth_oct_f32)] bandwidth_oct: f32,
+    #[pyo3(from_py_with = aspect_f32)] aspect: f32,
 ) -> PyResult<Pair<'py>> {
     let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
     // The core checks the angle as one of `orientations_deg`, the name its error gave here.
@@ -207,12 +207,12 @@ pub fn gabor_newton_step<'py>(
     left: &Bound<'py, PyAny>,
     right: &Bound<'py, PyAny>,
     disp: &Bound<'py, PyAny>,
-    freq: f32,
+    #[pyo3(from_py_with = freq_f32)] freq: f32,
     orientations_deg: Option<Vec<f32>>,
-    bandwidth_oct: f32,
-    aspect: f32,
-    amp_rel_thresh: f32,
-    stability_tau: f32,
+    #[pyo3(from_py_with = bandwidth_oct_f32)] bandwidth_oct: f32,
+    #[pyo3(from_py_with = aspect_f32)] aspect: f32,
+    #[pyo3(from_py_with = amp_rel_thresh_f32)] amp_rel_thresh: f32,
+    #[pyo3(from_py_with = stability_tau_f32)] stability_tau: f32,
 ) -> PyResult<Pair<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
@@ -256,7 +256,7 @@ pub fn gabor_lr_check<'py>(
     py: Python<'py>,
     disp_left: &Bound<'py, PyAny>,
     disp_right: &Bound<'py, PyAny>,
-    tol: f32,
+    #[pyo3(from_py_with = tol_f32)] tol: f32,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
     let disp_left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp_left, "disp_left")?;
     let disp_right: PyReadonlyArray2<'py, f32> =
@@ -298,7 +298,7 @@ pub fn gabor_remove_speckles<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = gabor_remove_speckles_min_size)] min_size: usize,
-    max_diff: f32,
+    #[pyo3(from_py_with = max_diff_f32)] max_diff: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     crate::params::non_negative("max_diff", max_diff)?;
@@ -326,4 +326,21 @@ crate::named_ints! {
     fine_levels_arg: usize = "fine_levels";
     speckle_size_arg: usize = "speckle_size";
     gabor_remove_speckles_min_size: usize = "min_size";
+}
+
+crate::named_floats! {
+    d_min_f32: f32 = "d_min";
+    d_max_f32: f32 = "d_max";
+    freq_f32: f32 = "freq";
+    bandwidth_oct_f32: f32 = "bandwidth_oct";
+    aspect_f32: f32 = "aspect";
+    amp_rel_thresh_f32: f32 = "amp_rel_thresh";
+    stability_tau_f32: f32 = "stability_tau";
+    smooth_sigma_opt_f32: Option<f32> = "smooth_sigma";
+    conf_min_f32: f32 = "conf_min";
+    lr_tol_f32: f32 = "lr_tol";
+    speckle_range_f32: f32 = "speckle_range";
+    theta_deg_f32: f32 = "theta_deg";
+    tol_f32: f32 = "tol";
+    max_diff_f32: f32 = "max_diff";
 }

@@ -126,10 +126,10 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
 pub fn hopfield_interest<'py>(
     py: Python<'py>,
     img: &Bound<'py, PyAny>,
-    rel_threshold: f32,
+    #[pyo3(from_py_with = rel_threshold_f32)] rel_threshold: f32,
     #[pyo3(from_py_with = nms_half_arg)] nms_half: usize,
     #[pyo3(from_py_with = tile_arg)] tile: usize,
-    floor_rel: f32,
+    #[pyo3(from_py_with = floor_rel_f32)] floor_rel: f32,
 ) -> PyResult<(
     Bound<'py, PyArray2<f32>>,
     Bound<'py, PyArray2<i32>>,
@@ -377,4 +377,9 @@ pub fn hopfield_candidates<'py>(
 crate::named_ints! {
     nms_half_arg: usize = "nms_half";
     tile_arg: usize = "tile";
+}
+
+crate::named_floats! {
+    rel_threshold_f32: f32 = "rel_threshold";
+    floor_rel_f32: f32 = "floor_rel";
 }

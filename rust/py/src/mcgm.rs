@@ -136,7 +136,7 @@ fn matches_array<'py>(py: Python<'py>, ms: &[Match]) -> PyResult<Bound<'py, PyAr
 pub fn mcgm_log<'py>(
     py: Python<'py>,
     img: &Bound<'py, PyAny>,
-    sigma: f32,
+    #[pyo3(from_py_with = sigma_f32)] sigma: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
     // Both checks come before the copy below: a huge shape-only (broadcast) image was copied
@@ -466,4 +466,8 @@ fn check_match_rows(view: &ArrayView2<'_, f32>, w: usize, h: usize) -> PyResult<
         )));
     }
     Ok(())
+}
+
+crate::named_floats! {
+    sigma_f32: f32 = "sigma";
 }

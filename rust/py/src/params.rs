@@ -47,6 +47,8 @@ pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py> + Slot>(
                 _ => PyValueError::new_err(format!("parameter `{key}`: {e}")),
             }
         })?;
+        // A float slot's value float32 cannot hold, said as for the functions' arguments.
+        T::check_exact(&v, key)?;
     }
     Ok(())
 }
@@ -58,6 +60,11 @@ pub trait Slot {
     /// The range an integer slot's error names; `None` for other types.
     fn int_range() -> Option<String> {
         None
+    }
+
+    /// A value the slot holds only approximately beyond its rounding, refused ([`FloatArg`]).
+    fn check_exact(_v: &Bound<'_, PyAny>, _key: &str) -> PyResult<()> {
+        Ok(())
     }
 }
 
@@ -72,7 +79,11 @@ macro_rules! int_slot {
 }
 int_slot!(u8, u16, u32, u64, i32, i64, usize);
 
-impl Slot for f32 {}
+impl Slot for f32 {
+    fn check_exact(v: &Bound<'_, PyAny>, key: &str) -> PyResult<()> {
+        f32::extract_named(v, key).map(|_| ())
+    }
+}
 impl Slot for f64 {}
 impl Slot for bool {}
 impl Slot for String {}
@@ -144,6 +155,76 @@ macro_rules! named_ints {
     ($($f:ident: $t:ty = $name:literal;)*) => {$(
         fn $f(ob: &pyo3::Bound<'_, pyo3::PyAny>) -> pyo3::PyResult<$t> {
             $crate::params::int_arg(ob, $name)
+        }
+    )*};
+}
+
+/// The float arguments of the functions, held as the kernels' `f32`: pyo3's own conversion
+/// cut a Python float to `f32` before any check, so 1e39 reached the kernel as inf ("`fb`:
+/// must be finite, got inf", `tol=1e39` passed as no tolerance at all) and 1e-50 as 0 ("must
+/// be > 0, got 0"), and it named no argument for a value that is no number ("must be real
+/// number, not str") or an int past a double ("int too large to convert to float"). A value
+/// float32 cannot hold is a `ValueError` naming the argument and the value given now (NaN and
+/// inf pass, for the kernels' own checks), one that is no number a `TypeError` naming it.
+pub trait FloatArg: Sized {
+    /// The argument `name` from `ob`.
+    fn extract_named(ob: &Bound<'_, PyAny>, name: &str) -> PyResult<Self>;
+}
+
+impl FloatArg for f32 {
+    fn extract_named(ob: &Bound<'_, PyAny>, name: &str) -> PyResult<Self> {
+        let py = ob.py();
+        let got = || {
+            ob.repr()
+                .map_or_else(|_| "?".to_string(), |r| r.to_string())
+        };
+        let v: f64 = ob.extract::<f64>().map_err(|e| {
+            if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(py) {
+                PyValueError::new_err(format!(
+                    "invalid parameter `{name}`: expected a number within float32's range, the \
+                     kernel's precision, got {}",
+                    got()
+                ))
+            } else {
+                PyTypeError::new_err(format!("invalid parameter `{name}`: {}", e.value(py)))
+            }
+        })?;
+        let f = v as f32;
+        if v.is_finite() && !f.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "invalid parameter `{name}`: expected a number within float32's range, the \
+                 kernel's precision, got {}",
+                got()
+            )));
+        }
+        if v != 0.0 && f == 0.0 {
+            return Err(PyValueError::new_err(format!(
+                "invalid parameter `{name}`: {} is 0 in float32, the kernel's precision \
+                 (give 0, or a magnitude of at least 1e-45)",
+                got()
+            )));
+        }
+        Ok(f)
+    }
+}
+
+impl FloatArg for Option<f32> {
+    fn extract_named(ob: &Bound<'_, PyAny>, name: &str) -> PyResult<Self> {
+        if ob.is_none() {
+            Ok(None)
+        } else {
+            f32::extract_named(ob, name).map(Some)
+        }
+    }
+}
+
+/// [`named_ints`]'s float sibling: `named_floats!(tol_f32: f32 = "tol");` defines
+/// `tol_f32(ob) -> PyResult<f32>` through [`FloatArg`].
+#[macro_export]
+macro_rules! named_floats {
+    ($($f:ident: $t:ty = $name:literal;)*) => {$(
+        fn $f(ob: &pyo3::Bound<'_, pyo3::PyAny>) -> pyo3::PyResult<$t> {
+            <$t as $crate::params::FloatArg>::extract_named(ob, $name)
         }
     )*};
 }

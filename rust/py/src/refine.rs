@@ -23,20 +23,20 @@ pub fn refine_disparity<'py>(
     right: &Bound<'py, PyAny>,
     disp: &Bound<'py, PyAny>,
     conf: &Bound<'py, PyAny>,
-    d_min: f32,
-    d_max: f32,
-    base_sigma: f32,
-    win_sigma: f32,
+    #[pyo3(from_py_with = d_min_f32)] d_min: f32,
+    #[pyo3(from_py_with = d_max_f32)] d_max: f32,
+    #[pyo3(from_py_with = base_sigma_f32)] base_sigma: f32,
+    #[pyo3(from_py_with = win_sigma_f32)] win_sigma: f32,
     #[pyo3(from_py_with = win_radius_arg)] win_radius: usize,
     #[pyo3(from_py_with = search_arg)] search: usize,
-    step: f32,
+    #[pyo3(from_py_with = step_f32)] step: f32,
     #[pyo3(from_py_with = fill_search_arg)] fill_search: usize,
-    fill_step: f32,
-    var_floor: f32,
+    #[pyo3(from_py_with = fill_step_f32)] fill_step: f32,
+    #[pyo3(from_py_with = var_floor_f32)] var_floor: f32,
     fills: Vec<(f32, f32)>,
-    fill_confidence: f32,
+    #[pyo3(from_py_with = fill_confidence_f32)] fill_confidence: f32,
     fill_plane: bool,
-    fill_max_residual: f32,
+    #[pyo3(from_py_with = fill_max_residual_f32)] fill_max_residual: f32,
 ) -> PyResult<Refined<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
@@ -100,4 +100,16 @@ crate::named_ints! {
     win_radius_arg: usize = "win_radius";
     search_arg: usize = "search";
     fill_search_arg: usize = "fill_search";
+}
+
+crate::named_floats! {
+    d_min_f32: f32 = "d_min";
+    d_max_f32: f32 = "d_max";
+    base_sigma_f32: f32 = "base_sigma";
+    win_sigma_f32: f32 = "win_sigma";
+    step_f32: f32 = "step";
+    fill_step_f32: f32 = "fill_step";
+    var_floor_f32: f32 = "var_floor";
+    fill_confidence_f32: f32 = "fill_confidence";
+    fill_max_residual_f32: f32 = "fill_max_residual";
 }

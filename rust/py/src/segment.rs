@@ -20,7 +20,7 @@ use stereovision_core::image::MAX_PIXELS;
 pub fn graph_segments<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
-    k: f32,
+    #[pyo3(from_py_with = k_f32)] k: f32,
     #[pyo3(from_py_with = graph_segments_min_size)] min_size: usize,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
     let image: PyReadonlyArray3<'py, f32> = crate::convert::array_arg(image, "image")?;
@@ -64,9 +64,9 @@ pub fn plane_fill<'py>(
     disp: &Bound<'py, PyAny>,
     labels: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = min_pixels_arg)] min_pixels: usize,
-    max_residual: f32,
-    lo: f32,
-    hi: f32,
+    #[pyo3(from_py_with = max_residual_f32)] max_residual: f32,
+    #[pyo3(from_py_with = lo_f32)] lo: f32,
+    #[pyo3(from_py_with = hi_f32)] hi: f32,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, usize, usize)> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let labels: PyReadonlyArray2<'py, u32> = crate::convert::array_arg(labels, "labels")?;
@@ -154,7 +154,7 @@ pub fn fill_planes<'py>(
     disp: &Bound<'py, PyAny>,
     image: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = passes_arg)] passes: Vec<(u32, usize)>,
-    max_residual: f32,
+    #[pyo3(from_py_with = max_residual_f32)] max_residual: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let image: PyReadonlyArray3<'py, u8> = crate::convert::array_arg(image, "image")?;
@@ -226,4 +226,11 @@ fn passes_arg(ob: &Bound<'_, PyAny>) -> PyResult<Vec<(u32, usize)>> {
         out.push((step, min_pixels));
     }
     Ok(out)
+}
+
+crate::named_floats! {
+    k_f32: f32 = "k";
+    max_residual_f32: f32 = "max_residual";
+    lo_f32: f32 = "lo";
+    hi_f32: f32 = "hi";
 }

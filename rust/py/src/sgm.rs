@@ -20,7 +20,7 @@ pub fn sgm_disparity<'py>(
     #[pyo3(from_py_with = d_max_arg)] d_max: i32,
     #[pyo3(from_py_with = p1_arg)] p1: u16,
     #[pyo3(from_py_with = p2_arg)] p2: u16,
-    gamma: f32,
+    #[pyo3(from_py_with = gamma_f32)] gamma: f32,
     #[pyo3(from_py_with = uniqueness_arg)] uniqueness: u32,
     #[pyo3(from_py_with = lr_tol_arg)] lr_tol: u32,
     #[pyo3(from_py_with = edge_margin_arg)] edge_margin: u32,
@@ -84,4 +84,8 @@ fn paths_arg(ob: &Bound<'_, PyAny>) -> PyResult<u8> {
         Err(e) if e.is_instance_of::<pyo3::exceptions::PyValueError>(py) => Err(bad()),
         Err(e) => Err(e),
     }
+}
+
+crate::named_floats! {
+    gamma_f32: f32 = "gamma";
 }

@@ -76,7 +76,7 @@ pub fn temporal_running_mean<'py>(
     mean: &Bound<'py, PyAny>,
     count: &Bound<'py, PyAny>,
     diff: &Bound<'py, PyAny>,
-    ks: f32,
+    #[pyo3(from_py_with = ks_f32)] ks: f32,
     #[pyo3(from_py_with = max_frames_arg)] max_frames: u8,
 ) -> PyResult<Bound<'py, PyArrayDyn<u8>>> {
     let mut mean: PyReadwriteArrayDyn<'py, f32> = crate::convert::array_arg_rw(mean, "mean")?;
@@ -132,4 +132,8 @@ pub fn temporal_running_mean<'py>(
 
 crate::named_ints! {
     max_frames_arg: u8 = "max_frames";
+}
+
+crate::named_floats! {
+    ks_f32: f32 = "ks";
 }

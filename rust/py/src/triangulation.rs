@@ -22,12 +22,12 @@ pub fn depth_rectified<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
     conf: &Bound<'py, PyAny>,
-    fb: f32,
-    doffs: f32,
-    s0: f32,
-    slope: f32,
-    s_min: f32,
-    s_fill: f32,
+    #[pyo3(from_py_with = fb_f32)] fb: f32,
+    #[pyo3(from_py_with = doffs_f32)] doffs: f32,
+    #[pyo3(from_py_with = s0_f32)] s0: f32,
+    #[pyo3(from_py_with = slope_f32)] slope: f32,
+    #[pyo3(from_py_with = s_min_f32)] s_min: f32,
+    #[pyo3(from_py_with = s_fill_f32)] s_fill: f32,
 ) -> PyResult<Pair<'py>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let conf: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(conf, "conf")?;
@@ -48,4 +48,13 @@ pub fn depth_rectified<'py>(
         data,
     };
     Ok((image_to_numpy(py, img(z))?, image_to_numpy(py, img(s))?))
+}
+
+crate::named_floats! {
+    fb_f32: f32 = "fb";
+    doffs_f32: f32 = "doffs";
+    s0_f32: f32 = "s0";
+    slope_f32: f32 = "slope";
+    s_min_f32: f32 = "s_min";
+    s_fill_f32: f32 = "s_fill";
 }
