@@ -796,18 +796,18 @@ fn half_mad(
         let x1 = (x0 + 1).min(right.width - 1);
         cols[c] = (x as usize, x0, x1, pos - x0 as f32);
     }
-    let diff = |ly: usize, ry: usize, c: usize| {
-        let (x, x0, x1, f) = cols[c];
-        let row = &right.data[ry * right.width..(ry + 1) * right.width];
-        left.at(x, ly) - (row[x0] + f * (row[x1] - row[x0]))
-    };
-    // The differences once, in raster order, for both passes (`diffs`: the caller's buffer).
+    // The differences once, in raster order, for both passes (`diffs`: the caller's buffer);
+    // each row's left and right slices taken once, not once per pixel.
     diffs.clear();
     for dy in -hh..=hh {
         let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
-        for c in 0..nc {
-            diffs.push(diff(ly, ry, c));
-        }
+        let lrow = &left.data[ly * left.width..(ly + 1) * left.width];
+        let rrow = &right.data[ry * right.width..(ry + 1) * right.width];
+        diffs.extend(
+            cols[..nc]
+                .iter()
+                .map(|&(x, x0, x1, f)| lrow[x] - (rrow[x0] + f * (rrow[x1] - rrow[x0]))),
+        );
     }
     let mut offset = 0.0f32;
     if mean_free {
