@@ -130,32 +130,61 @@ impl SgmParams {
     }
 }
 
+/// Interior columns of a census row coded at once: their two halves of the code fit in two
+/// stack blocks of u32 (L1-resident; no allocation per row).
+const CENSUS_BLOCK: usize = 64;
+
 simd_fn! {
     /// One census row: `rows` are the 7 image rows around it (clamped at the image's edges).
+    /// The interior columns are coded a block at a time in two u32 halves (bits 0-31, 32-61):
+    /// a u64 lane per pixel and bit took twice the vector work for the same bits.
     fn census_row(rows: &[&[f32]], code: &mut [u64]) {
         let w = code.len();
         let centre = rows[RY];
-        code.fill(0);
-        let mut bit = 0u32;
-        for (dy, r) in rows.iter().enumerate() {
-            for dx in -(RX as isize)..=RX as isize {
-                if dy == RY && dx == 0 {
-                    continue;
-                }
-                // Interior columns in one vectorisable loop, the edges with clamped columns.
-                let (lo, hi) = if w > 2 * RX { (RX, w - RX) } else { (0, 0) };
-                if hi > lo {
-                    let src = &r[(lo as isize + dx) as usize..];
-                    for ((c, &v), &ctr) in code[lo..hi].iter_mut().zip(src).zip(&centre[lo..hi]) {
-                        *c |= u64::from(v < ctr) << bit;
+        let (lo, hi) = if w > 2 * RX { (RX, w - RX) } else { (0, 0) };
+        let mut x0 = lo;
+        while x0 < hi {
+            let n = CENSUS_BLOCK.min(hi - x0);
+            let (mut low, mut high) = ([0u32; CENSUS_BLOCK], [0u32; CENSUS_BLOCK]);
+            let ctr = &centre[x0..x0 + n];
+            let mut bit = 0u32;
+            for (dy, r) in rows.iter().enumerate() {
+                for dx in -(RX as isize)..=RX as isize {
+                    if dy == RY && dx == 0 {
+                        continue;
                     }
+                    let src = &r[(x0 as isize + dx) as usize..][..n];
+                    let (half, b) = if bit < 32 {
+                        (&mut low[..n], bit)
+                    } else {
+                        (&mut high[..n], bit - 32)
+                    };
+                    for ((c, &v), &cv) in half.iter_mut().zip(src).zip(ctr) {
+                        *c |= u32::from(v < cv) << b;
+                    }
+                    bit += 1;
                 }
-                for x in (0..lo).chain(hi..w) {
-                    let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
-                    code[x] |= u64::from(r[xx] < centre[x]) << bit;
-                }
-                bit += 1;
             }
+            for ((c, &a), &b) in code[x0..x0 + n].iter_mut().zip(&low).zip(&high) {
+                *c = u64::from(a) | u64::from(b) << 32;
+            }
+            x0 += n;
+        }
+        // The edge columns, with clamped columns.
+        for x in (0..lo).chain(hi..w) {
+            let mut c = 0u64;
+            let mut bit = 0u32;
+            for (dy, r) in rows.iter().enumerate() {
+                for dx in -(RX as isize)..=RX as isize {
+                    if dy == RY && dx == 0 {
+                        continue;
+                    }
+                    let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
+                    c |= u64::from(r[xx] < centre[x]) << bit;
+                    bit += 1;
+                }
+            }
+            code[x] = c;
         }
     }
 }
@@ -2290,8 +2319,9 @@ mod tests {
     #[test]
     fn census_equals_its_definition() {
         // Bit k (the 9 x 7 window row-major, centre skipped) where the neighbour, at clamped
-        // coordinates, is darker than the centre; widths below and above the window.
-        for (w, h) in [(23usize, 9usize), (6, 4)] {
+        // coordinates, is darker than the centre; widths below, at and above the window, and
+        // one of three interior blocks (CENSUS_BLOCK), the last one short.
+        for (w, h) in [(23usize, 9usize), (6, 4), (9, 3), (150, 8)] {
             let img = noise(w, h, 5);
             let c = census(ImageView::new(w, h, &img).unwrap()).unwrap();
             for y in 0..h as isize {
