@@ -486,6 +486,18 @@ def test_batch_ground_outputs(data_dir: Path, tmp_path: Path) -> None:
                                  "ground": True}))  # fmt: skip
 
 
+def test_a_fractional_max_disparity_is_recorded_as_searched(tmp_path: Path) -> None:
+    """max_disparity=20.5 (run_batch takes any positive number, as depth_map does) was recorded
+    as the pair's max_disparity 20, int() cutting the range searched; a whole one stays an int."""
+    from stereovision.batch import _task, process_pair
+
+    _noise_pair(tmp_path / "s")
+    (job,) = find_pairs(tmp_path / "s")
+    for given in (20.5, 16):
+        out = process_pair(_task(job, {"method": "fast", "max_disparity": given, "fill": None}))
+        assert out["max_disparity"] == given and type(out["max_disparity"]) is type(given)
+
+
 def test_batch_max_disparity_zero_is_refused(tmp_path: Path) -> None:
     """max_disparity=0 is no disparity range (0 is not "estimated"): refused by name, before
     the input is searched."""

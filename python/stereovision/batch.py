@@ -688,6 +688,13 @@ def _decode(name: str, data: bytes) -> Any:
     return img
 
 
+def _pixels(value: float) -> int | float:
+    """A disparity range for the summary: an int when whole (as recorded before), else the
+    float searched (write_npz keeps it so too)."""
+    v = float(value)
+    return int(v) if v.is_integer() else v
+
+
 def process_pair(task: dict[str, Any]) -> dict[str, Any]:
     """Compute one pair's ``stereovision depth`` outputs (runs on a Dask worker).
 
@@ -744,7 +751,8 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
         files = {name: Path(p).read_bytes() for name, p in written.items()}
     return {
         "files": files,
-        "max_disparity": int(res.max_disparity),
+        # a fractional range searched (max_disparity=20.5) was recorded as 20
+        "max_disparity": _pixels(res.max_disparity),
         "density": float(res.density),
         "points": len(res.points),
         "seconds": time.perf_counter() - t0,
