@@ -1400,6 +1400,28 @@ def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
     assert summary["pairs"]["b"]["status"] == "done"
 
 
+def test_a_broken_link_where_a_pair_folder_goes_is_named(tmp_path: Path) -> None:
+    """OUT/a (or OUT/seq above OUT/seq/0001) a link to a disk not mounted: the pair failed
+    with "Not a directory: '.../.a.partial-1a2b3c4d' -> '.../a'", a hidden folder the user
+    never made, and under such a link mkdir's FileExistsError stopped the whole run. The link
+    is named now, as a file in the way is (the pair alone fails), and kept."""
+    from stereovision import batch
+
+    out = tmp_path / "out"
+    out.mkdir()
+    for link, name in (("a", "a"), ("seq", "seq/0001")):
+        (out / link).symlink_to(tmp_path / "unmounted" / link)
+        with pytest.raises(NotADirectoryError) as info:
+            batch._commit_pair(out, name, {"disparity.pfm": b"x"})
+        assert str(info.value) == (
+            f"{out / link} is a link to {tmp_path / 'unmounted' / link}, which does not exist, "
+            f"where the pair's output folder {out / name} goes: make its target, or remove "
+            "the link"
+        )
+        assert (out / link).is_symlink()
+    assert sorted(p.name for p in out.iterdir()) == ["a", "seq"]  # no partial folder left
+
+
 def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -952,6 +952,7 @@ def _commit_pair(
     (the pair fails, its earlier files and the folder are kept).
     """
     from stereovision.cli import DEPTH_OUTPUTS
+    from stereovision.io import _broken_link
 
     dest = out / name
     for folder in (dest, *dest.parents):
@@ -960,6 +961,13 @@ def _commit_pair(
         if folder.exists() and not folder.is_dir():
             raise NotADirectoryError(
                 f"{folder} is a file, where the pair's output folder {dest} goes: move it away"
+            )
+        if folder.is_symlink() and not folder.exists():
+            # a link to an unmounted disk: the rename said "Not a directory: '.../.a.partial-
+            # 1a2b3c4d' -> '.../a'" (a hidden folder), under it mkdir stopped the run (File exists)
+            raise NotADirectoryError(
+                f"{folder} is {_broken_link(folder)}, where the pair's output folder {dest} "
+                "goes: make its target, or remove the link"
             )
     for fname in files:
         # checked before any file moves: the files renamed over theirs before the folder was
