@@ -15,6 +15,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from collections import deque
@@ -1420,6 +1421,35 @@ def test_a_broken_link_where_a_pair_folder_goes_is_named(tmp_path: Path) -> None
         )
         assert (out / link).is_symlink()
     assert sorted(p.name for p in out.iterdir()) == ["a", "seq"]  # no partial folder left
+
+
+def test_a_pair_folder_linked_to_another_disk_is_written(tmp_path: Path) -> None:
+    """OUT/a a link to a folder on another disk (outputs spread over disks): each file was
+    renamed from OUT/.a.partial-... across the disks, "Invalid cross-device link", which
+    stopped the run, every run. The files are staged inside the folder now; a killed run's
+    staging folder there is removed by the next run over the pair."""
+    from stereovision import batch
+
+    shm = Path("/dev/shm")
+    if not (shm.is_dir() and os.access(shm, os.W_OK)):
+        pytest.skip("no /dev/shm")
+    other = Path(tempfile.mkdtemp(dir=shm))
+    try:
+        if os.stat(other).st_dev == os.stat(tmp_path).st_dev:
+            pytest.skip("/dev/shm is on the disk of tmp_path")
+        out = tmp_path / "out"
+        out.mkdir()
+        (other / "a").mkdir()
+        (out / "a").symlink_to(other / "a")
+        batch._commit_pair(out, "a", {"disparity.pfm": b"new"})
+        assert [p.name for p in (other / "a").iterdir()] == ["disparity.pfm"]
+        assert (other / "a" / "disparity.pfm").read_bytes() == b"new"
+        assert sorted(p.name for p in out.iterdir()) == ["a"]
+        (other / "a" / ".a.partial-1a2b3c4d").mkdir()  # a killed run's
+        batch._remove_partials(out, ["a"])
+        assert [p.name for p in (other / "a").iterdir()] == ["disparity.pfm"]
+    finally:
+        shutil.rmtree(other)
 
 
 def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(

@@ -979,7 +979,12 @@ def _commit_pair(
                 "pair's earlier outputs are kept)"
             )
     dest.parent.mkdir(parents=True, exist_ok=True)
-    tmp = dest.parent / f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
+    partial = f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
+    tmp = dest.parent / partial
+    if dest.is_dir() and os.stat(dest).st_dev != os.stat(dest.parent).st_dev:
+        # OUT/a a link to (or a mount of) a folder on another disk: no file is renamed across
+        # disks ("Invalid cross-device link" stopped the run, every run); staged inside it
+        tmp = dest / partial
     tmp.mkdir()
     try:
         for fname, data in files.items():
@@ -1006,7 +1011,8 @@ _PARTIAL_RE = re.compile(r"\.(.+)\.partial-[0-9a-f]{8}")
 
 
 def _remove_partials(out: Path, names: list[str]) -> None:
-    """Remove the temporary folders (``.NAME.partial-1a2b3c4d`` beside ``OUT/NAME``) that a
+    """Remove the temporary folders (``.NAME.partial-1a2b3c4d`` beside ``OUT/NAME``, or in it
+    when it is on another disk) that a
     run killed while writing those pairs left (SIGKILL, the OOM killer, a power cut: its
     ``finally`` did not run); each held a pair's outputs and stayed, hidden, for good. Only
     folders of that pattern for the pairs ``names`` are touched, under the run's lock."""
@@ -1014,6 +1020,8 @@ def _remove_partials(out: Path, names: list[str]) -> None:
     for name in names:
         dest = out / name
         by_parent.setdefault(dest.parent, set()).add(dest.name)
+        # and inside it, where a folder on another disk has them (_commit_pair)
+        by_parent.setdefault(dest, set()).add(dest.name)
     for parent, pairs in by_parent.items():
         try:
             entries = list(os.scandir(parent))
