@@ -975,6 +975,52 @@ def test_atomic_pair_writes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> 
         save_pair(out, 3, img, img, ext=".nope")
 
 
+def test_a_disk_that_fills_mid_capture_names_the_file_and_the_pairs_kept(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An output disk that fills up (a robot's SD card) said "[Errno 28] No space left on
+    device" alone, out of capture and `stereovision capture`: neither the file nor the pairs
+    saved before. The file is named, and the pairs kept are said as for a source's failure."""
+    import errno
+
+    from stereovision.cli import main
+
+    left, right = _videos(tmp_path, 6, 6)
+    out = tmp_path / "pairs"
+    real_fsync, calls = os.fsync, [0]
+
+    def full_after_two_pairs(fd: int) -> None:
+        calls[0] += 1
+        if calls[0] > 4:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", full_after_two_pairs)
+    with StereoCamera(left, right) as cam, pytest.raises(OSError) as ei:
+        capture(cam, out, count=5)
+    assert str(ei.value) == (
+        f"cannot write {out / 'left_0003.png'}: No space left on device; "
+        f"2 of 5 pairs were saved in {out} and are kept"
+    )
+    assert ei.value.errno == errno.ENOSPC
+    calls[0] = 0
+    with StereoCamera(left, right) as cam, pytest.raises(OSError) as ei:
+        capture(cam, out)  # without a count: the pairs saved by this capture
+    assert str(ei.value).endswith(
+        f"left_0005.png: No space left on device; 2 pairs were saved in {out} and are kept"
+    )
+    names = sorted(p.name for p in out.iterdir())  # whole pairs, no temporary file
+    assert names == [f"{s}_{i:04d}.png" for s in ("left", "right") for i in range(1, 5)]
+    # the CLI's one line says it too
+    calls[0] = 0
+    capsys.readouterr()
+    assert main(["capture", "--left", str(left), "--right", str(right), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: cannot write {out / 'left_0007.png'}: No space left on device; "
+        f"2 pairs were saved in {out} and are kept\n"
+    )
+
+
 @pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "link"])
 def test_interrupted_pair_save_leaves_no_temp_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str

@@ -2475,10 +2475,16 @@ def _atomic_write_bytes(path: Path, data: bytes) -> None:
             # the temporary file was named ('No such file or directory: '/proc/.left_0001.png
             # .32467-0f59063e.tmp''), not the pair's file and its folder
             raise temp_refused(path, exc) from exc
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            # a full disk said "[Errno 28] No space left on device" alone, naming no file
+            failed = type(exc)(f"cannot write {path}: {exc.strerror or exc}")
+            failed.errno = exc.errno
+            raise failed from exc
         try:
             os.link(tmp, path)
         except FileExistsError:
@@ -2932,6 +2938,9 @@ def capture(
         does not decode (a bag), its message saying how many pairs were saved and are kept.
     PermissionError
         If ``directory`` cannot be written.
+    OSError
+        If a pair cannot be written (a full disk): the message names the file and says the
+        pairs saved so far, which are kept.
     """
     # 2.5 saved 3 pairs and NaN none ("count reached"); every=NaN saved none to the end
     if count is not None:
@@ -3019,23 +3028,32 @@ def capture(
                 continue
         elif frame.index % every:
             continue
-        while True:
-            try:
-                paths = save_pair(out, index, frame.left, frame.right, ext=ext)
-                break
-            except FileExistsError:  # another capture into the folder took this number
-                taken = (PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right"))
-                if not any(os.path.lexists(out / name) for name in taken):
-                    raise  # not a number taken (the folder became a file): no retry without end
-                index = max(index + 1, next_pair_index(out))
-            except KeyboardInterrupt:
-                # held while both images were written (save_pair): a pair whose right image is
-                # there is saved whole, and said so before the interrupt goes on
-                rp = out / PAIR_NAME.format(side="right", index=index, ext=ext)
-                if log is not None and rp.exists():
-                    lp = out / PAIR_NAME.format(side="left", index=index, ext=ext)
-                    log(f"saved {lp.name} {rp.name} (skew {frame.skew_ms:.2f} ms)")
-                raise
+        try:
+            while True:
+                try:
+                    paths = save_pair(out, index, frame.left, frame.right, ext=ext)
+                    break
+                except FileExistsError:  # another capture into the folder took this number
+                    taken = (
+                        PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right")
+                    )
+                    if not any(os.path.lexists(out / name) for name in taken):
+                        raise  # not a number taken (the folder became a file): no endless retry
+                    index = max(index + 1, next_pair_index(out))
+                except KeyboardInterrupt:
+                    # held while both images were written (save_pair): a pair whose right
+                    # image is there is saved whole, and said so before the interrupt goes on
+                    rp = out / PAIR_NAME.format(side="right", index=index, ext=ext)
+                    if log is not None and rp.exists():
+                        lp = out / PAIR_NAME.format(side="left", index=index, ext=ext)
+                        log(f"saved {lp.name} {rp.name} (skew {frame.skew_ms:.2f} ms)")
+                    raise
+        except OSError as exc:
+            # a full disk, a card turned read-only: the pairs saved before are said, as for a
+            # source's failure (the error said neither them nor, from a write, the file)
+            failed = type(exc)(f"{exc}; {kept_note()}")
+            failed.errno = exc.errno
+            raise failed from exc
         saved.append(paths)
         last_index = frame.index
         index += 1
