@@ -850,6 +850,23 @@ def test_open_failures_name_the_source(tmp_path: Path) -> None:
     assert issubclass(SourceError, OSError)
 
 
+def test_a_second_capture_on_one_camera_reports_its_own_pairs(tmp_path: Path) -> None:
+    """A camera kept open for captures one after another (a pair per pose of a script) had
+    each result say the camera's pairs since its open: the second capture of 3 pairs said
+    frames_read 6 and a skew over 6 pairs. Each capture says its own."""
+    left, right = _videos(tmp_path, 10, 10)
+    out = tmp_path / "pairs"
+    with StereoCamera(left, right) as cam:
+        first = capture(cam, out, count=3)
+        second = capture(cam, out, count=3)
+        rest = capture(cam, out)
+    assert (first.frames_read, first.skew["n"]) == (3, 3)
+    assert (second.frames_read, second.skew["n"]) == (3, 3)
+    assert (rest.frames_read, rest.skew["n"], len(rest.saved)) == (4, 4, 4)
+    assert rest.ended == "end of stream"
+    assert math.isfinite(second.skew["mean_ms"]) and second.skew["max_ms"] >= 0
+
+
 def test_disconnect_mid_run_keeps_saved_pairs(tmp_path: Path) -> None:
     left, right = _videos(tmp_path, 10, 4)
     out = tmp_path / "pairs"

@@ -2824,10 +2824,11 @@ class CaptureResult:
     saved : list of tuple of pathlib.Path
         The ``(left, right)`` files of each pair saved, in order.
     frames_read : int
-        Pairs read from the camera (saved or not).
+        Pairs read from the camera by this capture (saved or not; not those of an earlier
+        capture on the same camera).
     skew : dict of str to float
-        Left/right grab skew over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``
-        (NaN without pairs).
+        Left/right grab skew over the pairs this capture read: ``n``, ``mean_ms``,
+        ``median_ms``, ``max_ms`` (NaN without pairs).
     coverage : dict of str to float or None
         With a board: each pose parameter's coverage in ``[0, 1]``
         (:meth:`ChessboardCollector.progress`); None without one.
@@ -2982,6 +2983,10 @@ def capture(
     ended = "count reached"
     last_index = -1  # the frame index of the pair saved last
     read = 0  # pairs read by this capture
+    # a camera read before (an earlier capture on it) counts its pairs too: this capture's
+    # count and skews are its own
+    read_before = getattr(camera, "count", 0)
+    skews = SkewStats()
 
     def kept_note() -> str:
         if count is not None:
@@ -3009,6 +3014,7 @@ def capture(
                 raise
             raise ValueError(f"{exc}; {kept_note()}") from exc
         read += 1
+        skews.append(frame.skew_ms)
         if progress is not None:
             progress(read)
         averaged = None
@@ -3068,8 +3074,9 @@ def capture(
             log(line)
     return CaptureResult(
         saved=saved,
-        frames_read=camera.count,
-        skew=camera.skew_report(),
+        frames_read=read,
+        # the camera's own report when it read nothing before (as exact for a bag's list)
+        skew=camera.skew_report() if not read_before else skews.report(),
         coverage=None if collector is None else collector.progress(),
         ended=ended,
         removed_temps=stale,
