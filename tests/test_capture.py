@@ -1389,6 +1389,36 @@ def test_temporal_capture_saves_the_mean_of_still_frames(data_dir: Path, tmp_pat
     assert moving.saved == [] and moving.frames_read == 12 and moving.ended == "end of stream"
 
 
+def test_temporal_averaging_of_16_bit_frames_is_refused_naming_the_source(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """capture --temporal (and stream --temporal) of a 16-bit image sequence said "left:
+    expected a uint8 image, got uint16", the filter's words for an argument the user never
+    passed; it now names the averaging and the source that delivers such frames."""
+    from stereovision.cli import main
+
+    deep = [(_numbered(i).astype(np.uint16) * 257) for i in range(4)]
+    left16 = _write_sequence(tmp_path / "deep", "left", deep)
+    right16 = _write_sequence(tmp_path / "deep", "right", deep)
+    right8 = _write_sequence(tmp_path / "flat", "right", [_numbered(i) for i in range(4)])
+    left8 = _write_sequence(tmp_path / "flat", "left", [_numbered(i) for i in range(4)])
+    words = (
+        "temporal averaging takes 8-bit frames: the {} source delivers uint16 ones (a 16-bit "
+        "image sequence?); convert them to 8 bits, or leave the averaging out"
+    )
+    for (left, right), side in (((left16, right8), "left"), ((left8, right16), "right")):
+        with StereoCamera(left, right) as cam, pytest.raises(ValueError) as ei:
+            capture(cam, tmp_path / "pairs", temporal=2)
+        assert str(ei.value) == words.format(side)
+    assert not (tmp_path / "pairs").exists() or not list((tmp_path / "pairs").iterdir())
+    capsys.readouterr()
+    src = ["--left", left8, "--right", right16, "--temporal", "2"]
+    assert main(["capture", *src, "-o", str(tmp_path / "pairs")]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {words.format('right')}\n"
+    assert main(["stream", *src, "--no-display", "--frames", "2"]) == 2
+    assert capsys.readouterr().err.endswith(f"stereovision: error: {words.format('right')}\n")
+
+
 def test_temporal_chessboard_capture_waits_for_a_still_board(tmp_path: Path) -> None:
     """Poses A A A B B A C C (D) (-) A in PNG frames with grey noise (sigma 6), ``temporal=2``:
     A is taken on its 2nd frame, B and C on theirs; the third A frame and the later A are the

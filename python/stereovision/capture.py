@@ -2224,7 +2224,22 @@ def temporal_average(tf: Any, frame: StereoFrame) -> tuple[np.ndarray, np.ndarra
     -------
     left, right : numpy.ndarray
         The filter's running means (uint8), at the pair's size.
+
+    Raises
+    ------
+    ValueError
+        If a source delivers frames of more than 8 bits (a 16-bit image sequence), which the
+        filter does not average.
     """
+    for side, img in (("left", frame.left), ("right", frame.right)):
+        if img.dtype != np.uint8:
+            # the filter's own words named a "left" image the caller never passed: "left:
+            # expected a uint8 image, got uint16"
+            hint = " (a 16-bit image sequence?)" if img.dtype == np.uint16 else ""
+            raise ValueError(
+                f"temporal averaging takes 8-bit frames: the {side} source delivers {img.dtype} "
+                f"ones{hint}; convert them to 8 bits, or leave the averaging out"
+            )
     if not _averaged_before_resize(frame):
         left, right = tf(frame.left, frame.right)
         return left, right
