@@ -1038,6 +1038,35 @@ def test_a_disk_that_fills_mid_capture_names_the_file_and_the_pairs_kept(
     )
 
 
+def test_an_extension_that_is_no_image_formats_is_refused_before_any_read(
+    tmp_path: Path,
+) -> None:
+    """capture(ext="png") (no dot) read the camera's first pair, then said "cannot encode the
+    left image as png"; ext="/x.png" wrote below the folder and ".png " saved names the
+    numbering does not read. Refused before any read, nothing made."""
+    left, right = _videos(tmp_path, 4, 4)
+    out = tmp_path / "pairs"
+    img = _numbered(1)
+    for ext in ("png", "", "/x.png", ".png ", "../x", None):
+        words = f"ext: expected an image format's extension such as '.png', got {ext!r}"
+        with StereoCamera(left, right) as cam:
+            with pytest.raises(ValueError) as ei:
+                capture(cam, out, ext=ext)  # type: ignore[arg-type]
+            assert str(ei.value) == words and cam.count == 0
+        with pytest.raises(ValueError) as ei:
+            save_pair(out, 1, img, img, ext=ext)  # type: ignore[arg-type]
+        assert str(ei.value) == words
+    with StereoCamera(left, right) as cam, pytest.raises(ValueError) as ei:
+        capture(cam, out, ext=".nope")
+    assert str(ei.value) == "ext: cannot encode images as .nope: OpenCV has no writer for it"
+    assert cam.count == 0 and not out.exists()
+    with StereoCamera(left, right) as cam:  # any case of a format's extension is one
+        assert [p.name for p in capture(cam, out, count=1, ext=".JPG").saved[0]] == [
+            "left_0001.JPG",
+            "right_0001.JPG",
+        ]
+
+
 @pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "link"])
 def test_interrupted_pair_save_leaves_no_temp_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str

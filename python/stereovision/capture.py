@@ -125,6 +125,8 @@ PROGRESS_BAR_WIDTH = 10
 #: File name pattern of saved pairs (index from 1; 4 digits sort well up to 9999 pairs).
 PAIR_NAME = "{side}_{index:04d}{ext}"
 _PAIR_RE = re.compile(r"^(left|right)_(\d+)\.[A-Za-z0-9]+$")
+#: The image format's extension of saved pairs (``.png``, ``.jpg``): the names _PAIR_RE reads.
+_EXT_RE = re.compile(r"^\.[A-Za-z0-9]+$")
 
 
 class SourceError(OSError):
@@ -2468,6 +2470,14 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
 _TMP_RE = re.compile(r"^\.(?:left|right)_\d+\.[A-Za-z0-9]+\.(?:(\d+)-)?[a-z0-9_]+\.tmp$")
 
 
+def _check_ext(ext: object) -> None:
+    """Refuse an ``ext`` that is no image format's extension: ``"png"`` (no dot) was "cannot
+    encode the left image as png", after the camera's first pair; ``"/x.png"`` wrote below the
+    folder, ``".png "`` names the numbering does not read."""
+    if not isinstance(ext, str) or not _EXT_RE.match(ext):
+        raise ValueError(f"ext: expected an image format's extension such as '.png', got {ext!r}")
+
+
 def _atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to a temporary file beside ``path``, then give it the name ``path`` if
     no file has it (:class:`FileExistsError` otherwise; another capture into the folder may
@@ -2608,7 +2618,8 @@ def save_pair(
     Raises
     ------
     ValueError
-        If ``index`` is not an integer ``>= 0``, or an image cannot be encoded in that format.
+        If ``index`` is not an integer ``>= 0``, ``ext`` is no extension (``.png``), or an
+        image cannot be encoded in that format.
     FileExistsError
         If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind).
     OSError
@@ -2617,6 +2628,7 @@ def save_pair(
     # -1 made left_-001.png, a name next_pair_index does not read; a float failed on the format
     if not isinstance(index, (int, np.integer)) or isinstance(index, NOT_NUMBERS) or index < 0:
         raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
+    _check_ext(ext)
     d = as_path(directory, "directory")
     d.mkdir(parents=True, exist_ok=True)
     data = []
@@ -2948,9 +2960,9 @@ def capture(
         ``count``), ends before ``count`` pairs were saved, or ends before a first pair could
         be read; the pairs saved so far stay on disk, and the message says how many.
     ValueError
-        For an invalid ``count``, ``every``, ``temporal`` or pattern, a ``directory`` that is a
-        file (or below one), or one whose saved pairs an image-sequence source would read as
-        its next frames (``--left 'pairs/left_%04d.png' -o pairs``); a recorded frame that
+        For an invalid ``count``, ``every``, ``temporal``, ``ext`` or pattern, a ``directory``
+        that is a file (or below one), or one whose saved pairs an image-sequence source would
+        read as its next frames (``--left 'pairs/left_%04d.png' -o pairs``); a recorded frame that
         does not decode (a bag), its message saying how many pairs were saved and are kept.
     PermissionError
         If ``directory`` cannot be written.
@@ -2963,6 +2975,9 @@ def capture(
         count = positive_whole(count, "count", "a positive number of pairs")
     every = positive_whole(every, "every")
     check_read_timeout(read_timeout)
+    _check_ext(ext)
+    if not cv2.haveImageWriter("pair" + ext):  # said before a pair is read, not after
+        raise ValueError(f"ext: cannot encode images as {ext}: OpenCV has no writer for it")
     if chessboard and charuco is not None:
         raise ValueError("chessboard and charuco: give one calibration target, not both")
     tf = None
