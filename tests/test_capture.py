@@ -1067,6 +1067,30 @@ def test_an_extension_that_is_no_image_formats_is_refused_before_any_read(
         ]
 
 
+def test_an_image_the_format_cannot_hold_is_refused_not_saved_as_8_bits(tmp_path: Path) -> None:
+    """save_pair of a float image in [0, 1] wrote it as 8 bits, 0 and 1 (a black picture), and
+    a 16-bit one as .jpg clipped to white, without a word: refused now, nothing written; a
+    format that holds the type keeps it."""
+    img = _numbered(1)
+    for bad, ext in (
+        (img.astype(np.float32) / 255, ".png"),
+        (img.astype(np.uint16) * 257, ".jpg"),
+        (img > 100, ".png"),
+    ):
+        with pytest.raises(ValueError) as ei:
+            save_pair(tmp_path, 1, img, bad, ext=ext)
+        assert str(ei.value) == (
+            f"cannot save the right image ({bad.dtype}) as {ext} without loss: that format "
+            "would write it as 8 bits; convert it to uint8 first (a float image in [0, 1]: "
+            "times 255)"
+        )
+    assert list(tmp_path.iterdir()) == []
+    deep = img.astype(np.uint16) * 257
+    for kept, ext in ((deep, ".png"), (img.astype(np.float32) / 255, ".tiff"), (img, ".jpg")):
+        lp, _ = save_pair(tmp_path, next_pair_index(tmp_path), kept, kept, ext=ext)
+        assert cv2.imread(str(lp), cv2.IMREAD_UNCHANGED).dtype == kept.dtype
+
+
 @pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "link"])
 def test_interrupted_pair_save_leaves_no_temp_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str

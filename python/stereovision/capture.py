@@ -2606,7 +2606,8 @@ def save_pair(
     index : int
         Pair number (``>= 0``).
     left, right : array_like
-        ``uint8`` images (grey or BGR).
+        ``uint8`` images (grey or BGR); another type (``uint16``, ``float32``) only in a
+        format that holds it (``.png`` for ``uint16``, ``.tiff`` for both).
     ext : str
         Image format by extension (``.png`` lossless by default).
 
@@ -2619,7 +2620,8 @@ def save_pair(
     ------
     ValueError
         If ``index`` is not an integer ``>= 0``, ``ext`` is no extension (``.png``), or an
-        image cannot be encoded in that format.
+        image cannot be encoded in that format, or not without loss (a float image in
+        ``.png``: it would be written as 8 bits).
     FileExistsError
         If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind).
     OSError
@@ -2639,6 +2641,17 @@ def save_pair(
             ok = False
         if not ok:
             raise ValueError(f"cannot encode the {side} image as {ext}")
+        arr = np.asarray(img)
+        if arr.dtype != np.uint8:
+            # a format without the image's depth is written as 8 bits: a float image in
+            # [0, 1] was saved black (0 and 1), a 16-bit one in .jpg white, without a word
+            back = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+            if back is None or back.dtype != arr.dtype:
+                raise ValueError(
+                    f"cannot save the {side} image ({arr.dtype}) as {ext} without loss: that "
+                    "format would write it as 8 bits; convert it to uint8 first (a float image "
+                    "in [0, 1]: times 255)"
+                )
         data.append(buf.tobytes())
     paths = tuple(d / PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right"))
     # A pair is saved whole or not at all: Ctrl-C (SIGTERM in the CLI) is held until both
