@@ -780,6 +780,17 @@ def test_an_infinite_pixel_is_nan_and_triangulates_without_a_warning() -> None:
     assert np.isnan(res.XL[0]).all() and res.XL[1].tolist() == pytest.approx([0.1, 0, 6.0])
 
 
+def test_a_pixel_past_float64_squared_triangulates_without_a_warning() -> None:
+    # 1e300 px squares to inf: delta's inf - inf warned "invalid value encountered in subtract"
+    K = np.array([[600.0, 0.0, 321.5], [0.0, 603.0, 238.2], [0.0, 0.0, 1.0]])
+    c = Calibration(K, np.zeros(5), K, np.zeros(5), np.eye(3), np.array([-0.1, 0, 0]), SIZE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = triangulate([[1e300, 240.0], [331.5, 238.2]], [[1e300 - 1, 240.0], [321.5, 238.2]], c)
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all() and res.XL[1].tolist() == pytest.approx([0.1, 0, 6.0])
+
+
 @pytest.mark.parametrize(
     ("K", "D", "says"),
     [

@@ -291,14 +291,16 @@ def triangulate(
     ray_l = np.column_stack([nl, np.ones(n)])
     ray_r = np.column_stack([nr, np.ones(n)])
     R, T = calib.R, calib.T
-    u = ray_l @ R.T
-    uu = np.einsum("ij,ij->i", u, u)
-    rr = np.einsum("ij,ij->i", ray_r, ray_r)
-    ur = np.einsum("ij,ij->i", u, ray_r)
-    ut = u @ T
-    rt = ray_r @ T
-    delta = uu * rr - ur * ur
+    # a far pixel (1e300 px) squares past float64: inf - inf in delta warned "invalid value
+    # encountered in subtract" for a point rightly invalid
     with np.errstate(all="ignore"):
+        u = ray_l @ R.T
+        uu = np.einsum("ij,ij->i", u, u)
+        rr = np.einsum("ij,ij->i", ray_r, ray_r)
+        ur = np.einsum("ij,ij->i", u, ray_r)
+        ut = u @ T
+        rt = ray_r @ T
+        delta = uu * rr - ur * ur
         not_parallel = delta > PARALLEL_SIN2_TOL * uu * rr
         zl = (ur * rt - rr * ut) / delta
         zr = (uu * rt - ut * ur) / delta
