@@ -1933,6 +1933,27 @@ def test_a_scan_from_0_to_2_pi_sees_the_right_side() -> None:
     assert np.count_nonzero(np.isfinite(full.ranges)) == 2
 
 
+@pytest.mark.parametrize(
+    ("directory", "says"),
+    [
+        (b"maps", "directory: expected a str or os.PathLike file name, got the bytes 'maps'"),
+        (None, "directory: expected a str or os.PathLike file name, got NoneType"),
+    ],
+)
+def test_occupancy_grid_save_refuses_a_directory_that_is_no_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, directory: object, says: str
+) -> None:
+    """Path(str(directory)) wrote b"maps" into a folder named "b'maps'", None into "None"."""
+    from stereovision.ground import OccupancyGrid
+
+    monkeypatch.chdir(tmp_path)
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    with pytest.raises(TypeError) as exc:
+        grid.save(directory)  # type: ignore[arg-type]
+    assert str(exc.value).startswith(says)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("name", ["run #3", "lab: 2", "*x", "[a]", 'say "hi"', "é\tb", "map"])
 def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: str) -> None:
     """map.yaml's 'image: run #3.png' read as 'run' (YAML took the rest for a comment), and

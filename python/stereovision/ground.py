@@ -946,6 +946,8 @@ class OccupancyGrid:
         ------
         ValueError
             A ``name`` that is empty or holds a folder (``"../x"``, ``"a/b"``).
+        TypeError
+            A ``directory`` that is bytes or no file name at all.
         RuntimeError
             If the grid could not be encoded as PNG.
         OSError
@@ -960,7 +962,10 @@ class OccupancyGrid:
         # a stem with a folder in it ("../x") wrote outside ``directory``
         if not isinstance(name, str) or name in ("", ".", "..") or Path(name).name != name:
             raise ValueError(f"name: expected a file stem without a folder, got {name!r}")
-        d = Path(str(directory))
+        from stereovision._validate import as_path
+
+        # Path(str(...)): b"/tmp/maps" wrote into a folder named "b'", None into "None"
+        d = as_path(directory, "directory")
         d.mkdir(parents=True, exist_ok=True)
         png, yml = d / f"{name}.png", d / f"{name}.yaml"
         ok, buf = cv2.imencode(".png", self.image())
