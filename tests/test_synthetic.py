@@ -107,6 +107,27 @@ def test_no_distortion_coefficients_is_no_distortion() -> None:
     )
 
 
+def test_none_for_distortion_is_no_distortion() -> None:
+    """D=None (OpenCV's distCoeffs for none) was asarray's NaN: "D: expected 4, 5, 8, 12 or 14
+    coefficients (or none) for model 'pinhole' (finite), got shape (1,)"."""
+    from stereovision.charuco import CharucoBoard, render_charuco
+
+    kw = {"image_size": (20, 12)}
+    np.testing.assert_array_equal(
+        render_plane(TEX, 0.01, K, None, np.zeros(3), [0, 0, 1.0], **kw),
+        render_plane(TEX, 0.01, K, D, np.zeros(3), [0, 0, 1.0], **kw),
+    )
+    board = CharucoBoard("5x4", 0.04, 0.03, "DICT_5X5_100")
+    pose = ([0.0, 0.0, 0.0], [-0.1, -0.08, 0.5])
+    kc = np.array([[300.0, 0.0, 80.0], [0.0, 300.0, 60.0], [0.0, 0.0, 1.0]])
+    got = render_charuco(board, kc, None, *pose, image_size=(160, 120), supersample=1)
+    want = render_charuco(board, kc, D, *pose, image_size=(160, 120), supersample=1)
+    np.testing.assert_array_equal(got, want)
+    assert 0 < got.min() < got.max()  # the board is in view
+    with pytest.raises(ValueError, match=r"^D: expected 4 coefficients .* \(finite\), got None$"):
+        render_plane(TEX, 0.01, K, None, np.zeros(3), [0, 0, 1.0], model="fisheye", **kw)
+
+
 @pytest.mark.parametrize("s", [0.0, -0.01, float("nan"), float("inf")])
 def test_units_per_pixel_must_be_positive(s: float) -> None:
     with pytest.raises(ValueError, match="units_per_pixel"):

@@ -661,7 +661,7 @@ def render_charuco(
     board : CharucoBoard
         The board (its dictionary must be known).
     K, D : array_like
-        Camera matrix and OpenCV distortion coefficients.
+        Camera matrix and OpenCV distortion coefficients (None or none at all: no distortion).
     rvec, tvec : array_like
         Board-to-camera rotation (Rodrigues) and translation, in the board's unit.
     image_size : tuple of int

@@ -148,7 +148,8 @@ def render_plane(
     units_per_pixel : float
         Size of one texture pixel on the plane (in the unit of ``tvec``).
     K, D : array_like
-        Camera matrix and distortion coefficients (OpenCV's order; 4 for ``model="fisheye"``).
+        Camera matrix and distortion coefficients (OpenCV's order; 4 for ``model="fisheye"``;
+        for ``"pinhole"`` None or none at all is no distortion).
     rvec, tvec : array_like
         Plane-to-camera rotation (Rodrigues) and translation.
     image_size : tuple of int
@@ -195,7 +196,9 @@ def render_plane(
     if not (np.isfinite(s) and s > 0):
         raise ValueError(f"units_per_pixel: expected a positive number, got {units_per_pixel!r}")
     Kf = np.asarray(K, np.float64)
-    Df = np.asarray(D, np.float64).ravel()
+    # None is no distortion, as the message below and OpenCV's distCoeffs have it: it was
+    # asarray's NaN, "... (or none) for model 'pinhole' (finite), got shape (1,)"
+    Df = np.zeros(0) if D is None and model == "pinhole" else np.asarray(D, np.float64).ravel()
     rv = np.asarray(rvec, np.float64).ravel()
     t = np.asarray(tvec, np.float64).ravel()
     # OpenCV's lengths; none at all is no distortion for the pinhole model
@@ -213,7 +216,8 @@ def render_plane(
                 if model == "fisheye"
                 else "4, 5, 8, 12 or 14 coefficients (or none) for model 'pinhole'",
             )
-            raise ValueError(f"{name}: expected {want} (finite), got shape {arr.shape}")
+            got = "None" if name == "D" and D is None else f"shape {arr.shape}"
+            raise ValueError(f"{name}: expected {want} (finite), got {got}")
     Rb, _ = cv2.Rodrigues(rv.reshape(3, 1))
     plane = np.column_stack([Rb[:, 0], Rb[:, 1], t])
     if abs(np.linalg.det(plane)) <= 1e-12 * max(1.0, float(np.abs(t).max())):
