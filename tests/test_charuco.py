@@ -1380,3 +1380,20 @@ def test_board_functions_name_a_board_that_is_no_charuco_board(given: object) ->
     for call in calls:
         with pytest.raises(TypeError, match=want):
             call()
+
+
+@pytest.mark.parametrize("given", ["10x7", (10, 7)])
+def test_calibration_from_recordings_names_a_board_that_is_no_charuco_board(
+    tmp_path: Path, given: object
+) -> None:
+    """A pattern as board was AttributeError "'str' object has no attribute 'inner'" from
+    deep inside, after both recordings were opened; now calibrate's own ValueError, first."""
+    from stereovision.calibrate import calibrate_from_bag
+
+    want = rf"^board: expected a stereovision\.charuco\.CharucoBoard, got {type(given).__name__}$"
+    frame = tmp_path / "frame.png"  # a recording of one frame, opened before (now not)
+    cv2.imwrite(str(frame), np.full((48, 64), 128, np.uint8))
+    with pytest.raises(ValueError, match=want):
+        calibrate_from_video(frame, frame, board=given)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=want):
+        calibrate_from_bag(tmp_path / "none.bag", board=given)  # type: ignore[arg-type]

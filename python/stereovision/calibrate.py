@@ -1487,13 +1487,10 @@ def calibrate(
     """
     from stereovision._validate import known_unit, positive_finite
     from stereovision.calibration import UNIT_TO_METRES, Calibration
-    from stereovision.charuco import CharucoBoard, corners_span_plane, find_charuco_corners
+    from stereovision.charuco import corners_span_plane, find_charuco_corners
 
     if board is not None:
-        if not isinstance(board, CharucoBoard):
-            raise ValueError(
-                f"board: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
-            )
+        _check_board(board)
         if square_size is not None and positive_finite(square_size, "square_size") != float(
             board.square_size
         ):
@@ -2027,6 +2024,9 @@ def calibrate_from_video(
     """
     from stereovision.capture import StereoCamera, check_read_timeout
 
+    # a pattern string '10x7' as board was AttributeError "'str' object has no attribute
+    # 'inner'", after the cameras were opened
+    _check_board(board)
     max_pairs = _check_max_pairs(max_pairs)
     check_read_timeout(read_timeout)
 
@@ -2087,6 +2087,7 @@ def calibrate_from_bag(
     """
     from stereovision.rosbag import BagCamera
 
+    _check_board(board)  # '10x7' was AttributeError "'str' object has no attribute 'inner'"
     max_pairs = _check_max_pairs(max_pairs)
     cam = BagCamera(path, left_topic=left_topic, right_topic=right_topic, max_skew_ms=max_skew_ms)
     return _calibrate_from_camera(
@@ -2099,6 +2100,14 @@ def calibrate_from_bag(
         log=log,
         **kwargs,
     )
+
+
+def _check_board(board: object) -> None:
+    """A ValueError naming ``board`` when it is given and is no ChArUco board."""
+    if board is not None and not isinstance(board, CharucoBoard):
+        raise ValueError(
+            f"board: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
+        )
 
 
 def _check_max_pairs(max_pairs: object) -> int:
