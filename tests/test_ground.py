@@ -1910,6 +1910,27 @@ def test_point_functions_name_a_whole_result() -> None:
             call(DepthResult())
 
 
+def test_point_functions_refuse_complex_points() -> None:
+    """Complex points lost their imaginary part with NumPy's ComplexWarning (the heights, grid
+    and scan of the real part, without an error), where fit_ground_plane and support refuse a
+    complex map."""
+    from stereovision.ground import laser_scan, obstacle_mask, occupancy_grid
+
+    plane, _ = _level_floor()
+    pts = np.asarray(_camera_points([(2.0, 0.0, 0.5), (2.5, 0.5, 0.5)]), complex) + 1j
+    calls = [
+        lambda: obstacle_mask(pts.reshape(1, -1, 3), plane),
+        lambda: occupancy_grid(pts, plane),
+        lambda: laser_scan(pts, plane, angle_min=-1.0, angle_max=1.0, angle_increment=0.1),
+        lambda: plane.height_of(pts),
+    ]
+    for call in calls:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(ValueError, match=r"^points: expected real points, got complex"):
+                call()
+
+
 def test_a_scan_from_0_to_2_pi_sees_the_right_side() -> None:
     """A scan given as 0 to 2 pi (REP 103 allows any start) lost every point to the right of
     the optical axis (arctan2's negative angles fell before beam 0): the obstacle 0.5 rad to

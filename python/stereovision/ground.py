@@ -193,10 +193,7 @@ class GroundPlane:
         ndarray, float64
             ``(...)`` heights, metres.
         """
-        from stereovision._validate import not_a_result
-
-        not_a_result(points, "points", "points")  # "float() argument must be ..."
-        pts = np.asarray(points, np.float64)
+        pts = _points_array(points, "points")
         if pts.ndim == 0 or pts.shape[-1] != 3:
             raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
         out: F64 = pts @ self.normal + self.height  # the camera (X = 0) is at +height
@@ -759,6 +756,19 @@ def _disparity_map(disparity: npt.ArrayLike) -> F64:
     return disp
 
 
+def _points_array(points: npt.ArrayLike, field: str) -> F64:
+    """``points`` as a float64 array, after the checks of what is none: a whole
+    ``DepthResult`` (TypeError naming ``result.<field>``: it was "float() argument must be ...
+    not 'DepthResult'") and complex values (NumPy dropped the imaginary part with a warning).
+    """
+    from stereovision._validate import not_a_result
+
+    not_a_result(points, "points", field)
+    if np.iscomplexobj(points):
+        raise ValueError("points: expected real points, got complex values")
+    return np.asarray(points, np.float64)
+
+
 def _no_floor_line(disparity: npt.ArrayLike, calib: Calibration) -> str:
     """The line for a map :func:`fit_ground_plane` (default parameters) found no floor in, with
     the reason that holds: under :data:`MIN_PIXELS` disparities (finite, in front of the
@@ -813,13 +823,10 @@ def obstacle_mask(
     Raises
     ------
     ValueError
-        For points not of shape ``(H, W, 3)`` or an empty or negative band.
+        For points not real or not of shape ``(H, W, 3)``, or an empty or negative band.
     """
     _require_type(plane, "GroundPlane", "plane")
-    from stereovision._validate import not_a_result
-
-    not_a_result(points, "points", "point_image()")
-    pts = np.asarray(points, np.float64)
+    pts = _points_array(points, "point_image()")
     if pts.ndim != 3 or pts.shape[2] != 3:
         # res.points is the cloud, one row per pixel with a depth: no image to mark
         cloud = pts.ndim == 2 and pts.shape[1:] == (3,)
@@ -1058,15 +1065,13 @@ def occupancy_grid(
     Raises
     ------
     ValueError
-        For points not of shape ``(..., 3)``, a non-positive resolution, an extent not two
-        numbers or empty, a grid over 4096 cells a side, or a bad height band.
+        For points not real or not of shape ``(..., 3)``, a non-positive resolution, an extent
+        not two numbers or empty, a grid over 4096 cells a side, or a bad height band.
     """
     _require_type(plane, "GroundPlane", "plane")
-    from stereovision._validate import not_a_result, positive_finite
+    from stereovision._validate import positive_finite
 
-    # a whole DepthResult was "float() argument must be ... not 'DepthResult'"
-    not_a_result(points, "points", "point_image()")
-    pts = np.asarray(points, np.float64)
+    pts = _points_array(points, "point_image()")
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
     res = positive_finite(resolution, "resolution")
@@ -1271,9 +1276,10 @@ def laser_scan(
     Raises
     ------
     ValueError
-        For points not of shape ``(..., 3)``, no angles (no ``calib`` and no ``angle_min`` /
-        ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or over 100000
-        beams, a bad height band or range (``range_max`` infinite too), or ``min_points < 1``.
+        For points not real or not of shape ``(..., 3)``, no angles (no ``calib`` and no
+        ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or
+        over 100000 beams, a bad height band or range (``range_max`` infinite too), or
+        ``min_points < 1``.
     TypeError
         If ``plane`` is not a :class:`GroundPlane`, or ``calib`` is given and is not a
         :class:`~stereovision.Calibration` (a path: read it with ``Calibration.from_file``).
@@ -1281,11 +1287,9 @@ def laser_scan(
     _require_type(plane, "GroundPlane", "plane")
     if calib is not None:  # a path or a dict was AttributeError "'str' object has no attribute"
         _require_type(calib, "Calibration", "calib")
-    from stereovision._validate import not_a_result, positive_finite
+    from stereovision._validate import positive_finite
 
-    # a whole DepthResult was "float() argument must be ... not 'DepthResult'"
-    not_a_result(points, "points", "point_image()")
-    pts = np.asarray(points, np.float64)
+    pts = _points_array(points, "point_image()")
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
     lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
