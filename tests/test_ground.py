@@ -1975,6 +1975,17 @@ def test_occupancy_grid_save_refuses_a_directory_that_is_no_path(
     assert list(tmp_path.iterdir()) == []
 
 
+def test_occupancy_grid_save_into_a_file_says_it_is_no_folder(tmp_path: Path) -> None:
+    """A file where the folder goes was mkdir's bare "[Errno 17] File exists: '.../maps'"."""
+    from stereovision.ground import OccupancyGrid
+
+    (tmp_path / "maps").write_bytes(b"x")
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    with pytest.raises(FileExistsError, match=r"^cannot write the map into .*maps: it is a file"):
+        grid.save(tmp_path / "maps")
+    assert (tmp_path / "maps").read_bytes() == b"x"
+
+
 @pytest.mark.parametrize("name", ["run #3", "lab: 2", "*x", "[a]", 'say "hi"', "é\tb", "map"])
 def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: str) -> None:
     """map.yaml's 'image: run #3.png' read as 'run' (YAML took the rest for a comment), and

@@ -958,8 +958,9 @@ class OccupancyGrid:
         RuntimeError
             If the grid could not be encoded as PNG.
         OSError
-            If a file could not be written; the previous pair is then intact (should putting a
-            previous file back fail too, its copy is kept and named in the exception's notes).
+            If ``directory`` is a file (FileExistsError), or a file could not be written; the
+            previous pair is then intact (should putting a previous file back fail too, its
+            copy is kept and named in the exception's notes).
         """
         import json
         import re
@@ -973,6 +974,8 @@ class OccupancyGrid:
 
         # Path(str(...)): b"/tmp/maps" wrote into a folder named "b'", None into "None"
         d = as_path(directory, "directory")
+        if d.exists() and not d.is_dir():  # mkdir's "[Errno 17] File exists: 'maps'"
+            raise FileExistsError(f"cannot write the map into {d}: it is a file, not a folder")
         d.mkdir(parents=True, exist_ok=True)
         png, yml = d / f"{name}.png", d / f"{name}.yaml"
         ok, buf = cv2.imencode(".png", self.image())
