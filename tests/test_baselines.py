@@ -589,3 +589,20 @@ def test_a_width_that_holds_only_the_16_px_range_names_it(fn, width: int, need: 
                        r"max_disparity of at most 16$"):  # fmt: skip
         fn(img, img, 32)
     assert fn(img, img, 16).shape == (30, width)
+
+
+def test_row_fill_refuses_a_value_beyond_float32_rather_than_fill_over_it() -> None:
+    """A float64 map's finite 1e300 became inf in the float32 cast and was filled over as a
+    hole ([[1e300, NaN, 2]] -> [[2, 2, 2]], only NumPy's overflow warning); it is refused."""
+    with pytest.raises(
+        ValueError,
+        match=r"^disparity: 2 finite value\(s\) beyond float32's range \(e\.g\. 1e\+300\) "
+        r"would be filled over as holes$",
+    ):
+        row_fill(np.array([[1e300, np.nan, 2.0], [np.nan, -1e300, 1.0]]))
+    # the float32 range's edge, an inf (a hole) and float64 values within range read as before
+    big = float(np.finfo(np.float32).max)
+    np.testing.assert_array_equal(
+        row_fill(np.array([[big, np.nan, 2.0], [np.inf, 1.5, np.nan]])),
+        np.array([[big, 2.0, 2.0], [1.5, 1.5, 1.5]], np.float32),
+    )
