@@ -45,7 +45,9 @@ def main() -> None:
             sc.left, sc.right, max_disparity=md, method="fast", fill=False
         ).disparity,
     }
-    valid = np.isfinite(gt) & (gt > 0)
+    # evaluation.md's known GT (finite; a 0 px GT counts, as in dense_metrics and
+    # plot_bad2_panels): "& gt > 0" left a 0 px pixel out of the titles' shares
+    valid = np.isfinite(gt)
     vmax = float(np.nanmax(gt[valid]))
     fig, axes = plt.subplots(2, 2, figsize=(10, 8.4))
     axes[0, 0].imshow(sc.left[..., ::-1] if sc.left.ndim == 3 else sc.left, cmap="gray")
