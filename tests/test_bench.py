@@ -76,7 +76,11 @@ _RUNS_ERROR = "stereovision bench: error: argument --runs: expected "
         ),
         (["bench", "--runs", "0"], _RUNS_ERROR + "at least 5 runs"),
         (["bench", "--runs", "4.5"], _RUNS_ERROR + "a whole number, got '4.5'"),
-        (["bench", "/no/such/folder"], "stereovision: error: scene root not found"),
+        # eval's words for the same folder (it was 'scene root not found: /no/such/folder')
+        (
+            ["bench", "/no/such/folder"],
+            "stereovision: error: scene folder not found: /no/such/folder",
+        ),
         # any count was taken: 10**20 timed the cases until killed
         (["bench", "--runs", "1001", "/no/such"], _RUNS_ERROR + "at most 1000 runs, got '1001'"),
         (

@@ -335,9 +335,11 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
         return [Path(str(resources.files("stereovision") / "data" / "cones"))]
     dirs: list[Path] = []
     for d in paths:
-        if Path(d).exists() and not Path(d).is_dir():  # find_scenes: "scene root not found"
+        if not Path(d).exists():  # as eval says it (scan_scenes: "scene root not found")
+            raise FileNotFoundError(f"scene folder not found: {d}")
+        if not Path(d).is_dir():  # find_scenes: "scene root not found"
             raise ValueError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
-        found, half = scan_scenes(d)  # FileNotFoundError for a missing folder
+        found, half = scan_scenes(d)
         if not found:
             # eval's line: a half scene skipped, or a JPEG pair, was not named
             raise ValueError(_no_scene_under(Path(d), d, half))
