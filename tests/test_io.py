@@ -2499,3 +2499,20 @@ def test_a_socket_destination_is_refused_as_a_socket(
     if Path("/dev/null").exists():
         with pytest.raises(OSError, match=r"\(a character device\)$"), atomic_write("/dev/null"):
             pass
+
+
+def test_keep_previous_takes_a_legal_name_whose_suffix_is_long(tmp_path: Path) -> None:
+    """'x.' + 250 letters (252 bytes, legal) hung keep_previous: '.previous' + its 251-byte
+    suffix left the stem no room, and cutting it to '' never fitted. The whole name is cut
+    now, the copy made."""
+    from stereovision.io import keep_previous
+
+    dest = tmp_path / ("x." + "b" * 250)
+    dest.write_bytes(b"old")
+    kept = keep_previous(dest, b"new")
+    assert kept is not None and kept.read_bytes() == b"old"
+    assert kept.name == "x." + "b" * 244 + ".previous"  # 255 bytes
+    assert keep_previous(dest, b"newer") == kept  # already kept byte for byte
+    dest.write_bytes(b"other")
+    second = keep_previous(dest, b"new")
+    assert second is not None and second.name == "x." + "b" * 242 + ".previous.2"

@@ -444,11 +444,14 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     # compared and copied in chunks, not read whole: besides calibrations, `demo` keeps a
     # cloud.ply of any size aside this way
     n = 1
+    # a "suffix" too long to keep beside .previous ('x.' + 250 letters, a legal name) is the
+    # name's body: the whole name is cut instead (cutting the stem alone never fitted: a hang)
+    stem, suffix = (p.stem, p.suffix) if len(os.fsencode(p.suffix)) <= 200 else (p.name, "")
     while True:
-        tail = f".previous{'' if n == 1 else f'.{n}'}{p.suffix}"
+        tail = f".previous{'' if n == 1 else f'.{n}'}{suffix}"
         # the stem is cut when NAME.previous.EXT would pass NAME_MAX ("File name too long"
         # refused the write of a legal 250-byte name)
-        kept = p.with_name(_fit_name(p.stem, _NAME_MAX - len(os.fsencode(tail))) + tail)
+        kept = p.with_name(_fit_name(stem, _NAME_MAX - len(os.fsencode(tail))) + tail)
         # a link is taken, not followed: a dangling one had the copy made at its target
         # (elsewhere), one to NAME.EXT itself passed for the copy of the file about to be
         # replaced, and a looping one failed after the work; none is a copy this made
@@ -590,7 +593,7 @@ _NAME_MAX = 255
 
 def _fit_name(name: str, room: int) -> str:
     """``name`` cut to at most ``room`` bytes in the filesystem's encoding (whole characters)."""
-    while len(os.fsencode(name)) > room:
+    while name and len(os.fsencode(name)) > room:  # "" ends it: a room below 0 looped on it
         name = name[:-1]
     return name
 
