@@ -659,6 +659,20 @@ def test_sparse_metrics_names_an_argument_that_is_no_array_of_numbers() -> None:
     assert sparse_metrics(m.xl, m.yl, m.xr, gt).count == 1
 
 
+def test_sparse_metrics_refuses_complex_positions_and_scores() -> None:
+    """A complex array lost its imaginary part with NumPy's ComplexWarning alone: xl 1+4j was
+    read as 1 (count 1), where dense_metrics refuses a complex map."""
+    gt = np.ones((4, 6))
+    x, y = np.array([1.0]), np.array([1.0])
+    with pytest.raises(
+        ValueError, match=r"^xl: expected a 1-D array of real numbers, got complex values$"
+    ):
+        sparse_metrics(np.array([1 + 4j]), y, x - 1, gt)
+    with pytest.raises(ValueError, match=r"^score: expected a 1-D array of real numbers"):
+        count_at_precision(x, y, x - 1, np.array([0.9 + 0j]), gt, 90.0)
+    assert sparse_metrics(x, y, x - 1, gt).count == 1
+
+
 def test_dense_metrics_refuses_a_mask_of_another_shape() -> None:
     # a one-row mask was broadcast over every row, without a word
     gt = np.ones((2, 3))

@@ -648,6 +648,10 @@ def _coordinates(values: object, name: str) -> npt.NDArray[np.float64]:
     sequence. The requested array would exceed the maximum number of dimension of 64", a
     string "could not convert string to float: 'a'".
     """
+    if isinstance(values, np.ndarray) and values.dtype.kind == "c":
+        # the cast dropped the imaginary part with NumPy's ComplexWarning alone (1+4j read as 1);
+        # a list of complex numbers is refused below (float() takes none)
+        raise ValueError(f"{name}: expected a 1-D array of real numbers, got complex values")
     try:
         return np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):
@@ -680,7 +684,7 @@ def sparse_metrics(
     Raises
     ------
     ValueError
-        If ``xl``, ``yl``, ``xr`` are not 1-D arrays of numbers of equal length or ``gt`` is
+        If ``xl``, ``yl``, ``xr`` are not 1-D arrays of real numbers of equal length or ``gt`` is
         not 2-D.
     """
     g = _real_2d(gt, "gt")
