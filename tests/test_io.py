@@ -2516,3 +2516,22 @@ def test_keep_previous_takes_a_legal_name_whose_suffix_is_long(tmp_path: Path) -
     dest.write_bytes(b"other")
     second = keep_previous(dest, b"new")
     assert second is not None and second.name == "x." + "b" * 242 + ".previous.2"
+
+
+def test_atomic_write_refuses_a_name_ending_in_a_slash(tmp_path: Path) -> None:
+    """'new/' (no such folder) was written as a file named 'new': Path() drops the slash,
+    where open('new/', 'w') refuses it. It is refused now, nothing made."""
+    from stereovision.io import atomic_write
+
+    given = f"{tmp_path}/new/"
+    with pytest.raises(
+        IsADirectoryError,
+        match=r"^cannot write .*/new/: a name ending in '/' is a folder's; give a file name$",
+    ):
+        with atomic_write(given) as fh:
+            fh.write(b"x")
+    assert list(tmp_path.iterdir()) == []
+    # an existing folder is refused as before
+    with pytest.raises(IsADirectoryError, match=r": it is a folder; give a file name$"):
+        with atomic_write(f"{tmp_path}/"):
+            pass

@@ -635,12 +635,19 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     FileNotFoundError
         If the destination directory does not exist.
     IsADirectoryError, NotADirectoryError
-        If ``path`` is a folder, or its directory is a file.
+        If ``path`` is a folder or a name ending in ``/`` (a folder's), or its directory is a
+        file.
     OSError
         If ``path`` is a link that loops, or a FIFO, a socket or a device (replaced, the reader
         waiting on it got nothing), or a link to one.
     """
     given = as_path(path, file=True)
+    text = os.fspath(path)
+    if text.endswith(("/", os.sep)) and not given.is_dir():
+        # Path() drops the slash: 'new/' was written as a file named 'new' (open() refuses it)
+        raise IsADirectoryError(
+            f"cannot write {text}: a name ending in '/' is a folder's; give a file name"
+        )
     dest = _through_links(given)
     _writable_destination(dest, given)
     fd, tmp = _temp_beside(dest, ".tmp")
