@@ -486,6 +486,19 @@ try:
                 call()
             except (ValueError, MemoryError) as e:
                 print(f"{{type(e).__name__}}: {{e}}")
+    elif case == "params_before_copies":
+        # a bad scalar with 16 GiB views: said before the copies
+        grey = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
+        nan = float("nan")
+        for call in (
+            lambda: _core.gabor_responses(grey, freq=nan),
+            lambda: _core.depth_rectified(grey, grey, nan, 0, 1, 0, 0.1, 1),
+            lambda: _core.gabor_newton_step(grey, grey, grey, freq=nan),
+        ):
+            try:
+                call()
+            except (ValueError, MemoryError) as e:
+                print(f"{{type(e).__name__}}: {{e}}")
     elif case in ("log_too_large", "log_bad_sigma"):
         img = np.broadcast_to(np.float32(0.5), (2**16, 2**16))
         try:
@@ -618,6 +631,22 @@ def test_sgm_and_newton_step_refuse_a_mismatched_pair_before_copying_it() -> Non
         "(width, height)"
     )
     assert out.stdout.splitlines() == [differ] * 2, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_scalar_kernels_refuse_a_bad_parameter_before_copying() -> None:
+    """``gabor_responses``, ``depth_rectified`` and ``gabor_newton_step`` copied a broadcast
+    65536 x 65536 image or map (16 GiB each) before the kernel refused a NaN ``freq`` or
+    ``fb``: "MemoryError: out of memory: a copy of img needs 16.00 GiB" under ``ulimit -v``
+    (the memory taken without one). The kernel's own words now, before any copy."""
+    out = _under_address_limit("params_before_copies", 3_000_000 * 1024, timeout=60)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    freq = "ValueError: invalid parameter `freq`: must be in (0, 0.5) cycles/px, got NaN"
+    assert out.stdout.splitlines() == [
+        freq,
+        "ValueError: invalid parameter `fb`: must be finite, got NaN",
+        freq,
+    ], out.stdout
 
 
 @pytest.mark.parametrize("channels", [2, 5])

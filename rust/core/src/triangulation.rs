@@ -25,20 +25,9 @@ pub struct SigmaModel {
     pub s_fill: f32,
 }
 
-/// `(depth, sigma)` of a `w` x `h` rectified disparity map: `fb = f B` (px times the output
-/// unit), `doffs` the principal-point offset (px). NaN where the disparity is not finite, where
-/// `d + doffs <= sigma_d` (or `<= 0`), or where the depth is not finite.
-pub fn depth_rectified(
-    disp: &[f32],
-    conf: &[f32],
-    w: usize,
-    h: usize,
-    fb: f32,
-    doffs: f32,
-    sigma: SigmaModel,
-) -> Result<(Vec<f32>, Vec<f32>)> {
-    check_map_pair(disp, conf, w, h)?;
-    let n = w * h;
+/// [`depth_rectified`]'s scalar parameters alone, so a binding can check them before it
+/// copies the maps (a broadcast 65536 x 65536 map was a 16 GiB copy before a NaN `fb` was said).
+pub fn check_params(fb: f32, doffs: f32, sigma: SigmaModel) -> Result<()> {
     for (name, v) in [
         ("fb", fb),
         ("doffs", doffs),
@@ -57,6 +46,24 @@ pub fn depth_rectified(
             return Err(CoreError::param(name, format!("must be > 0, got {v}")));
         }
     }
+    Ok(())
+}
+
+/// `(depth, sigma)` of a `w` x `h` rectified disparity map: `fb = f B` (px times the output
+/// unit), `doffs` the principal-point offset (px). NaN where the disparity is not finite, where
+/// `d + doffs <= sigma_d` (or `<= 0`), or where the depth is not finite.
+pub fn depth_rectified(
+    disp: &[f32],
+    conf: &[f32],
+    w: usize,
+    h: usize,
+    fb: f32,
+    doffs: f32,
+    sigma: SigmaModel,
+) -> Result<(Vec<f32>, Vec<f32>)> {
+    check_map_pair(disp, conf, w, h)?;
+    check_params(fb, doffs, sigma)?;
+    let n = w * h;
     // Checked: a failed `vec!` aborted the process.
     let mut depth = try_zeroed::<f32>(n, "the depth map")?;
     let mut sig = try_zeroed::<f32>(n, "the depth sigma map")?;

@@ -3,6 +3,7 @@
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use stereovision_core::matching::gabor::{
+    filter::Channel,
     gabor_disparity_view as core_gabor, gabor_newton_step as core_step,
     gabor_responses as core_resp,
     post::{lr_check, remove_speckles},
@@ -181,6 +182,9 @@ pub fn gabor_responses<'py>(
              {theta_deg}"
         )));
     }
+    // The channel's own checks before the image's copy: a broadcast 65536 x 65536 image was a
+    // 16 GiB copy (a MemoryError under a memory limit) before a NaN `freq` was refused.
+    Channel::new(freq, theta_deg, bandwidth_oct, aspect).map_err(crate::errors::to_pyerr)?;
     let im = image_from_numpy(&img, "img")?;
     let (w, h) = im.size();
     let (re, imag) = crate::workers::detach(py, || {
@@ -226,10 +230,6 @@ pub fn gabor_newton_step<'py>(
     }
     // right's shape too before either copy (a broadcast left was copied first)
     crate::errors::check_pair_shapes(img_dim, right.as_array().dim())?;
-    let l = image_from_numpy(&left, "left")?;
-    let r = image_from_numpy(&right, "right")?;
-    let d = image_from_numpy(&disp, "disp")?;
-    let (w, h) = l.size();
     let p = GaborParams {
         freq,
         orientations_deg: orientations_deg
@@ -240,6 +240,15 @@ pub fn gabor_newton_step<'py>(
         stability_tau,
         ..GaborParams::default()
     };
+    // The kernel's parameter checks before the three copies too (a NaN `freq` was refused
+    // only after 48 GiB of broadcast 65536 x 65536 arrays were copied).
+    p.validate()
+        .and_then(|()| p.channels())
+        .map_err(crate::errors::to_pyerr)?;
+    let l = image_from_numpy(&left, "left")?;
+    let r = image_from_numpy(&right, "right")?;
+    let d = image_from_numpy(&disp, "disp")?;
+    let (w, h) = l.size();
     let (delta, conf) = crate::workers::detach(py, || {
         guard("gabor_newton_step", || core_step(&l, &r, &d, &p))
     })?;

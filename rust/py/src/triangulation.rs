@@ -2,10 +2,10 @@
 
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
-use stereovision_core::triangulation::{depth_rectified as core_depth, SigmaModel};
+use stereovision_core::triangulation::{check_params, depth_rectified as core_depth, SigmaModel};
 
 use crate::convert::{image_to_numpy, map_and_confidence};
-use crate::errors::guard;
+use crate::errors::{guard, to_pyerr};
 use stereovision_core::Image;
 
 type Pair<'py> = (
@@ -31,14 +31,17 @@ pub fn depth_rectified<'py>(
 ) -> PyResult<Pair<'py>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let conf: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(conf, "conf")?;
-    let (h, w) = disp.as_array().dim();
-    let (d, c) = map_and_confidence(&disp, &conf, (h, w), "disp")?;
     let m = SigmaModel {
         s0,
         slope,
         s_min,
         s_fill,
     };
+    // The kernel's parameter check before the maps' copies: a broadcast 65536 x 65536 map was
+    // a 16 GiB copy (a MemoryError under a memory limit) before a NaN `fb` was refused.
+    check_params(fb, doffs, m).map_err(to_pyerr)?;
+    let (h, w) = disp.as_array().dim();
+    let (d, c) = map_and_confidence(&disp, &conf, (h, w), "disp")?;
     let (z, s) = crate::workers::detach(py, || {
         guard("depth_rectified", || core_depth(&d, &c, w, h, fb, doffs, m))
     })?;
