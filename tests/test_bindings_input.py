@@ -1307,6 +1307,13 @@ def test_refine_disparity_names_the_bound_it_refuses(d_min: float, d_max: float,
             "invalid parameter `compat_theta`: expected a number within float32's range, the "
             "kernel's precision, got -1e+39",
         ),
+        (
+            # an int past a double in a dict's float slot: it was "parameter `sides_mad`:
+            # OverflowError: int too large to convert to float"
+            lambda a: _core.mcgm_match(a, a, {"sides_mad": 10**400}),
+            "invalid parameter `sides_mad`: expected a number within float32's range, the "
+            f"kernel's precision, got {10**400}",
+        ),
     ],
 )
 def test_a_float_argument_float32_cannot_hold_is_named(

@@ -44,6 +44,15 @@ pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py> + Slot>(
                         "invalid parameter `{key}`: expected {range}, got {got}"
                     ))
                 }
+                // An int past a double in a float slot: the functions' arguments' words
+                // (it was "parameter `sides_mad`: OverflowError: int too large to convert to
+                // float").
+                _ if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(py) => {
+                    match T::check_exact(&v, key) {
+                        Err(said) => said,
+                        Ok(()) => PyValueError::new_err(format!("parameter `{key}`: {e}")),
+                    }
+                }
                 _ => PyValueError::new_err(format!("parameter `{key}`: {e}")),
             }
         })?;
