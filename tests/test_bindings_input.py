@@ -1314,6 +1314,12 @@ def test_refine_disparity_names_the_bound_it_refuses(d_min: float, d_max: float,
             "invalid parameter `sides_mad`: expected a number within float32's range, the "
             f"kernel's precision, got {10**400}",
         ),
+        (
+            # a list's angle: it was cut to inf ("each must be in (-90, 90) degrees ..., got inf")
+            lambda a: _core.gabor_newton_step(a, a, a, orientations_deg=[0.0, 1e39]),
+            "invalid parameter `orientations_deg`: expected a number within float32's range, "
+            "the kernel's precision, got 1e+39",
+        ),
     ],
 )
 def test_a_float_argument_float32_cannot_hold_is_named(

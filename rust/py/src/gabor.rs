@@ -98,7 +98,7 @@ pub fn gabor_disparity<'py>(
     #[pyo3(from_py_with = d_min_f32)] d_min: f32,
     #[pyo3(from_py_with = d_max_f32)] d_max: f32,
     #[pyo3(from_py_with = freq_f32)] freq: f32,
-    orientations_deg: Option<Vec<f32>>,
+    #[pyo3(from_py_with = orientations_deg_arg)] orientations_deg: Option<Vec<f32>>,
     #[pyo3(from_py_with = bandwidth_oct_f32)] bandwidth_oct: f32,
     #[pyo3(from_py_with = aspect_f32)] aspect: f32,
     #[pyo3(from_py_with = n_levels_arg)] n_levels: Option<usize>,
@@ -212,7 +212,7 @@ pub fn gabor_newton_step<'py>(
     right: &Bound<'py, PyAny>,
     disp: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = freq_f32)] freq: f32,
-    orientations_deg: Option<Vec<f32>>,
+    #[pyo3(from_py_with = orientations_deg_arg)] orientations_deg: Option<Vec<f32>>,
     #[pyo3(from_py_with = bandwidth_oct_f32)] bandwidth_oct: f32,
     #[pyo3(from_py_with = aspect_f32)] aspect: f32,
     #[pyo3(from_py_with = amp_rel_thresh_f32)] amp_rel_thresh: f32,
@@ -352,4 +352,19 @@ crate::named_floats! {
     theta_deg_f32: f32 = "theta_deg";
     tol_f32: f32 = "tol";
     max_diff_f32: f32 = "max_diff";
+}
+
+/// `orientations_deg`, each angle through [`FloatArg`](crate::params::FloatArg) as the scalar
+/// arguments are: `[1e39]` was cut to inf ("each must be in (-90, 90) degrees ..., got inf") and
+/// `[10**400]` a bare "OverflowError: int too large to convert to float".
+fn orientations_deg_arg(ob: &Bound<'_, PyAny>) -> PyResult<Option<Vec<f32>>> {
+    if ob.is_none() {
+        return Ok(None);
+    }
+    let items: Vec<Bound<'_, PyAny>> = ob.extract()?;
+    items
+        .iter()
+        .map(|v| <f32 as crate::params::FloatArg>::extract_named(v, "orientations_deg"))
+        .collect::<PyResult<Vec<f32>>>()
+        .map(Some)
 }
