@@ -3615,6 +3615,31 @@ def test_capture_averages_still_frames_when_asked(data_dir):
     assert app.state.source_label.endswith("(8.0 frames averaged)")
 
 
+def test_averaging_16_bit_frames_is_refused_naming_the_source(tmp_path):
+    """The acquisition panel's "average" of a 16-bit image sequence said "left: expected a
+    uint8 image, got uint16", the filter's words for an argument the user never passed (as
+    capture --temporal did before 256afa8d); it now says capture --temporal's words. Without
+    averaging the frames are read as they are."""
+    from stereovision.gui.app import _read_pair
+    from stereovision.gui.sources import open_stereo_source
+
+    for i in range(3):
+        deep = np.full((24, 32), 100 + i, np.uint16) * 257
+        cv2.imwrite(str(tmp_path / f"left_{i:03d}.png"), deep)
+        cv2.imwrite(str(tmp_path / f"right_{i:03d}.png"), (deep // 257).astype(np.uint8))
+    src = open_stereo_source(str(tmp_path / "left_%03d.png"), str(tmp_path / "right_%03d.png"))
+    try:
+        assert _read_pair(src, False).left.dtype == np.uint16
+        with pytest.raises(ValueError) as info:
+            _read_pair(src, True)
+    finally:
+        src.close()
+    assert str(info.value) == (
+        "temporal averaging takes 8-bit frames: the left source delivers uint16 ones (a 16-bit "
+        "image sequence?); convert them to 8 bits, or leave the averaging out"
+    )
+
+
 def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
     """Two videos of different sizes open, but give no pair: "Open" closed the cameras in use
     and kept the unusable pair, so every later Capture failed (and a capture was labelled with

@@ -2208,6 +2208,27 @@ def _averaged_before_resize(frame: StereoFrame) -> bool:
     return d is not None and d[0].shape == d[1].shape and d[0].shape[1] < frame.left.shape[1]
 
 
+def _check_8_bit_frames(left: np.ndarray, right: np.ndarray) -> None:
+    """Refuse frames that temporal averaging cannot take, naming the source that delivers them
+    (``temporal_average``'s check, the GUI's "average" too).
+
+    Raises
+    ------
+    ValueError
+        If a source delivers frames of more than 8 bits (a 16-bit image sequence), which the
+        filter does not average.
+    """
+    for side, img in (("left", left), ("right", right)):
+        if img.dtype != np.uint8:
+            # the filter's own words named a "left" image the caller never passed: "left:
+            # expected a uint8 image, got uint16"
+            hint = " (a 16-bit image sequence?)" if img.dtype == np.uint16 else ""
+            raise ValueError(
+                f"temporal averaging takes 8-bit frames: the {side} source delivers {img.dtype} "
+                f"ones{hint}; convert them to 8 bits, or leave the averaging out"
+            )
+
+
 def temporal_average(tf: Any, frame: StereoFrame) -> tuple[np.ndarray, np.ndarray]:
     """``tf(left, right)`` (a :class:`~stereovision.temporal.TemporalFilter`) of a pair, on
     the frames as delivered when the source enlarged them (:attr:`StereoFrame.delivered`), the
@@ -2233,15 +2254,7 @@ def temporal_average(tf: Any, frame: StereoFrame) -> tuple[np.ndarray, np.ndarra
         If a source delivers frames of more than 8 bits (a 16-bit image sequence), which the
         filter does not average.
     """
-    for side, img in (("left", frame.left), ("right", frame.right)):
-        if img.dtype != np.uint8:
-            # the filter's own words named a "left" image the caller never passed: "left:
-            # expected a uint8 image, got uint16"
-            hint = " (a 16-bit image sequence?)" if img.dtype == np.uint16 else ""
-            raise ValueError(
-                f"temporal averaging takes 8-bit frames: the {side} source delivers {img.dtype} "
-                f"ones{hint}; convert them to 8 bits, or leave the averaging out"
-            )
+    _check_8_bit_frames(frame.left, frame.right)
     if not _averaged_before_resize(frame):
         left, right = tf(frame.left, frame.right)
         return left, right

@@ -1252,7 +1252,8 @@ def _read_pair(source: StereoSource, average: bool) -> _Frames:
     Raises
     ------
     ValueError
-        The two frames differ in size.
+        The two frames differ in size, or ``average`` of frames of more than 8 bits (a 16-bit
+        image sequence), which the filter does not average.
     OSError, RuntimeError
         As the source's read raises them (a read given up after ``read_timeout``).
     """
@@ -1272,8 +1273,12 @@ def _read_pair(source: StereoSource, average: bool) -> _Frames:
 
             got.calib = Calibration.from_file(job.calib)
     elif average:
+        from stereovision.capture import _check_8_bit_frames
         from stereovision.temporal import TemporalFilter
 
+        # a 16-bit image sequence or bag was "left: expected a uint8 image, got uint16", the
+        # filter's words for an argument the user never passed (capture --temporal's check)
+        _check_8_bit_frames(left, right)
         tf = TemporalFilter(max_frames=AVERAGE_FRAMES)
         got.left, got.right = tf(left, right)
         for _ in range(AVERAGE_FRAMES - 1):
