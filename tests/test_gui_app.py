@@ -3640,6 +3640,20 @@ def test_averaging_16_bit_frames_is_refused_naming_the_source(tmp_path):
     )
 
 
+def test_a_16_bit_pair_is_shown_as_it_looks_not_white():
+    """A 16-bit image sequence's pair went to the page as it came: JPEG holds 8 bits, and
+    OpenCV cut every level to 255, both images shown white. It is shown at 8 bits now
+    (uint16 / 257, a float image in [0, 1] times 255), as an 8-bit pair of it is."""
+    from stereovision.gui.app import _data_url
+
+    img = np.tile(np.linspace(20, 220, 64).astype(np.uint8), (48, 1))
+    flat = _decode(_data_url(img))
+    for deep in (img.astype(np.uint16) * 257, img.astype(np.float32) / 255):
+        shown = _decode(_data_url(deep))
+        assert np.abs(shown - flat).max() <= 1, (deep.dtype, shown.min(), shown.max())
+    assert flat.min() < 30 and flat.max() > 210
+
+
 def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
     """Two videos of different sizes open, but give no pair: "Open" closed the cameras in use
     and kept the unusable pair, so every later Capture failed (and a capture was labelled with

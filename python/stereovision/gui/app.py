@@ -445,8 +445,14 @@ def _cannot_make(folder: Path) -> str | None:
 
 
 def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
-    """A BGR image as a JPEG ``data:`` URL, scaled down to ``width`` pixels."""
+    """A BGR image as a JPEG ``data:`` URL, scaled down to ``width`` pixels; one of more than
+    8 bits (a 16-bit image sequence's) shown at 8 (:func:`~stereovision._validate.as_bgr_uint8`)."""
     shown: Any = image
+    if image.dtype != np.uint8:
+        from stereovision._validate import as_bgr_uint8
+
+        # JPEG holds 8 bits: OpenCV cut a 16-bit frame to 255, the pair shown white
+        shown = image = as_bgr_uint8(image, "image")
     if image.shape[1] > width:
         h = max(1, round(image.shape[0] * width / image.shape[1]))
         shown = cv2.resize(image, (width, h), interpolation=cv2.INTER_AREA)
