@@ -58,7 +58,7 @@ lint: $(STAMP)  ## cargo fmt/clippy, ruff, mypy
 	$(VENV)/bin/mypy
 
 test-py: build  ## pytest (parity, API, CLI, accuracy)
-	$(PY) -m pytest -q -n auto --dist worksteal --durations=5
+	$(PY) -m pytest -q -n auto --dist loadfile --durations=5
 
 test: build system-deps test-rust lint test-py  ## everything CI runs
 
