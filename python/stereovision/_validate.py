@@ -1450,6 +1450,45 @@ def float32_reach(value: _T) -> _T | float:
     return math.copysign(math.inf, v)
 
 
+def refuse_beyond_float32(a: npt.NDArray[Any], name: str, fate: str) -> None:
+    """Refuse a float64 (or wider) array holding finite values beyond float32's range.
+
+    The float32 cast makes a finite 1e300 an inf with only NumPy's overflow warning; ``fate``
+    says what would then become of it ("would be written as inf"). Narrower floats and
+    integers pass unlooked-at (no integer reaches float32's max).
+
+    Parameters
+    ----------
+    a : numpy.ndarray
+        The array about to be cast to float32.
+    name : str
+        The argument's name, for the message.
+    fate : str
+        What the cast would make of such a value, for the message.
+
+    Raises
+    ------
+    ValueError
+        If ``a`` holds a finite value beyond float32's range.
+
+    Examples
+    --------
+    >>> refuse_beyond_float32(np.array([1.0, 1e300]), "arr", "would be written as inf")
+    Traceback (most recent call last):
+    ...
+    ValueError: arr: 1 finite value(s) beyond float32's range (e.g. 1e+300) would be written as inf
+    """
+    if a.dtype.kind != "f" or a.dtype.itemsize <= 4:
+        return
+    with np.errstate(invalid="ignore"):
+        big = np.isfinite(a) & (np.abs(a) > float(np.finfo(np.float32).max))
+    if big.any():
+        raise ValueError(
+            f"{name}: {int(big.sum())} finite value(s) beyond float32's range (e.g. "
+            f"{float(a[big][0])!r}) {fate}"
+        )
+
+
 def _whole(v: float) -> str:
     """``v`` as Python writes it, a whole number without ".0" (10, not 10.0; 10.0000001)."""
     return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)

@@ -500,16 +500,10 @@ def row_fill(disparity: npt.ArrayLike) -> npt.NDArray[np.float32]:
         )
     if d.size == 0:
         return d.astype(np.float32)
-    if d.dtype.kind == "f" and d.dtype.itemsize > 4:
-        # the float32 cast made a finite 1e300 an inf, filled over as a hole with only NumPy's
-        # overflow warning (no integer reaches float32's max)
-        with np.errstate(invalid="ignore"):
-            big = np.isfinite(d) & (np.abs(d) > float(np.finfo(np.float32).max))
-        if big.any():
-            raise ValueError(
-                f"disparity: {int(big.sum())} finite value(s) beyond float32's range (e.g. "
-                f"{float(d[big][0])!r}) would be filled over as holes"
-            )
+    from stereovision._validate import refuse_beyond_float32
+
+    # the float32 cast made a finite 1e300 an inf, filled over as a hole
+    refuse_beyond_float32(d, "disparity", "would be filled over as holes")
     from stereovision import _core
 
     # The Rust kernel (rust/core/src/fill.rs; NumPy reference tests/reference/row_fill_ref.py):

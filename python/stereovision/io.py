@@ -1321,18 +1321,10 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
         raise ValueError(f"arr: expected a non-empty real array, got {_describe(a)}")
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] == 3)):
         raise ValueError(f"arr: expected shape (H, W) or (H, W, 3), got {a.shape}")
-    from stereovision._validate import check_index_range
+    from stereovision._validate import check_index_range, refuse_beyond_float32
 
     check_index_range(a.shape, "arr", "map")  # before the float32 copy and the file's bytes
-    if a.dtype.kind == "f" and a.dtype.itemsize > 4:
-        # the cast made a finite 1e300 an inf without a word (no integer reaches float32's max)
-        with np.errstate(invalid="ignore"):
-            big = np.isfinite(a) & (np.abs(a) > float(np.finfo(np.float32).max))
-        if big.any():
-            raise ValueError(
-                f"arr: {int(big.sum())} finite value(s) beyond float32's range (e.g. "
-                f"{float(a[big][0])!r}) would be written as inf"
-            )
+    refuse_beyond_float32(a, "arr", "would be written as inf")
     height, width = a.shape[:2]
     magic = b"PF" if a.ndim == 3 else b"Pf"
     dtype = np.dtype("<f4") if little_endian else np.dtype(">f4")
