@@ -302,12 +302,14 @@ def test_a_cli_whose_open_was_given_up_ends_on_its_one_line(tmp_path: Path) -> N
         check=False,
     )
     assert (proc.returncode, proc.stdout) == (2, "")
-    # which source is given up first is the scheduler's: on a loaded machine the left one's
-    # open (a few ms) can finish before its 1e-300 s wait is even begun, and the right is named
+    # which source, and which step of its open, is given up first is the scheduler's: on a
+    # loaded machine the left one's open (a few ms) can finish before its 1e-300 s wait is even
+    # begun, and then reading back its settings, or the right source, is named
     said = [
-        f"stereovision: error: {side} source {pat!r} did not open within 1e-300 s (its open did "
+        f"stereovision: error: {side} source {pat!r} did not open within 1e-300 s ({step} did "
         "not return: a stalled stream or network share); give it a longer timeout\n"
         for side, pat in (("left", lpat), ("right", rpat))
+        for step in ("its open", "reading back its settings")
     ]
     assert proc.stderr in said, proc.stderr
 
