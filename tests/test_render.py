@@ -2291,3 +2291,22 @@ def test_the_depth_bar_labels_stay_readable_over_huge_and_tiny_ranges() -> None:
     assert [tiny % v for v in (1e-12, 1.25e-12, 1.5e-12)] == ["1e-12", "1.25e-12", "1.5e-12"]
     far = _bar_label_format(1e10, 1e10 + 1)
     assert far % (1e10 + 0.25) == "10000000000.25"
+
+
+def test_the_depth_bar_of_a_flat_far_cloud_has_short_labels() -> None:
+    """A cloud without colours all at one Z past 2**53 m: its +-0.5 m bar range is empty in
+    doubles, and the labels read "100000002004087734272.00" (40 digits at 3e38); they are
+    significant digits now, a flat cloud of metres keeps two decimals."""
+    for z, label in ((1e20, "1e+20"), (3e38, "3e+38"), (5.0, "4.50")):
+        points = np.zeros((50, 3), np.float32)
+        points[:, 0] = np.arange(50)
+        points[:, 2] = z
+        plotter = render.make_plotter((200, 150))
+        try:
+            render.add_geometry(plotter, render.point_cloud(points))
+            bar = plotter.scalar_bars["depth Z (m)"]
+            fmt = bar.GetLabelFormat()
+            lo, _ = bar.GetLookupTable().GetRange()
+        finally:
+            plotter.close()
+        assert fmt % lo == label, (z, fmt % lo)

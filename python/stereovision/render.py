@@ -1033,11 +1033,14 @@ def _bar_label_format(lo: float, hi: float) -> str:
     labels (a quarter of the range apart) would need them to differ (a stereo microscope's
     cloud 4-6 mm ahead was labelled "0.00 0.00 0.01 0.01 0.01"). Past a million metres or
     under a nanometre step, significant digits (``%g``): a far cloud's labels were hundreds of
-    digits long, a tiny range's all "0.000000000", and +-1e308 an OverflowError."""
+    digits long, a tiny range's all "0.000000000", and +-1e308 an OverflowError. An empty
+    range (a flat cloud) has two decimals, or 3 significant digits past a million metres: a
+    flat cloud at 1e20 m, whose +-0.5 m range is empty in doubles, read
+    "100000002004087734272.00"."""
     step = hi / 4 - lo / 4  # (hi - lo) / 4 overflowed to inf for +-1e308
-    if not step > 0 or not math.isfinite(step):
-        return "%.2f"
     big = max(abs(lo), abs(hi))
+    if not step > 0 or not math.isfinite(step):
+        return "%.2f" if big < 1e6 else "%.3g"
     decimals = max(2, math.ceil(-math.log10(step)))
     if decimals <= 9 and big < 1e6:
         return f"%.{decimals}f"
