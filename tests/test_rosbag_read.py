@@ -450,6 +450,23 @@ def test_mono16_pairs_share_one_shift_and_resize(cones: Any, tmp_path: Path) -> 
         assert cam.read().left.shape == (188, 225, 3)
 
 
+def test_a_16_bit_glint_does_not_halve_the_grey_levels_of_its_pair(tmp_path: Path) -> None:
+    """Each pair had its own shift to 8 bits: the same 11-bit scene read 172, 86, 172 at one
+    pixel over three pairs, the middle one with a single glint at 4095. The shift is now the
+    largest a pair has needed so far: 172, 86, 86."""
+    g = np.random.default_rng(0).integers(100, 2000, (60, 80)).astype(np.uint16)
+    glint = g.copy()
+    glint[0, 0] = 4095
+    frames = [
+        (T0 + i * PERIOD_NS, im, T0 + i * PERIOD_NS, im) for i, im in enumerate([g, glint, g])
+    ]
+    with BagCamera(write_bag(tmp_path / "rig", frames, encoding="mono16")) as cam:
+        lefts = [cam.read().left[..., 0] for _ in range(3)]
+    np.testing.assert_array_equal(lefts[0], (g >> 3).astype(np.uint8))
+    np.testing.assert_array_equal(lefts[1], (glint >> 4).astype(np.uint8))
+    np.testing.assert_array_equal(lefts[2], (g >> 4).astype(np.uint8))
+
+
 def test_calibration_from_camera_info(cones: Any, tmp_path: Path) -> None:
     raw = _raw_rig()
     texts = raw.to_ros()

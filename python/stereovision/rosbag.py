@@ -55,7 +55,8 @@ as :class:`~stereovision.capture.StereoCamera`, so ``stream``, ``capture``, ``ca
   as image_transport compresses it, demosaiced) come out as BGR
   ``uint8``, like a camera's. 16-bit pairs are brought to 8 bits by one power-of-two shift for
   both images, the smallest that keeps their brightest pixel (a 12-bit sensor in a 16-bit
-  container is shifted by 4, not left nearly black).
+  container is shifted by 4, not left nearly black), and never less than a pair read before
+  needed: a frame's grey levels do not halve for one glint.
 - **Calibration.** When the bag holds each camera's ``camera_info`` (beside its image topic),
   :meth:`BagCamera.calibration` makes the rig's :class:`~stereovision.calibration.Calibration`
   from them, as :meth:`~stereovision.calibration.Calibration.from_ros` does from the YAML files;
@@ -1082,8 +1083,17 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
     scale (the matchers compare the two images) and a 10- or 12-bit sensor's data in a 16-bit
     container is not left nearly black. ``uint8`` images are returned as they are.
     """
+    return _shifted_to_8bit(images, _needed_shift(images))
+
+
+def _needed_shift(images: tuple[np.ndarray, ...]) -> int:
+    """The smallest right shift that brings the brightest 16-bit pixel of ``images`` to 8 bits."""
     peak = max((int(im.max()) for im in images if im.dtype == np.uint16 and im.size), default=0)
-    shift = max(0, peak.bit_length() - 8)
+    return max(0, peak.bit_length() - 8)
+
+
+def _shifted_to_8bit(images: tuple[np.ndarray, ...], shift: int) -> tuple[np.ndarray, ...]:
+    """``images`` as ``uint8``, the 16-bit ones shifted right by ``shift``."""
     return tuple(
         (im >> shift).astype(np.uint8) if im.dtype == np.uint16 else np.asarray(im, np.uint8)
         for im in images
@@ -1428,6 +1438,7 @@ class BagCamera(PairSource):
         }
         self.size = self.requested_size
         self._shape: tuple[int, int] | None = None  # the first left frame's size
+        self._shift = 0  # the 16-bit frames' shift to 8 bits, the largest needed so far
         self._warned: set[str] = set()
         self.delivered_size: dict[str, tuple[int, int]] = {}
         self.skews_ms: list[float] = []
@@ -1660,7 +1671,12 @@ class BagCamera(PairSource):
                 imgs.append(decode_image(msg))
             except ValueError as exc:
                 raise ValueError(f"{self.topics[side]} at stamp {stamp} ns: {exc}") from None
-        left, right = to_8bit(*imgs)
+        # One shift for the whole recording so far, the largest a pair has needed: a shift of
+        # each pair's own halved a frame's grey levels for a single glint past the others'
+        # peak (the same 11-bit scene read 172, 86, 172 over three pairs, the middle one with
+        # one pixel at 4095), a flicker that capture --temporal took for a change of light.
+        self._shift = max(self._shift, _needed_shift((imgs[0], imgs[1])))
+        left, right = _shifted_to_8bit((imgs[0], imgs[1]), self._shift)
         start = self._start_ns()
         fitted = (self._fit("left", left, sl), self._fit("right", right, sr))
         frame = StereoFrame(
