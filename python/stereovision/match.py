@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -21,8 +22,10 @@ from stereovision.calibration import Calibration
 from stereovision.depth import (
     _below_automatic,
     _from_zero,
+    _range_too_wide,
     _rectify_grey,
     _rig_to_warp_by,
+    _too_narrow,
     estimate_max_disparity,
 )
 from stereovision.matches import Matches
@@ -105,8 +108,11 @@ def match(
         ``max_disparity`` that is not a finite number >= 0 (or below ``min_disparity``; equal
         to it, ``"gabor"`` and ``"fused"`` refuse it, the others search that one level), a
         ``min_disparity`` not below the image width (no pixel has a match that far: a pair with
-        no edges in a range it can match in still returns zero matches, not an error), a
-        negative ``min_disparity`` with a method other than ``"gabor"`` (they search from 0 px).
+        no edges in a range it can match in still returns zero matches, not an error), a range
+        ``max_disparity - min_disparity`` not below the image width (or, with no
+        ``max_disparity``, a pair too narrow for the automatic range: 16 px wide or less), as
+        :func:`~stereovision.depth_map` refuses them, a negative ``min_disparity`` with a
+        method other than ``"gabor"`` (they search from 0 px).
     """
     # a str first: an array as the method failed in the test ("truth value ... ambiguous")
     if not isinstance(method, str) or method not in METHODS:
@@ -196,12 +202,14 @@ def _refuse_unreachable(
     hopfield, best and mcgm run: at the width it returned 0 matches without a word); an
     estimated one (``automatic``) below such a min_disparity is not the problem, the
     min_disparity is. An int beyond a float's range is compared as it is: a min_disparity of
-    10**400 returned 0 matches without a word (hopfield, best, mcgm), a max_disparity of
-    10**400 searches the whole width. An estimated one below a reachable min_disparity (at it,
-    for ``method`` ``"gabor"`` and ``"fused"``, which search no single level) is refused as
-    :func:`stereovision.depth_map` refuses it: the matchers' own words named a max_disparity
-    the caller never gave ("max_disparity (32) must be >= min_disparity (40)"); ``rig``: the
-    automatic one is an uncalibrated rectification's."""
+    10**400 returned 0 matches without a word (hopfield, best, mcgm). An estimated one below a
+    reachable min_disparity (at it, for ``method`` ``"gabor"`` and ``"fused"``, which search no
+    single level) is refused as :func:`stereovision.depth_map` refuses it: the matchers' own
+    words named a max_disparity the caller never gave ("max_disparity (32) must be >=
+    min_disparity (40)"); ``rig``: the automatic one is an uncalibrated rectification's. So is
+    a range not below the width, given (``max_disparity=40`` on a 30 px wide pair; a bound
+    beyond a float, 10**400, as not a finite number) or estimated (a pair 16 px wide or
+    narrower): the matchers searched it, clipped to the image, without a word."""
     try:
         lo = _bound(min_disparity, "min_disparity")
         hi = _bound(max_disparity, "max_disparity")
@@ -209,9 +217,24 @@ def _refuse_unreachable(
         return
     if hi < lo and not automatic:
         return
+    try:
+        wide = hi - lo >= width  # as depth_map compares them
+    except OverflowError:  # an int beyond a float beside a float: 10**400 - 0.0
+        wide = Fraction(hi) - Fraction(lo) >= width
+    if wide and automatic and not rig:
+        # the estimate (at least 16 px) on a pair 16 px wide or narrower: depth_map's words
+        finite_number(lo, "min_disparity")  # -10**400 named as depth_map names it
+        raise _too_narrow(width, hi - lo, lo)
     refuse_unreachable_range(lo, hi, width)
     if automatic and (hi < lo or (hi == lo and method in ("gabor", "fused"))):
         raise _below_automatic(lo, hi, rig)
+    if wide:
+        # a range no pair this wide has (max_disparity=40 on a 30 px wide pair) was searched
+        # silently where depth_map refuses it: refused in its words (a bound beyond a float,
+        # 10**400, as depth_map names it, not as a range of 401 digits)
+        for value, name in ((lo, "min_disparity"), (hi, "max_disparity")):
+            finite_number(value, name)
+        raise _range_too_wide(hi - lo, width, lo)
 
 
 def _bound(value: object, name: str) -> float:
