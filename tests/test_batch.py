@@ -1625,6 +1625,29 @@ def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
     assert {p.name for p in (out / "k/image_2/7").iterdir()} == DISPARITY_FILES
 
 
+def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """``batch seq -o seq/left/out``: the run's own outputs (out/0001/disparity.png, in the
+    left camera folder) were searched as input on the next run, each a failed pair ("unpaired
+    image: no seq/right/out/0001/disparity.png"), exit 1. The output folder is not searched
+    (run_batch's scan); a folder beside it still is, and one named as an image is no image."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "seq"
+    out = root / "left" / "out"
+    _crops(root, data_dir, ["left/0001.png", "left/old/0002.png"], ["right/0001.png"])
+    _crops(root, data_dir, [], ["left/out/0001/disparity.png", "left/out/0001/overview.png"])
+    (root / "left" / "pair.png").mkdir()
+    jobs, unpaired, _ = _scan(root, output=out)
+    assert jobs == [PairJob("0001", root / "left/0001.png", root / "right/0001.png")]
+    assert [(u.name, u.present) for u in unpaired] == [("old/0002", root / "left/old/0002.png")]
+    # another output folder, or none: the folder is input as any other
+    for other in (tmp_path / "o", None):
+        found = {u.name for u in _scan(root, output=other)[1]}
+        assert found == {"old/0002", "out/0001/disparity", "out/0001/overview"}
+
+
 def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_listed(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -261,11 +261,14 @@ def _scan(
     root: str | os.PathLike[str],
     calib: str | os.PathLike[str] | None = None,
     calib_unit: str | None = None,
+    output: str | os.PathLike[str] | None = None,
 ) -> tuple[list[PairJob], list[_Unpaired], tuple[int, int] | None]:
     """:func:`find_pairs`, and the images named as one of a pair without the other: a ``left``
     image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
     ``left`` one; named as their pair would be, after the pairs' names. Also the image size
-    ``calib`` is read at when it holds none (:func:`_calib_size`), else None."""
+    ``calib`` is read at when it holds none (:func:`_calib_size`), else None. ``output``, the
+    run's output folder, is not searched when it lies below ``root``: ``batch seq -o
+    seq/left/out`` paired its own disparity.png files on the next run (each a failed pair)."""
     from stereovision._validate import as_path
 
     r = as_path(root, "root")
@@ -291,7 +294,8 @@ def _scan(
     cam_found: list[PairJob] = []  # in sibling camera folders
     cam_unpaired: list[_Unpaired] = []
     cam_taken: set[Path] = set()  # named images paired across camera folders, by number
-    for d, _dirs, files, listed in _walk(r):
+    skip = _output_below(r, output)
+    for d, _dirs, files, listed in _walk(r, skip):
         dirs = sorted(_dirs)
         _dirs[:] = [x for x in dirs if not x.startswith(".")]
         here = Path(d)
@@ -344,7 +348,9 @@ def _scan(
             prefix = "/".join(
                 x for x in (rel, left_dir if len(cams) > 1 else "") if x not in ("", ".")
             )
-            pairs, alone, by_number = _sibling_pairs(here / left_dir, here / right_dir, prefix, cal)
+            pairs, alone, by_number = _sibling_pairs(
+                here / left_dir, here / right_dir, prefix, cal, skip
+            )
             cam_found += pairs
             cam_unpaired += alone
             cam_taken |= by_number
@@ -450,7 +456,22 @@ def _recorded_calib_size(pairs: dict[str, Any], calib: Path) -> tuple[int, int] 
     return max(counts, key=lambda k: counts[k]) if counts else None
 
 
-def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
+def _output_below(root: Path, output: str | os.PathLike[str] | None) -> frozenset[str]:
+    """The real path of ``output`` when it lies strictly below ``root`` (a folder
+    :func:`_walk` is not to enter), else nothing."""
+    if output is None:
+        return frozenset()
+    top, out = os.path.realpath(root), os.path.realpath(output)
+    try:
+        below = out != top and os.path.commonpath([out, top]) == top
+    except ValueError:  # another drive (Windows)
+        below = False
+    return frozenset({out}) if below else frozenset()
+
+
+def _walk(
+    top: Path, skip: frozenset[str] = frozenset()
+) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
     """:func:`os.walk` (top-down) that also enters links to folders outside ``top``, each once;
     also yields each folder's sub-folders as listed, links not entered included.
 
@@ -460,7 +481,8 @@ def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
     folders named by such links, ``seq/left -> ../raw/cam_l``, are still paired: their
     search is their own). Hidden folders (``.git``, ``.Trash``) are not entered: a hidden
     link sorted first claimed the folder a visible link also named, and the caller's skip of
-    hidden folders then dropped the folder's scenes (``.cache -> /d/s`` beside ``s -> /d/s``)."""
+    hidden folders then dropped the folder's scenes (``.cache -> /d/s`` beside ``s -> /d/s``).
+    Folders whose real path is in ``skip`` (the output folder) are not entered either."""
     top_real = os.path.realpath(top)
     seen = {top_real}
     for d, dirs, files in os.walk(top, followlinks=True):
@@ -472,6 +494,8 @@ def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
             if x.startswith("."):
                 continue
             p = os.path.join(d, x)
+            if skip and os.path.realpath(p) in skip:
+                continue
             if os.path.islink(p):
                 real = os.path.realpath(p)
                 try:
@@ -506,11 +530,11 @@ def _named_image(f: str) -> bool:
     return _last_left(stem) is not None or _last(_RIGHT_RE, stem) is not None
 
 
-def _camera_images(folder: Path) -> set[str]:
-    """The images under ``folder`` (any depth, hidden ones excepted) not paired by their name,
-    as POSIX paths relative to it."""
+def _camera_images(folder: Path, skip: frozenset[str] = frozenset()) -> set[str]:
+    """The images under ``folder`` (any depth, hidden ones and ``skip``'s excepted) not paired
+    by their name, as POSIX paths relative to it."""
     images: set[str] = set()
-    for d, dirs, files, _ in _walk(folder):
+    for d, dirs, files, _ in _walk(folder, skip):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub = Path(d).relative_to(folder)
         for f in files:
@@ -520,7 +544,11 @@ def _camera_images(folder: Path) -> set[str]:
 
 
 def _sibling_pairs(
-    left_dir: Path, right_dir: Path, prefix: str, cal: Path | None
+    left_dir: Path,
+    right_dir: Path,
+    prefix: str,
+    cal: Path | None,
+    skip: frozenset[str] = frozenset(),
 ) -> tuple[list[PairJob], list[_Unpaired], set[Path]]:
     """The pairs of two sibling camera folders: the images of the same path under both (those
     with ``left`` or ``right`` in their names are paired by name, as everywhere); then those
@@ -529,8 +557,9 @@ def _sibling_pairs(
     ``prefix`` + its left image's path under the camera folder without the extension (and
     without ``left``: ``seq/data/0001`` for ``seq/cam0/data/0001.png``, ``seq/0001`` for
     ``seq/left/left_0001.png``); an image without the other is an :class:`_Unpaired`. Also
-    returns the named images paired here (the folder's own walk does not report them)."""
-    lefts, rights = _camera_images(left_dir), _camera_images(right_dir)
+    returns the named images paired here (the folder's own walk does not report them).
+    Folders in ``skip`` (the output folder) are not searched."""
+    lefts, rights = _camera_images(left_dir, skip), _camera_images(right_dir, skip)
 
     def name(sub: str) -> str:
         short = sub.rsplit(".", 1)[0]
@@ -539,8 +568,8 @@ def _sibling_pairs(
     pairs = [PairJob(name(f), left_dir / f, right_dir / f, cal) for f in sorted(lefts & rights)]
     # the others, by the number in their names (left/left_0001.png + right/right_0001.png)
     by_number = _by_number(
-        (lefts - rights) | _lone_named_images(left_dir),
-        (rights - lefts) | _lone_named_images(right_dir),
+        (lefts - rights) | _lone_named_images(left_dir, skip),
+        (rights - lefts) | _lone_named_images(right_dir, skip),
     )
     for a, b in by_number:
         pairs.append(PairJob(name(_without_side(a)), left_dir / a, right_dir / b, cal))
@@ -562,12 +591,12 @@ def _sibling_pairs(
     )
 
 
-def _lone_named_images(folder: Path) -> set[str]:
-    """The images under ``folder`` (any depth, hidden ones excepted) named as one of a pair
-    (``left`` or ``right`` in the name) without the other beside them, as POSIX paths relative
-    to it."""
+def _lone_named_images(folder: Path, skip: frozenset[str] = frozenset()) -> set[str]:
+    """The images under ``folder`` (any depth, hidden ones and ``skip``'s excepted) named as
+    one of a pair (``left`` or ``right`` in the name) without the other beside them, as POSIX
+    paths relative to it."""
     lone: set[str] = set()
-    for d, dirs, files, _ in _walk(folder):
+    for d, dirs, files, _ in _walk(folder, skip):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub, names = Path(d).relative_to(folder), set(files)
         for f in files:
@@ -1634,7 +1663,7 @@ def run_batch(
     t0 = time.perf_counter()
     if calib_unit is not None and calib is None:
         raise ValueError("calib_unit is the unit of calib's file: give calib too")
-    jobs, unpaired, calib_size = _scan(input_dir, calib, calib_unit)
+    jobs, unpaired, calib_size = _scan(input_dir, calib, calib_unit, output_dir)
     # a file in the way, or a folder that cannot be written: said as such, before a cluster
     # starts (it was "[Errno 17] File exists" or "[Errno 2] No such file or directory")
     check_output_folder(output_dir, "output folder")
@@ -2301,7 +2330,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
         size = None
         if sizeless:
             with contextlib.suppress(OSError):  # no input folder: run_batch says so
-                size = _calib_size(Path(args.calib), _scan(args.input)[0])
+                size = _calib_size(Path(args.calib), _scan(args.input, output=args.output)[0])
         if size is not None or not sizeless:
             load_calibration(args.calib, args.calib_unit, size=size)
     if args.scheduler is not None:
