@@ -1502,7 +1502,7 @@ def run_batch(
     workers: int | None = None,
     scheduler: str | None = None,
     method: str | None = None,
-    max_disparity: int | None = None,
+    max_disparity: float | None = None,
     fill: bool | None = None,
     calib: str | os.PathLike[str] | None = None,
     calib_unit: str | None = None,
@@ -1526,8 +1526,10 @@ def run_batch(
         Address of an existing Dask scheduler (``tcp://host:8786``).
     method : str, optional
         Matcher; None = ``depth_map``'s default.
-    max_disparity : int, optional
-        Disparity range for every pair; None = estimated per pair.
+    max_disparity : float, optional
+        Largest disparity searched in every pair, in pixels: any positive number (a fractional
+        one as :func:`~stereovision.depth.depth_map` searches it, recorded as given); None =
+        estimated per pair. Not ``"auto"`` (None is).
     fill : bool, optional
         Fill the holes (:func:`depth_map`'s ``fill``); None = the method's default.
     calib : path, optional
