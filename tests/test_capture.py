@@ -1090,6 +1090,15 @@ def test_an_image_the_format_cannot_hold_is_refused_not_saved_as_8_bits(tmp_path
             "would write it as 8 bits; convert it to uint8 first (a float image in [0, 1]: "
             "times 255)"
         )
+    # .hdr writes float32 whatever it is given: a 16-bit image was said "written as 8 bits",
+    # and uint8 advised, which .hdr writes as float32 too
+    for bad in (img.astype(np.uint16) * 257, img.astype(np.float64) / 255):
+        with pytest.raises(ValueError) as ei:
+            save_pair(tmp_path, 1, img, bad, ext=".hdr")
+        assert str(ei.value) == (
+            f"cannot save the right image ({bad.dtype}) as .hdr without loss: that format "
+            f"would write it as float32; .tiff holds {bad.dtype}"
+        )
     assert list(tmp_path.iterdir()) == []
     deep = img.astype(np.uint16) * 257
     for kept, ext in ((deep, ".png"), (img.astype(np.float32) / 255, ".tiff"), (img, ".jpg")):

@@ -2620,7 +2620,9 @@ def save_pair(
         Pair number (``>= 0``).
     left, right : array_like
         ``uint8`` images (grey or BGR); another type (``uint16``, ``float32``) only in a
-        format that holds it (``.png`` for ``uint16``, ``.tiff`` for both).
+        format that holds it (``.png`` for ``uint16``, ``.tiff`` for both). ``.hdr`` writes
+        three float32 channels (RGBE, steps of about 1 %) whatever it is given: ``uint8`` as
+        float in [0, 1], ``float32`` as it is; another type is refused.
     ext : str
         Image format by extension (``.png`` lossless by default).
 
@@ -2659,6 +2661,14 @@ def save_pair(
             # a format without the image's depth is written as 8 bits: a float image in
             # [0, 1] was saved black (0 and 1), a 16-bit one in .jpg white, without a word
             back = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+            if back is not None and back.dtype == np.float32 and arr.dtype != np.float32:
+                # .hdr writes float32 (RGBE, 1 % steps) whatever it is given: a 16-bit image
+                # was said to be "written as 8 bits", and uint8 advised, which .hdr turns
+                # into float32 too
+                raise ValueError(
+                    f"cannot save the {side} image ({arr.dtype}) as {ext} without loss: that "
+                    f"format would write it as float32; .tiff holds {arr.dtype}"
+                )
             if back is None or back.dtype != arr.dtype:
                 raise ValueError(
                     f"cannot save the {side} image ({arr.dtype}) as {ext} without loss: that "
