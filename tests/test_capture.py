@@ -1143,6 +1143,27 @@ def test_interrupted_pair_save_leaves_no_temp_file(
     assert sorted(p.name for p in tmp_path.iterdir()) == []
 
 
+def test_a_pair_that_cannot_be_put_in_place_names_its_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without hard links (FAT), the rename putting the left image in place failing (a full
+    card) said "[Errno 28] No space left on device: '.../.left_0001.png.1234-9f2c.tmp' ->
+    '.../left_0001.png'", the temporary file first; the pair's file is named, nothing stays."""
+    import errno
+
+    img = _numbered(1)
+
+    def refused(src: object, dst: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device", str(src), None, str(dst))
+
+    monkeypatch.setattr(os, "link", refused)
+    monkeypatch.setattr(os, "replace", refused)
+    with pytest.raises(OSError) as info:
+        save_pair(tmp_path, 1, img, img)
+    assert str(info.value) == f"cannot write {tmp_path / 'left_0001.png'}: No space left on device"
+    assert info.value.errno == errno.ENOSPC and list(tmp_path.iterdir()) == []
+
+
 def test_a_folder_refusing_the_temporary_file_names_the_pairs_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import shutil
@@ -1131,6 +1132,45 @@ def test_atomic_write_cleans_up_after_an_interrupt_and_writes_text_as_utf8(tmp_p
     with atomic_write(dest, "w") as fh:
         fh.write("z = 2.5 \u00b5m")
     assert dest.read_bytes() == "z = 2.5 \u00b5m".encode()
+
+
+@pytest.mark.parametrize("code", [errno.ENOSPC, errno.EXDEV, errno.EACCES])
+def test_atomic_write_failing_to_put_the_file_in_place_names_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, code: int
+) -> None:
+    """The rename failing (a full disk, another device, a folder that refuses it) was
+    os.replace's "[Errno 28] No space left on device: '.../.x.pfm.k2j3abcd.tmp' -> '.../x.pfm'",
+    the temporary file named first; a full disk in the body or the sync was "[Errno 28] No space
+    left on device", naming no file. The file the caller gave is named, in the error's class and
+    errno, and no temporary file stays (write_together alike)."""
+    dest = tmp_path / "x.pfm"
+    dest.write_bytes(b"old")
+    said = os.strerror(code)
+
+    def refused(src: object, dst: object) -> None:
+        raise OSError(code, said, str(src), None, str(dst))
+
+    monkeypatch.setattr(os, "replace", refused)
+    with pytest.raises(OSError) as info:
+        write_pfm(dest, np.ones((2, 2), np.float32))
+    assert str(info.value) == f"cannot write {dest}: {said}" and info.value.errno == code
+    assert isinstance(info.value, PermissionError) == (code == errno.EACCES)
+    with pytest.raises(OSError, match=rf"^cannot write {re.escape(str(dest))}: {said}$"):
+        write_together([(dest, b"new")])
+    monkeypatch.undo()
+    full = OSError(errno.ENOSPC, "No space left on device")
+    with pytest.raises(OSError, match=r"^cannot write .*x\.pfm: No space left on device$"):
+        with atomic_write(dest) as fh:
+            raise full
+
+    def sync_fails(fd: int) -> None:
+        raise full
+
+    monkeypatch.setattr(os, "fsync", sync_fails)
+    with pytest.raises(OSError, match=r"^cannot write .*x\.pfm: No space left on device$"):
+        with atomic_write(dest, "w") as fh:
+            fh.write("new")
+    assert os.listdir(tmp_path) == ["x.pfm"] and dest.read_bytes() == b"old"
 
 
 def test_pfm_sizes_and_range_limits(tmp_path: Path) -> None:

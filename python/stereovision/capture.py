@@ -2530,7 +2530,13 @@ def _atomic_write_bytes(path: Path, data: bytes) -> None:
         except OSError:  # no hard links here
             if os.path.lexists(path):
                 raise FileExistsError(errno.EEXIST, "file exists", str(path)) from None
-            os.replace(tmp, path)
+            try:
+                os.replace(tmp, path)
+            except OSError as exc:
+                # it named the temporary file first ('.left_0001.png.1234-9f2c.tmp' -> ...)
+                failed = type(exc)(f"cannot write {path}: {exc.strerror or exc}")
+                failed.errno = exc.errno
+                raise failed from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)

@@ -587,6 +587,21 @@ def temp_refused(dest: Path, exc: OSError) -> OSError:
     return failed
 
 
+#: Errors of a write into a full disk or quota (the body of :func:`atomic_write` raises them
+#: naming no file).
+_DISK_FULL = frozenset({errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC)})
+
+
+def _not_written(dest: Path, exc: OSError) -> OSError:
+    """The error to raise when the new contents of ``dest`` cannot be written or put in place
+    (a full disk, a rename refused): ``dest`` named, in ``exc``'s class and errno. os.replace's
+    own named the temporary file first ('[Errno 28] No space left on device:
+    '.../.x.pfm.k2j3abcd.tmp' -> '.../x.pfm''), a write's none."""
+    failed = type(exc)(f"cannot write {dest}: {exc.strerror or exc}")
+    failed.errno = exc.errno
+    return failed
+
+
 #: Longest file name (bytes) of Linux's and macOS's filesystems, NAME_MAX.
 _NAME_MAX = 255
 
@@ -639,7 +654,9 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         file.
     OSError
         If ``path`` is a link that loops, or a FIFO, a socket or a device (replaced, the reader
-        waiting on it got nothing), or a link to one.
+        waiting on it got nothing), or a link to one; or if the new contents cannot be written
+        or put in place (a full disk, a rename refused): the message names ``path``, and the
+        temporary file is removed.
     """
     given = as_path(path, file=True)
     text = os.fspath(path)
@@ -654,13 +671,25 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     try:
         encoding = None if "b" in mode else "utf-8"
         with os.fdopen(fd, mode, encoding=encoding) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
-        # mkstemp creates 0600; give the result the permissions open() would (the replaced
-        # file's, else a new file's)
-        os.chmod(tmp, _mode_for(dest))
-        os.replace(tmp, dest)
+            try:
+                yield fh
+            except OSError as exc:
+                # the body's write into a full disk named no file
+                if exc.filename is None and exc.errno in _DISK_FULL:
+                    raise _not_written(dest, exc) from exc
+                raise
+            try:
+                fh.flush()
+                os.fsync(fh.fileno())
+            except OSError as exc:
+                raise _not_written(dest, exc) from exc
+        try:
+            # mkstemp creates 0600; give the result the permissions open() would (the
+            # replaced file's, else a new file's)
+            os.chmod(tmp, _mode_for(dest))
+            os.replace(tmp, dest)
+        except OSError as exc:
+            raise _not_written(dest, exc) from exc
     except BaseException:
         try:
             os.unlink(tmp)
@@ -718,11 +747,14 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
         for dest, data in files:
             fd, name = _temp_beside(dest, ".tmp")
             temps.append(Path(name))
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.chmod(name, _mode_for(dest))  # mkstemp's 0600 -> what open() leaves
+            try:
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(data)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+                os.chmod(name, _mode_for(dest))  # mkstemp's 0600 -> what open() leaves
+            except OSError as exc:  # a full disk named no file
+                raise _not_written(dest, exc) from exc
         for (dest, _), new in zip(files, temps, strict=True):
             previous: Path | None = None
             if dest.is_file():
@@ -733,7 +765,10 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
             kept.append((dest, previous))
             if previous is not None:
                 shutil.copy2(dest, previous)  # dest stays in place meanwhile
-            os.replace(new, dest)
+            try:
+                os.replace(new, dest)
+            except OSError as exc:  # it named the temporary file first
+                raise _not_written(dest, exc) from exc
             replaced += 1
     except BaseException as exc:
         stranded: list[tuple[Path, Path]] = []  # (destination, the only copy of its old contents)
