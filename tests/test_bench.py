@@ -118,6 +118,46 @@ def test_bench_cli_folder_without_scenes(
 
 
 @pytest.mark.parametrize("command", ["eval", "bench"])
+def test_a_folder_of_middleburys_names_is_said_with_the_names_a_scene_takes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    """A scene as Middlebury's archives ship it (im0.png, im1.png, disp0.pfm, calib.txt) was
+    "no scene (left.png + right.png) under X", its files unnamed: the line says the names to
+    give them, of the folder given or of those under it; among scenes it is said skipped."""
+    root = tmp_path / "root"
+    fix = (
+        "a scene's images are named left.png + right.png and its ground truth gt_disp.pfm "
+        "(rename im0.png, im1.png and disp0.pfm or disp0GT.pfm; calib.txt is read as it is)"
+    )
+    for name in ("artroom", "bike"):
+        for image in ("im0.png", "im1.png", "disp0.pfm", "calib.txt"):
+            (root / name).mkdir(parents=True, exist_ok=True)
+            (root / name / image).write_bytes(b"")
+    assert main([command, str(root / "bike")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: {root / 'bike'}: has Middlebury's im0.png + im1.png: {fix}"
+    ]
+    assert main([command, str(root)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: no scene (left.png + right.png) under {root}; {root / 'artroom'}, "
+        f"{root / 'bike'} hold Middlebury's im0.png + im1.png: {fix}"
+    ]
+    from stereovision.io import scan_scenes
+
+    (root / "half").mkdir()
+    (root / "half" / "left.png").write_bytes(b"")
+    (root / "bike" / "right.png").write_bytes(b"")  # half a scene: said as such
+    assert scan_scenes(root) == (
+        [],
+        [
+            (root / "artroom", f"has Middlebury's im0.png + im1.png: {fix}"),
+            (root / "bike", "has right.png but no left.png (a scene folder holds both)"),
+            (root / "half", "has left.png but no right.png (a scene folder holds both)"),
+        ],
+    )
+
+
+@pytest.mark.parametrize("command", ["eval", "bench"])
 def test_no_scene_line_names_the_half_scenes_it_skipped(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
 ) -> None:

@@ -2031,6 +2031,15 @@ def find_scenes(root: PathLike) -> list[Path]:
     return scan_scenes(root)[0]
 
 
+# Why a folder of Middlebury's names (im0.png + im1.png, as its archives ship a scene) is no
+# scene: eval and bench said "no scene (left.png + right.png)" there, the names to use unsaid.
+_MIDDLEBURY_FIX = (
+    "a scene's images are named left.png + right.png and its ground truth gt_disp.pfm (rename "
+    "im0.png, im1.png and disp0.pfm or disp0GT.pfm; calib.txt is read as it is)"
+)
+_MIDDLEBURY_NAMES = f"has Middlebury's im0.png + im1.png: {_MIDDLEBURY_FIX}"
+
+
 def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     """:func:`find_scenes`'s scenes, and the folders left out as half a scene, each with why.
 
@@ -2038,7 +2047,9 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     a word (``batch`` reports such an image as unpaired): they now say so from this list.
     Hidden folders (``.git``, ``.Trash``) under ``root`` are not searched, as ``batch`` does
     not (a hidden copy of a scene was evaluated twice); ``root`` itself is searched even if
-    hidden, as given.
+    hidden, as given. A folder of Middlebury's names (``im0.png`` + ``im1.png``, no
+    ``left.png`` or ``right.png``) is left out too, saying the names a scene's files take (it
+    was "no scene" without a word on the names expected).
 
     Parameters
     ----------
@@ -2050,7 +2061,8 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     scenes : list of pathlib.Path
         Sorted scene directories.
     skipped : list of (pathlib.Path, str)
-        Sorted folders holding one image of a scene's two, and why they are no scene.
+        Sorted folders holding one image of a scene's two, or Middlebury's names, and why
+        they are no scene.
 
     Raises
     ------
@@ -2086,6 +2098,8 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
                 else "has left.png but no right.png"
             )
             skipped.append((Path(folder), f"{why} (a scene folder holds both)"))
+        elif "im0.png" in files and "im1.png" in files:
+            skipped.append((Path(folder), _MIDDLEBURY_NAMES))
     return sorted(found), sorted(skipped)
 
 
@@ -2128,6 +2142,13 @@ def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] =
         if q.is_file() and q.stem.lower() in ("left", "right") and q.name not in pair
     )
     found = f" ({', '.join(others)} found: a scene's images are PNG)" if others else ""
+    middlebury = [f for f, why in half if why == _MIDDLEBURY_NAMES]
+    if middlebury:
+        shown = ", ".join(str(f) for f in middlebury[:3])
+        more = f" and {len(middlebury) - 3} more" if len(middlebury) > 3 else ""
+        verb = "holds" if len(middlebury) == 1 else "hold"
+        found += f"; {shown}{more} {verb} Middlebury's im0.png + im1.png: {_MIDDLEBURY_FIX}"
+        half = [(f, why) for f, why in half if why != _MIDDLEBURY_NAMES]
     # a few named, the rest counted: the line stays one line under a tree of them
     named = [f"{f} {why.removesuffix(' (a scene folder holds both)')}" for f, why in half[:3]]
     if len(half) > 3:
