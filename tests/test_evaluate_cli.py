@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 import subprocess
 import sys
@@ -261,6 +262,33 @@ def test_eval_of_a_scene_narrower_than_its_range_names_the_width_needed(
     ]
 
 
+def test_the_members_line_says_those_under_a_pixel_of_disparity_apart() -> None:
+    """ETH3D playground: one validated match at 0.74 px of disparity (43.9 m for a GT of
+    8.6 m, a pixel's error being the whole distance there) took the members' RMSE from 6.30 %
+    to 10.16 % of the mean depth, unsaid. The line counts such members and gives the RMSE
+    without them (members_depth_1px); the members' own figures are unchanged, and a scene
+    without such members is said as before."""
+    from stereovision.cli import _members_line
+
+    def figures(n: int, rmse: float) -> dict[str, float]:
+        return {"n": n, "rmse_pct": rmse, "median_rel": 2.8}
+
+    row = {"members_depth": figures(8116, 10.164), "members_depth_1px": figures(8115, 6.2956)}
+    head = (
+        "playground: validated matches (>= 2 of Gabor, MCGM, Hopfield agree) with GT depth: "
+        "8116, RMSE 10.16 % of the mean depth, median |dZ|/Z 2.80 %"
+    )
+    assert _members_line("playground", row) == (
+        f"{head} (1 under 1 px of disparity, where a pixel's error is the whole distance; RMSE "
+        "without them: 6.30 %)"
+    )
+    row["members_depth_1px"] = row["members_depth"]
+    row["sgbm_depth"] = figures(9000, 12.0)
+    assert _members_line("playground", row) == f"{head}; SGBM-3WAY's RMSE 12.00 %"
+    row = {"members_depth": figures(2, 50.0), "members_depth_1px": figures(0, math.nan)}
+    assert _members_line("x", row).endswith("RMSE without them: none left)")
+
+
 def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> None:
     """Each block of an ``eval`` row is evaluation.md's metric of its own output, reproducible
     from the public functions: ``ours+fill`` of the row-filled map, ``members_depth`` of the
@@ -294,8 +322,11 @@ def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> No
     sgbm_z = calib.depth_from_disparity(opencv_sgbm(scene.left, scene.right, md))
     assert row["sgbm_depth"] == json_ready(depth_metrics(sgbm_z, zgt).as_dict())
     gl, gr = as_gray_float(scene.left, "left"), as_gray_float(scene.right, "right")
-    z_members = calib.depth_from_disparity(fuse_pair(gl, gr, max_disparity=md).dispx)
+    dispx = fuse_pair(gl, gr, max_disparity=md).dispx
+    z_members = calib.depth_from_disparity(dispx)
     assert row["members_depth"] == json_ready(depth_metrics(z_members, zgt).as_dict())
+    near = np.where(dispx >= 1, z_members, np.nan)
+    assert row["members_depth_1px"] == json_ready(depth_metrics(near, zgt).as_dict())
 
 
 def test_eval_scene_uses_only_a_rectified_calibration(
