@@ -290,7 +290,7 @@ def test_calibrate_argument_errors(rig: dict[str, Any]) -> None:
     with pytest.raises(ValueError, match=re.escape(differs)):
         calibrate(left, right, board=BOARD, square_size=0.05)
     with pytest.raises(
-        ValueError, match=re.escape("board: expected a stereovision.charuco.CharucoBoard")
+        TypeError, match=re.escape("board: expected a stereovision.charuco.CharucoBoard")
     ):
         calibrate(left, right, board="charuco")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="square_size: required for a chessboard"):
@@ -1387,13 +1387,18 @@ def test_calibration_from_recordings_names_a_board_that_is_no_charuco_board(
     tmp_path: Path, given: object
 ) -> None:
     """A pattern as board was AttributeError "'str' object has no attribute 'inner'" from
-    deep inside, after both recordings were opened; now calibrate's own ValueError, first."""
+    deep inside, after both recordings were opened; now calibrate's own error, first. A
+    TypeError, as find_charuco_corners' for the same board (calibrate's was ValueError)."""
     from stereovision.calibrate import calibrate_from_bag
 
     want = rf"^board: expected a stereovision\.charuco\.CharucoBoard, got {type(given).__name__}$"
     frame = tmp_path / "frame.png"  # a recording of one frame, opened before (now not)
     cv2.imwrite(str(frame), np.full((48, 64), 128, np.uint8))
-    with pytest.raises(ValueError, match=want):
+    with pytest.raises(TypeError, match=want):
         calibrate_from_video(frame, frame, board=given)  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match=want):
+    with pytest.raises(TypeError, match=want):
         calibrate_from_bag(tmp_path / "none.bag", board=given)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=want):
+        calibrate([frame] * 3, [frame] * 3, board=given)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=want):
+        find_charuco_corners(cv2.imread(str(frame)), given)  # type: ignore[arg-type]

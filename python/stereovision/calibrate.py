@@ -63,7 +63,7 @@ from stereovision._validate import NOT_NUMBERS, as_path, whole_value
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
-from stereovision.charuco import CharucoBoard
+from stereovision.charuco import CharucoBoard, _require_board
 from stereovision.overview import cv2_text
 
 __all__ = [
@@ -1457,6 +1457,9 @@ def calibrate(
     ------
     FileNotFoundError
         If an image file does not exist (the message names it).
+    TypeError
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard` (a
+        chessboard's ``"9x6"`` goes in ``pattern``).
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
@@ -2017,6 +2020,8 @@ def calibrate_from_video(
     SourceError
         If a source cannot be opened, or does not open or deliver a pair within
         ``read_timeout`` s (:class:`stereovision.capture.SourceError`, an OSError).
+    TypeError
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`.
     ValueError
         As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
         a ``max_pairs`` below :data:`MIN_PAIRS` or a ``read_timeout`` that is not a positive
@@ -2082,6 +2087,8 @@ def calibrate_from_bag(
     ------
     FileNotFoundError
         If the bag does not exist.
+    TypeError
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`.
     ValueError
         As :class:`~stereovision.rosbag.BagCamera` and :func:`calibrate`.
     """
@@ -2103,11 +2110,10 @@ def calibrate_from_bag(
 
 
 def _check_board(board: object) -> None:
-    """A ValueError naming ``board`` when it is given and is no ChArUco board."""
-    if board is not None and not isinstance(board, CharucoBoard):
-        raise ValueError(
-            f"board: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
-        )
+    """A TypeError naming ``board`` when it is given and is no ChArUco board (the charuco
+    functions' check: a pattern string '10x7' was ValueError here, TypeError there)."""
+    if board is not None:
+        _require_board(board)
 
 
 def _check_max_pairs(max_pairs: object) -> int:
