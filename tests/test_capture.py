@@ -1550,6 +1550,30 @@ def test_collector_decisions() -> None:
     assert col.progress() == {"x": 0.0, "y": 0.0, "size": 0.0, "skew": 0.0}
 
 
+def test_collector_checks_its_arguments_when_made() -> None:
+    """The pattern "9x6" was a raw cv2.error from findChessboardCorners, board="9x6" AttributeError
+    "'str' object has no attribute 'resolved'" at the first pair, and min_distance NaN kept
+    the same pose over and over."""
+    frame = _board(POSE_A, 0, False)
+    pair = capmod.StereoFrame(frame, frame, 0.0, 0.0, 0)
+    as_text = ChessboardCollector("9x6")  # type: ignore[arg-type]
+    assert as_text.pattern == (9, 6)
+    assert as_text.consider(pair) == ChessboardCollector((9, 6)).consider(pair)
+    want = r"^board: expected a stereovision\.charuco\.CharucoBoard, got str$"
+    with pytest.raises(TypeError, match=want):
+        ChessboardCollector((9, 6), board="9x6")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^pattern: expected inner corners as COLSxROWS"):
+        ChessboardCollector("nine by six")  # type: ignore[arg-type]
+    for bad, said in ((math.nan, "nan"), ("0.2", "'0.2'")):
+        with pytest.raises(
+            ValueError, match=f"^min_distance: expected a finite number, got {said}$"
+        ):
+            ChessboardCollector((9, 6), min_distance=bad)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^min_distance: expected a finite number of 0 or more"):
+        ChessboardCollector((9, 6), min_distance=-1.0)
+    assert ChessboardCollector((9, 6), min_distance=np.float32(0.5)).min_distance == 0.5
+
+
 #: 10x7 squares: the same 9x6 inner corners as the chessboard above.
 CHARUCO = CharucoBoard("10x7", SQUARE, 0.022, "DICT_5X5_100")
 #: POSE_B moved right until a quarter of the board leaves the left image.

@@ -2772,13 +2772,22 @@ class ChessboardCollector:
     Parameters
     ----------
     pattern : tuple of int
-        ``(cols, rows)`` inner corners (ignored with ``board``).
+        ``(cols, rows)`` inner corners, or ``"9x6"`` as :func:`~stereovision.calibrate.calibrate`
+        takes it (ignored with ``board``).
     min_distance : float
         A pair is kept when ``sum(|p - q|)`` over ``(x, y, size, skew)`` is above this for every
-        kept pair ``q`` (:data:`MIN_POSE_DISTANCE`).
+        kept pair ``q`` (:data:`MIN_POSE_DISTANCE`); a finite number, 0 or more.
     board : stereovision.charuco.CharucoBoard, optional
         A ChArUco board instead of a chessboard: a pair counts when both cameras see at least
         :data:`~stereovision.calibrate.CHARUCO_MIN_COMMON` common corners, not all on one line.
+
+    Raises
+    ------
+    TypeError
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, or
+        ``pattern`` is no pattern (:func:`~stereovision.calibrate.parse_pattern`).
+    ValueError
+        If ``pattern`` is a bad pattern, or ``min_distance`` is not a finite number of 0 or more.
 
     Attributes
     ----------
@@ -2790,6 +2799,24 @@ class ChessboardCollector:
     min_distance: float = MIN_POSE_DISTANCE
     kept: list[tuple[float, float, float, float]] = field(default_factory=list)
     board: CharucoBoard | None = None
+
+    def __post_init__(self) -> None:
+        # Checked here, not at the first board seen: "9x6" reached findChessboardCorners as a
+        # raw cv2.error, board="9x6" was AttributeError "'str' object has no attribute
+        # 'resolved'", min_distance NaN kept every pair (the same pose over and over) and "0.2"
+        # was TypeError "'<=' not supported" once a second board was seen.
+        from stereovision._validate import finite_number
+        from stereovision.charuco import _require_board
+
+        if self.board is not None:
+            _require_board(self.board)
+        else:
+            self.pattern = parse_pattern(self.pattern)
+        self.min_distance = finite_number(self.min_distance, "min_distance")
+        if self.min_distance < 0:
+            raise ValueError(
+                f"min_distance: expected a finite number of 0 or more, got {self.min_distance!r}"
+            )
 
     def _charuco_pose(self, frame: StereoFrame) -> tuple[float, float, float, float] | str:
         from stereovision.calibrate import CHARUCO_MIN_COMMON
