@@ -523,6 +523,24 @@ def test_rectify_rectified_is_identity() -> None:
         c.rectify(np.zeros((240, 100)), right)
 
 
+@pytest.mark.parametrize(
+    ("size", "hint"),
+    [
+        ((320, 240), "(images resized, not cropped: calib.scaled_to((320, 240)))"),
+        ((640, 400), "(another aspect ratio: another camera mode or camera, or cropped images)"),
+        ((640, 481), "(images cropped or padded, not resized (1 row more): crop or pad them to "),
+    ],
+)
+def test_rectify_of_another_size_says_what_the_pair_is(size: tuple[int, int], hint: str) -> None:
+    """A pair of a lower camera mode (320x240 frames, a 640x480 calibration) was told the two
+    sizes only; depth_map, for the same pair, said to scale the calibration: now both do."""
+    c = Calibration.ideal((640, 480), 60.0, 0.1)
+    img = np.zeros((size[1], size[0]), np.uint8)
+    said = f"left: image is {size[0]}x{size[1]}, calibration image_size is 640x480 {hint}"
+    with pytest.raises(ValueError, match=re.escape(said)):
+        c.rectify(img, img)
+
+
 def _render_blobs(points_px: np.ndarray, size: tuple[int, int], sigma: float = 1.2) -> np.ndarray:
     w, h = size
     yy, xx = np.mgrid[0:h, 0:w].astype(np.float64)

@@ -1189,6 +1189,28 @@ def crop_or_pad_hint(calib_size: tuple[int, int], size: tuple[int, int]) -> str 
     return f"images cropped or padded, not resized ({off}): crop or pad them to {cw}x{ch}"
 
 
+def calib_size_hint(calib_size: tuple[int, int], size: tuple[int, int]) -> str:
+    """What images of ``size`` against a calibration of ``calib_size`` likely are, and the
+    remedy (:data:`ADVICE`'s Python words): depth_map's and :meth:`Calibration.rectify`'s
+    refusal of another size (rectify named the two sizes only: a pair resized from the
+    calibration's images, a robot's lower camera mode, was not told of ``scaled_to``).
+
+    Examples
+    --------
+    >>> calib_size_hint((640, 480), (320, 240))
+    'images resized, not cropped: calib.scaled_to((320, 240))'
+    """
+    (cw, ch), (w, h) = calib_size, size
+    if (cw, ch) == (h, w):
+        return "width and height swapped? image_size is (width, height)"
+    if (crop := crop_or_pad_hint((cw, ch), (w, h))) is not None:
+        return crop
+    if same_aspect((cw, ch), (w, h)):
+        # fit_to_frames' 1 % (stream and gui scale such frames): a halved odd side rounds
+        return ADVICE["resized"]["api"].format(w=w, h=h)
+    return "another aspect ratio: another camera mode or camera, or cropped images"
+
+
 def pixels_shown(value: float) -> str:
     """A number of pixels for a message: every digit of a whole number up to 12 digits
     (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits; an

@@ -34,6 +34,7 @@ from stereovision._validate import (
     NOT_NUMBERS,
     as_image_array,
     as_path,
+    calib_size_hint,
     crop_or_pad_hint,
     known_unit,
     number_shown,
@@ -825,8 +826,12 @@ class Calibration:
         w, h = self.image_size
         for name, a in (("left", la), ("right", ra)):
             if a.shape[:2] != (h, w):
+                # depth_map's hint too: a pair resized from the calibration's (a lower camera
+                # mode) was told the two sizes only, not of scaled_to
+                hint = calib_size_hint((w, h), (a.shape[1], a.shape[0]))
                 raise ValueError(
-                    f"{name}: image is {a.shape[1]}x{a.shape[0]}, calibration image_size is {w}x{h}"
+                    f"{name}: image is {a.shape[1]}x{a.shape[0]}, calibration image_size is "
+                    f"{w}x{h} ({hint})"
                 )
         _check_alpha(alpha)  # also of a rectified calibration: alpha=5 passed there unsaid
         if self.rectified:

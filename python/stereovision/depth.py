@@ -33,8 +33,8 @@ from stereovision._validate import (
     as_bgr_uint8,
     as_gray_float,
     as_path,
+    calib_size_hint,
     check_pair,
-    crop_or_pad_hint,
     figure_shown,
     finite_number,
     known_unit,
@@ -43,7 +43,6 @@ from stereovision._validate import (
     path_given,
     real_number,
     refuse_unknown,
-    same_aspect,
     unreachable_range,
     user_stacklevel,
 )
@@ -280,17 +279,8 @@ def _rig_to_warp_by(
         )
     if tuple(calib.image_size) != (width, height):
         cw, ch = calib.image_size
-        w, h = width, height
-        if (cw, ch) == (h, w):
-            hint = "width and height swapped? image_size is (width, height)"
-        elif (crop := crop_or_pad_hint((cw, ch), (w, h))) is not None:
-            hint = crop
-        elif same_aspect((cw, ch), (w, h)):
-            # fit_to_frames' 1 % (stream and gui scale such frames): a halved odd side rounds
-            hint = ADVICE["resized"]["api"].format(w=w, h=h)
-        else:
-            hint = "another aspect ratio: another camera mode or camera, or cropped images"
-        raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
+        hint = calib_size_hint((cw, ch), (width, height))
+        raise ValueError(f"calibration is for {cw}x{ch} images, got {width}x{height} ({hint})")
     return (None if calib.rectified else calib), calib, max_disparity
 
 
