@@ -277,6 +277,20 @@ def test_bad_boards_are_named(args: tuple[Any, ...], match: str) -> None:
         CharucoBoard(*args)
 
 
+def test_a_board_of_unknown_dictionary_says_how_to_give_it() -> None:
+    """CharucoBoard("10x7", 0.03, 0.022).image(), the README's board printed from Python, said
+    only "the board's dictionary is not known yet (dictionary='auto')"."""
+    board = CharucoBoard("10x7", 0.03, 0.022)
+    want = re.escape(
+        "the board's dictionary is not known yet (dictionary='auto'): give one (e.g. "
+        "dictionary='DICT_5X5_100' for a board to print), or resolve() the board on an image "
+        "of it"
+    )
+    with pytest.raises(ValueError, match=f"^{want}$"):
+        board.image()
+    assert CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_100").image(20).shape == (180, 240)
+
+
 def test_dictionary_names() -> None:
     assert dictionary_name("5x5_100") == "DICT_5X5_100"
     assert dictionary_name("apriltag_36h11") == "DICT_APRILTAG_36H11"

@@ -316,7 +316,13 @@ class CharucoBoard:
             If the dictionary is not known yet (``dictionary="auto"``: :meth:`resolve` first).
         """
         if self.dictionary == "auto":
-            raise ValueError("the board's dictionary is not known yet (dictionary='auto')")
+            # said what to do: image() and render_charuco of CharucoBoard("10x7", 0.03, 0.022),
+            # the README's board (its default dictionary "auto"), stopped at this bare line
+            raise ValueError(
+                "the board's dictionary is not known yet (dictionary='auto'): give one (e.g. "
+                "dictionary='DICT_5X5_100' for a board to print), or resolve() the board on an "
+                "image of it"
+            )
         return _cv_board(
             self.squares, self.square_size, self.marker_size, self.dictionary, bool(self.legacy)
         )
