@@ -1026,6 +1026,26 @@ def test_scale_pair_averages_the_pixels_it_merges() -> None:
     np.testing.assert_array_equal(small_r, small)
 
 
+def test_scale_pair_keeps_a_16_bit_pair_16_bit() -> None:
+    """A 16-bit pair (a 16-bit PNG sequence) at 640 or 320 px was cast to uint8, its levels
+    wrapped modulo 256: matched as noise (cones at 200 px: disparities 0-112 px, 'look
+    unrectified', where its 8-bit copy gives 0-32 px)."""
+    from stereovision.gui.app import compute_view
+    from stereovision.io import imread
+
+    cones = Path(sources.__file__).resolve().parents[1] / "data" / "cones"
+    left8, right8 = imread(cones / "left.png"), imread(cones / "right.png")
+    left, right = (im.astype(np.uint16) * 257 for im in (left8, right8))
+    small, small_r, s = sources.scale_pair(left, right, 200)
+    small8, _, s8 = sources.scale_pair(left8, right8, 200)
+    assert small.dtype == small_r.dtype == np.uint16 and s == s8
+    assert np.abs(small.astype(np.int64) - small8.astype(np.int64) * 257).max() <= 257
+    view16 = compute_view(left, right, None, "fast", width=200)
+    view8 = compute_view(left8, right8, None, "fast", width=200)
+    assert view16.result.max_disparity == view8.result.max_disparity == 32
+    assert "unrectified" not in view16.stats
+
+
 def test_scaled_calibration_passes_none_and_unscaled_through() -> None:
     asked: list[Any] = []
 

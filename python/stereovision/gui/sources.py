@@ -676,17 +676,20 @@ def open_stereo_source(
 
 
 def scale_pair(
-    left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8], width: int | None
-) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8], float]:
-    """Resize both images to ``width`` pixels wide (never up); returns the scale factor too."""
+    left: npt.NDArray[Any], right: npt.NDArray[Any], width: int | None
+) -> tuple[npt.NDArray[Any], npt.NDArray[Any], float]:
+    """Resize both images to ``width`` pixels wide (never up); returns the scale factor too.
+    The images keep their type (a 16-bit pair stays 16-bit)."""
     w = left.shape[1]
     if width is None or width >= w:
         return left, right, 1.0
     s = width / w
     size = (width, max(1, round(left.shape[0] * s)))
+    # in the images' own type: a 16-bit pair (a 16-bit PNG sequence) was cast to uint8, its
+    # levels wrapped modulo 256, and matched as noise at 640 or 320 px
     return (
-        np.asarray(cv2.resize(left, size, interpolation=cv2.INTER_AREA), dtype=np.uint8),
-        np.asarray(cv2.resize(right, size, interpolation=cv2.INTER_AREA), dtype=np.uint8),
+        np.asarray(cv2.resize(left, size, interpolation=cv2.INTER_AREA), dtype=left.dtype),
+        np.asarray(cv2.resize(right, size, interpolation=cv2.INTER_AREA), dtype=right.dtype),
         s,
     )
 
