@@ -5318,6 +5318,38 @@ def test_draw_sparse_colours_each_match_by_its_value():
     assert not np.array_equal(ramp[0], ramp[1])
 
 
+def test_a_16_bit_pairs_sparse_pictures_are_drawn_at_8_bits():
+    """A 16-bit pair (a 16-bit PNG sequence) with a sparse method: draw_sparse cast it to
+    uint8, keeping each level's low byte (the left image under the dots noise), draw_matches
+    drew 8-bit colours on the 16-bit pair (255 of 65535: near-black lines on the page), and
+    the empty depth picture, 16-bit zeros, was warned of as 'largest value is 0'."""
+    import warnings
+
+    from stereovision.gui.app import compute_view, draw_matches, draw_sparse
+
+    rng = np.random.default_rng(0)
+    left8 = rng.integers(0, 256, (30, 40, 3), dtype=np.uint8)
+    left16 = left8.astype(np.uint16) * 256 + 128  # low byte 128 everywhere
+    values = np.full((30, 40), np.nan, np.float32)
+    values[5, 30] = 4.0
+    np.testing.assert_array_equal(
+        draw_sparse(left16, values, 0.0, 8.0), draw_sparse(left8, values, 0.0, 8.0)
+    )
+    lines16 = draw_matches(left16, left16, values, lo=0.0, hi=8.0)
+    lines8 = draw_matches(left8, left8, values, lo=0.0, hi=8.0)
+    assert lines16.dtype == np.uint8
+    np.testing.assert_array_equal(lines16[5, 30], lines8[5, 30])  # the left end's colour
+    assert lines16[5, 30].max() > 200  # not drawn at 255 of 65535: near black once shown
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        view = compute_view(
+            left.astype(np.uint16) * 257, right.astype(np.uint16) * 257, None, "mcgm", width=160
+        )
+    assert [str(c.message) for c in caught] == []
+    assert not _decode(view.depth_url).any()  # no calibration: black
+
+
 # ----------------------------------------------------------------------------- page events
 
 

@@ -527,10 +527,12 @@ def draw_matches(
     -------
     ndarray, uint8 (H, 2W, 3)
     """
+    from stereovision._validate import as_bgr_uint8
     from stereovision.cli import colorize
 
     w = disparity.shape[1]
-    canvas = np.hstack([left, right]).copy()
+    # at 8 bits: a 16-bit pair's lines were drawn in 8-bit colours (255 of 65535), near black
+    canvas = np.hstack([as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right")])
     ys, xs = np.nonzero(np.isfinite(disparity))
     if len(xs) == 0:
         return canvas
@@ -569,9 +571,11 @@ def draw_sparse(
     ndarray, uint8 (H, W, 3)
         The picture; a dot's centre has the colour ``colorize`` gives its value.
     """
+    from stereovision._validate import as_bgr_uint8
     from stereovision.cli import colorize
 
-    grey = cv2.cvtColor(np.ascontiguousarray(image, dtype=np.uint8), cv2.COLOR_BGR2GRAY)
+    # at 8 bits as the page shows it: a 16-bit image cast to uint8 kept its low byte, noise
+    grey = cv2.cvtColor(as_bgr_uint8(image, "image"), cv2.COLOR_BGR2GRAY)
     out: npt.NDArray[np.uint8] = np.repeat((grey // 2)[..., None], 3, axis=2).astype(np.uint8)
     ys, xs = np.nonzero(np.isfinite(values))
     if len(xs) == 0:
@@ -973,7 +977,8 @@ def compute_view(
         disparity_url = _data_url(draw_sparse(shown_left, result.disparity, disp_lo, disp_hi))
     else:
         disparity_url = _data_url(colorize(result.disparity, lo=disp_lo, hi=disp_hi))
-    depth_img = np.zeros_like(shown_left)
+    # 8-bit black: a 16-bit pair's zeros were warned of as "largest value is 0" when shown
+    depth_img = np.zeros((*shown_left.shape[:2], 3), np.uint8)
     depth_caption = DEPTH_CAPTION if result.depth is not None else NO_DEPTH_CAPTION
     depth_ends = None
     if result.depth is not None:
