@@ -5350,6 +5350,34 @@ def test_a_16_bit_pairs_sparse_pictures_are_drawn_at_8_bits():
     assert not _decode(view.depth_url).any()  # no calibration: black
 
 
+def test_a_16_bit_calibrated_pairs_sparse_result_has_8_bit_colours_and_saves(tmp_path):
+    """A calibrated 16-bit pair with a sparse (or OpenCV) method: _result_from_disparity cast
+    the colours to uint8 (each level's low byte: a cloud of noise) and kept the 16-bit left
+    image, which failed the Save's overview ('result: expected a uint8 left image, got
+    uint16'). A grey pair's colours were an IndexError."""
+    from stereovision.calibration import Calibration
+    from stereovision.cli import write_overview
+    from stereovision.gui.app import _sparse_result
+
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    left, right, s = sources.scale_pair(left, right, 160)
+    calib = sources.scaled_calibration(
+        Calibration.from_file(CONES / "calib.txt"), s, (left.shape[1], left.shape[0])
+    )
+    r8, _ = _sparse_result("mcgm", left, right, calib, 32)
+    left16, right16 = (im.astype(np.uint16) * 256 + 128 for im in (left, right))
+    r16, _ = _sparse_result("mcgm", left16, right16, calib, 32)
+    assert r16.left_rectified.dtype == np.uint8 and len(r16.colors) > 0
+    diff = r16.left_rectified.astype(int) - r8.left_rectified.astype(int)
+    assert np.abs(diff).max() <= 1  # the 8-bit pair's picture, to the rounding
+    xs, ys = r16.pixels.T
+    np.testing.assert_array_equal(r16.colors, r16.left_rectified[ys, xs, ::-1])  # not 128s
+    write_overview(r16, tmp_path, "pair", "m")  # raised ValueError
+    assert (tmp_path / "overview.png").is_file()
+    grey, _ = _sparse_result("mcgm", left[:, :, 1], right[:, :, 1], calib, 32)
+    assert grey.left_rectified.shape[2] == 3 and (grey.colors[:, 0] == grey.colors[:, 2]).all()
+
+
 # ----------------------------------------------------------------------------- page events
 
 

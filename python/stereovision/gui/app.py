@@ -816,9 +816,14 @@ def _sparse_result(
 def _result_from_disparity(
     method: str, disp: np.ndarray, left: np.ndarray, calib: Any, d_max: int
 ) -> Any:
-    """A ``DepthResult`` of a disparity map (NaN: none) of the rectified ``left`` image."""
+    """A ``DepthResult`` of a disparity map (NaN: none) of the rectified ``left`` image (kept
+    at 8 bits, BGR, as ``depth_map`` keeps its ``left_rectified``)."""
+    from stereovision._validate import as_bgr_uint8
     from stereovision.depth import DepthResult
 
+    # a 16-bit pair's colours were cast to uint8 (their low byte: a cloud of noise), and its
+    # 16-bit left image failed the Save ("result: expected a uint8 left image, got uint16")
+    left = as_bgr_uint8(left, "left")
     valid = np.isfinite(disp)
     depth = None
     points = np.zeros((0, 3), np.float32)
