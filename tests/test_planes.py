@@ -379,7 +379,8 @@ def test_segments_clips_float_values_to_0_255_before_the_blur() -> None:
         np.testing.assert_array_equal(segments(img, blur=1.0), np.zeros((6, 12), np.uint32))
     low = np.zeros((6, 12), np.float32)
     low[:, 6:] = -10.0
-    np.testing.assert_array_equal(segments(low, blur=1.0), np.zeros((6, 12), np.uint32))
+    with pytest.warns(UserWarning, match="values down to -10 are clipped to 0-255"):
+        np.testing.assert_array_equal(segments(low, blur=1.0), np.zeros((6, 12), np.uint32))
 
 
 def test_plane_fill_refuses_a_label_equal_to_the_pixel_count_and_a_negative_min_pixels() -> None:
@@ -658,3 +659,29 @@ def test_an_image_the_0_255_cast_loses_is_warned_of(data_dir: Path) -> None:
             fill_planes(d, im)
             side_fill(d, im)
             segments(im)
+
+
+def test_an_image_with_negative_values_the_0_255_cast_clips_is_warned_of(data_dir: Path) -> None:
+    """Negative values are clipped to 0 as values above 255 are to 255, and were not named: a
+    zero-centred float image (grey / 255 - 0.5) was one segment of the whole crop, a signed
+    16-bit one lost its lower half to 0, and fill_planes filled the holes from that without
+    a word. fill_planes, side_fill and segments warn of them now."""
+    img, d = _crop(data_dir, "middlebury2003/cones", 120, 160)
+    grey = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    centred = grey / 255.0 - 0.5
+    signed = grey.astype(np.int16) - 128
+    share = f"{100.0 * np.count_nonzero(signed < 0) / signed.size:.1f}"
+    lo, hi = int(signed.min()), int(signed.max())
+    cases = (
+        (centred, rf"values down to {centred.min():g} are clipped to 0-255 \({share} % "),
+        (signed, rf"values down to {lo} are clipped to 0-255 \({share} % "),
+        (signed * 4, rf"values {4 * lo} to {4 * hi} are clipped to 0-255 \("),
+    )
+    with pytest.warns(UserWarning):
+        assert int(segments(centred).max()) == 0  # one segment: what the warning is for
+    for im, says in cases:
+        for run in (partial(fill_planes, d), partial(side_fill, d), segments):
+            with pytest.warns(UserWarning, match=rf"^image: {says}") as got:
+                run(im)
+            assert got[0].filename == __file__  # the caller's line
+            assert "pass an 8-bit image" in str(got[0].message)

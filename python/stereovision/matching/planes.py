@@ -112,7 +112,7 @@ def segments(
     -----
     UserWarning
         With ``blur > 0``, an image whose levels the 0-255 cast before the blur loses: float
-        values within [0, 1] (truncated to 0 and 1) or values above 255 (clipped).
+        values within [0, 1] (truncated to 0 and 1) or values above 255 or below 0 (clipped).
     """
     from stereovision import _core
 
@@ -214,9 +214,10 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
 
 def _warn_if_not_0_255(im: npt.NDArray[Any]) -> None:
     """Warn of an image whose levels the 0-255 cast loses: a float image in [0, 1] (the
-    matchers' convention) truncated to 0 and 1, or 16-bit values clipped to 255. Either made
-    one segment of nearly the whole image, and fill_planes filled every hole from it without a
-    word (cones' Gabor map: all 3,631 holes, up to 3.8 px from the uint8 image's fill)."""
+    matchers' convention) truncated to 0 and 1, 16-bit values clipped to 255, or negative
+    values clipped to 0. The first two (and a zero-centred float image) made one segment of
+    nearly the whole image, and fill_planes filled every hole from it without a word (cones'
+    Gabor map: all 3,631 holes, up to 3.8 px from the uint8 image's fill)."""
     import warnings
 
     if im.size == 0:
@@ -227,11 +228,17 @@ def _warn_if_not_0_255(im: npt.NDArray[Any]) -> None:
             "float values within [0, 1] are read as 0-255 levels (truncated to 0 and 1); "
             "pass the uint8 image (or image * 255)"
         )
-    elif hi > 255:
-        share = 100.0 * float(np.count_nonzero(im > 255)) / im.size
+    elif hi > 255 or lo < 0:
+        # negative values too: a zero-centred float image ([-0.5, 0.5]) was one segment, a
+        # signed one lost its lower half to 0, without a word
+        share = 100.0 * float(np.count_nonzero((im > 255) | (im < 0))) / im.size
+        span = (
+            f"up to {hi:g}" if lo >= 0 else f"down to {lo:g}" if hi <= 255 else f"{lo:g} to {hi:g}"
+        )
+        advice = "image // 257 for 16-bit data" if lo >= 0 else "levels 0 to 255"
         said = (
-            f"values up to {hi:g} are clipped to 0-255 ({share:.1f} % of the values); "
-            "pass an 8-bit image (image // 257 for 16-bit data)"
+            f"values {span} are clipped to 0-255 ({share:.1f} % of the values); "
+            f"pass an 8-bit image ({advice})"
         )
     else:
         return
@@ -351,7 +358,7 @@ def fill_planes(
     -----
     UserWarning
         An image whose levels the 0-255 cast loses: float values within [0, 1] (truncated to 0
-        and 1) or values above 255 (a 16-bit image, clipped).
+        and 1) or values above 255 (a 16-bit image) or below 0 (clipped).
     """
     from stereovision import _core
 
@@ -447,7 +454,7 @@ def side_fill(
     -----
     UserWarning
         An image whose levels the 0-255 cast loses: float values within [0, 1] (truncated to 0
-        and 1) or values above 255 (a 16-bit image, clipped).
+        and 1) or values above 255 (a 16-bit image) or below 0 (clipped).
     """
     import cv2
 
