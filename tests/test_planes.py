@@ -685,3 +685,22 @@ def test_an_image_with_negative_values_the_0_255_cast_clips_is_warned_of(data_di
                 run(im)
             assert got[0].filename == __file__  # the caller's line
             assert "pass an 8-bit image" in str(got[0].message)
+
+
+def test_segments_of_an_unblurred_float_image_in_0_1_is_warned_of(data_dir: Path) -> None:
+    """Without a blur a float image is binned as it is: in [0, 1] every pixel fell in one or
+    two bins of a step >= 1 (cones crop: 1 segment instead of 2,955), without the warning the
+    blurred path and fill_planes give; a float image in 0-255 and the uint8 one say nothing."""
+    import warnings
+
+    img, _ = _crop(data_dir, "middlebury2003/cones", 120, 160)
+    grey = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    says = "image: float values within [0, 1] are read as 0-255 levels (one or two bins of a"
+    with pytest.warns(UserWarning, match=rf"^{re.escape(says)}") as got:
+        assert int(segments(grey / 255.0, blur=0).max()) == 0
+    assert got[0].filename == __file__  # the caller's line
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for im in (grey, grey.astype(np.float32), grey - 128.0, grey.astype(np.uint16) * 257):
+            segments(im, blur=0)
+        assert int(segments(grey.astype(np.float32), blur=0).max()) > 10

@@ -111,8 +111,9 @@ def segments(
     Warns
     -----
     UserWarning
-        With ``blur > 0``, an image whose levels the 0-255 cast before the blur loses: float
-        values within [0, 1] (truncated to 0 and 1) or values above 255 or below 0 (clipped).
+        Float values within [0, 1] (read as 0-255 levels: one or two bins, or with ``blur >
+        0`` truncated to 0 and 1), or with ``blur > 0`` values the 0-255 cast before the blur
+        clips (above 255 or below 0).
     """
     from stereovision import _core
 
@@ -143,6 +144,10 @@ def segments(
         check_index_range(im.shape, "image", max_pixels=_GRAPH_MAX_PIXELS)
     if blur > 0:
         im = _blurred(im, blur)
+    elif im.dtype.kind == "f":
+        # unblurred floats are binned as they are: in [0, 1], one or two bins of a step >= 1
+        # (one segment of the whole image, as the blur's cast made it)
+        _warn_if_not_0_255(im, cast=False)
     if quantised:
         # Equal regions of a uint8 image: the kernel bins and labels in one pass.
         u8 = im[:, :, None] if im.ndim == 2 else im
@@ -212,23 +217,25 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     return np.asarray(cv2.GaussianBlur(u8, (0, 0), float(blur)), np.uint8)
 
 
-def _warn_if_not_0_255(im: npt.NDArray[Any]) -> None:
+def _warn_if_not_0_255(im: npt.NDArray[Any], cast: bool = True) -> None:
     """Warn of an image whose levels the 0-255 cast loses: a float image in [0, 1] (the
     matchers' convention) truncated to 0 and 1, 16-bit values clipped to 255, or negative
     values clipped to 0. The first two (and a zero-centred float image) made one segment of
     nearly the whole image, and fill_planes filled every hole from it without a word (cones'
-    Gabor map: all 3,631 holes, up to 3.8 px from the uint8 image's fill)."""
+    Gabor map: all 3,631 holes, up to 3.8 px from the uint8 image's fill). ``cast`` False: the
+    values are binned as they are (:func:`segments` without a blur), only [0, 1] is warned of."""
     import warnings
 
     if im.size == 0:
         return
     lo, hi = float(im.min()), float(im.max())
     if im.dtype.kind == "f" and 0 < hi <= 1 and lo >= 0:
+        lost = "truncated to 0 and 1" if cast else "one or two bins of a step >= 1"
         said = (
-            "float values within [0, 1] are read as 0-255 levels (truncated to 0 and 1); "
+            f"float values within [0, 1] are read as 0-255 levels ({lost}); "
             "pass the uint8 image (or image * 255)"
         )
-    elif hi > 255 or lo < 0:
+    elif cast and (hi > 255 or lo < 0):
         # negative values too: a zero-centred float image ([-0.5, 0.5]) was one segment, a
         # signed one lost its lower half to 0, without a word
         share = 100.0 * float(np.count_nonzero((im > 255) | (im < 0))) / im.size
