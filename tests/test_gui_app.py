@@ -735,6 +735,24 @@ def test_opencv_methods_on_a_pair_they_cannot_take_say_why(shape, method, said):
     assert str(err.value).startswith(said) and "/opencv/" not in str(err.value)
 
 
+def test_a_sparse_method_on_a_pair_too_narrow_for_the_automatic_range_says_so():
+    """A sparse method on a 12 px wide pair with no max disparity: the page said "disparity
+    range 16 is not smaller than the image width 12", a range nobody gave (the GUI's own
+    estimate, passed to match as given), where the dense methods say the pair is too narrow.
+    It says what depth_map says now."""
+    from stereovision import depth_map
+    from stereovision.gui.app import compute_view
+
+    img = np.random.default_rng(0).integers(0, 255, (20, 12, 3), dtype=np.uint8)
+    with pytest.raises(ValueError) as dense:
+        depth_map(img, np.roll(img, -2, axis=1), None)
+    for method in ("hopfield", "mcgm"):
+        with pytest.raises(ValueError) as err:
+            compute_view(img, np.roll(img, -2, axis=1), None, method)
+        assert str(err.value) == str(dense.value), method
+        assert str(err.value).startswith("image too narrow for stereo matching: 12 px wide")
+
+
 def test_the_depth_picture_says_the_distances_of_its_colours():
     """The depth picture had no key ("depth (near = warm)"), and its colour scale changes with
     every pair: its caption now gives the distances at its two ends, those of its colour map

@@ -808,6 +808,12 @@ def _sparse_result(
         left, right = calib.rectify(left, right)
         calib = calib.rectified_calibration()
     d = d_max if d_max is not None else estimate_max_disparity(left, right)
+    if d_max is None and d >= left.shape[1]:
+        # the estimate is no range the user gave: depth_map's words for the pair, as the other
+        # methods say it (match, given it, said "disparity range 16 is not smaller than ...")
+        from stereovision.depth import _too_narrow
+
+        raise _too_narrow(left.shape[1], d)
     matches = match(left, right, calib, method=method, max_disparity=d)
     disp = np.ascontiguousarray(matches.dispx, dtype=np.float32)
     return _result_from_disparity(method, disp, left, calib, d), matches
