@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 import synthetic_scene as syn
 
+import stereovision.bench
 from stereovision import baselines
-from stereovision.bench import bench_scene, format_table, sparse_name
+from stereovision.bench import BenchCase, bench_scene, format_table, sparse_name
 from stereovision.cli import main
 from stereovision.depth import METHODS
 from stereovision.evaluate import dense_metrics
@@ -21,9 +22,16 @@ from stereovision.match import METHODS as SPARSE_METHODS
 SCENE = "middlebury2001/tsukuba"  # the smallest GT scene: 384x288, max_disparity 16
 
 
-def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
+@pytest.fixture(scope="module")
+def tsukuba_cases(data_dir: Path) -> list[BenchCase]:
+    """``bench_scene(tsukuba, runs=5)``, timed once for the two tests that read it (neither
+    changes it)."""
+    return bench_scene(load_scene(data_dir / SCENE), runs=5)
+
+
+def test_bench_scene_cases_and_figures(data_dir: Path, tsukuba_cases: list[BenchCase]) -> None:
     scene = load_scene(data_dir / SCENE)
-    cases = bench_scene(scene, runs=5)
+    cases = tsukuba_cases
     names = [c.case for c in cases]
     # gabor's Matches are its dense run's confident pixels: timed once, as a dense method
     sparse = [sparse_name(m) for m in SPARSE_METHODS if m != "gabor"]
@@ -51,8 +59,22 @@ def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
     assert table.count("\n") == len(cases) and "SGBM-3WAY" in table
 
 
-def test_bench_cli_json_lines(data_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_bench_cli_json_lines(
+    data_dir: Path,
+    tsukuba_cases: list[BenchCase],
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    asked: list[tuple[tuple[int, ...], int]] = []
+
+    def timed_once(scene: Any, runs: int) -> list[BenchCase]:
+        # the same scene and runs as tsukuba_cases: its cases, not a second timing of them
+        asked.append((scene.left.shape, runs))
+        return tsukuba_cases
+
+    monkeypatch.setattr(stereovision.bench, "bench_scene", timed_once)
     assert main(["bench", "--runs", "5", "--json", str(data_dir / SCENE)]) == 0
+    assert asked == [((288, 384, 3), 5)]
     lines = [json.loads(ln) for ln in capsys.readouterr().out.splitlines() if ln.strip()]
     assert [ln["case"] for ln in lines][-2:] == ["StereoBM", "SGBM-3WAY"]
     assert all(ln["bench"] == "vs_opencv" and ln["scene"].endswith("tsukuba") for ln in lines)
