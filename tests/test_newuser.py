@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 
@@ -718,6 +719,23 @@ def test_calibrate_progress_reaches_its_total_when_a_fit_ends_early(
     assert rep.model_selection["k1k2p1p2"] == float("inf")
 
 
+class _HeardEnough(Exception):
+    """Raised by :func:`_until`'s callback: what the test reads has been heard."""
+
+
+def _until(stage: str, calls: list[tuple[str, int, int]]) -> Callable[[str, int, int], None]:
+    """A ``progress`` callback keeping every call in ``calls`` and stopping the work with
+    :class:`_HeardEnough` at the first call of ``stage``: the rest of a calibration (fitting,
+    choosing the distortion model) is not what a test of the frames' progress reads."""
+
+    def heard(what: str, done: int, total: int) -> None:
+        calls.append((what, done, total))
+        if what == stage:
+            raise _HeardEnough
+
+    return heard
+
+
 class _Terminal:
     """A stderr that says it is a terminal, keeping what is written to it."""
 
@@ -925,9 +943,10 @@ def test_reading_a_calibration_recording_reports_its_progress(
             assert cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), cv2.imread(str(path)))
     left, right = str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")
     calls: list[tuple[str, int, int]] = []
-    calibrate_from_video(
-        left, right, square_size=1.0, min_distance=0.0, progress=lambda *a: calls.append(a)
-    )
+    with pytest.raises(_HeardEnough):
+        calibrate_from_video(
+            left, right, square_size=1.0, min_distance=0.0, progress=_until(PROGRESS_BOARDS, calls)
+        )
     assert calls[:7] == [(PROGRESS_FRAMES, i, 6) for i in range(1, 7)] + [(PROGRESS_BOARDS, 1, 6)]
 
     args = ["calibrate", "--left", left, "--right", right, "--square", "1"]
@@ -996,7 +1015,7 @@ def test_a_recording_announcing_fewer_frames_than_it_holds_never_reports_past_it
     the reading passes the count announced, the total is said unknown (0), as a camera's."""
     import cv2
 
-    from stereovision.calibrate import PROGRESS_FRAMES, calibrate_from_video
+    from stereovision.calibrate import PROGRESS_BOARDS, PROGRESS_FRAMES, calibrate_from_video
     from stereovision.capture import StereoCamera
 
     lefts, rights = _chessboard_pairs(6)
@@ -1006,9 +1025,10 @@ def test_a_recording_announcing_fewer_frames_than_it_holds_never_reports_past_it
     left, right = str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")
     monkeypatch.setattr(StereoCamera, "_announced", lambda self, side: 3)
     calls: list[tuple[str, int, int]] = []
-    calibrate_from_video(
-        left, right, square_size=1.0, min_distance=0.0, progress=lambda *a: calls.append(a)
-    )
+    with pytest.raises(_HeardEnough):
+        calibrate_from_video(
+            left, right, square_size=1.0, min_distance=0.0, progress=_until(PROGRESS_BOARDS, calls)
+        )
     frames = [c for c in calls if c[0] == PROGRESS_FRAMES]
     assert frames == [(PROGRESS_FRAMES, i, 3) for i in (1, 2, 3)] + [
         (PROGRESS_FRAMES, i, 0) for i in (4, 5, 6)
