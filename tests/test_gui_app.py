@@ -710,9 +710,9 @@ def test_scaled_calibration_and_compute_view():
         (
             (300, 2, 3),
             "opencv-sgbm",
-            # depth_map's words: the width needed and the range that fits (it said neither)
-            "disparity range 16 is not smaller than the image width 2: it needs images at least "
-            "17 px wide, or give a max_disparity below 2",
+            # the width needed (it said neither that nor a range that fits: OpenCV has none)
+            "image too narrow for opencv-sgbm: 2 px wide, and its disparity range (a multiple "
+            "of 16, at least 16 px) needs images at least 17 px wide",
         ),
         # baselines' words: the height StereoBM's block needs (OpenCV's "(-211: ...
         # SADWindowSize must be odd, ... not larger than image width or height")
@@ -733,6 +733,34 @@ def test_opencv_methods_on_a_pair_they_cannot_take_say_why(shape, method, said):
     with pytest.raises(ValueError) as err:
         compute_view(img, img, None, method)
     assert str(err.value).startswith(said) and "/opencv/" not in str(err.value)
+
+
+def test_an_opencv_method_on_a_pair_too_narrow_for_any_of_its_ranges_says_so():
+    """OpenCV's ranges are multiples of 16: a 12 px wide pair with no max disparity was told
+    "disparity range 16 is not smaller than the image width 12 ..., or give a max_disparity
+    below 12", a range nobody gave, and the max_disparity it advised (8) got the same words.
+    It says the width the method needs, whatever range is given."""
+    from stereovision.gui.app import compute_view
+
+    rng = np.random.default_rng(0)
+    for width, method, need in (
+        (12, "opencv-sgbm", 17),
+        (16, "opencv-bm", 30),
+        (20, "opencv-bm", 30),
+    ):
+        img = rng.integers(0, 255, (40, width, 3), dtype=np.uint8)
+        for max_disparity in (None, 8, 40):
+            with pytest.raises(ValueError) as err:
+                compute_view(
+                    img, np.roll(img, -2, axis=1), None, method, max_disparity=max_disparity
+                )
+            said = str(err.value)
+            if width == 20 and max_disparity != 40:  # baselines' own words, unchanged
+                assert said.startswith("StereoBM's 15 px block and a 16 px"), said
+                continue
+            assert said.startswith(f"image too narrow for {method}: {width} px wide"), said
+            assert said.endswith(f"images at least {need} px wide"), said
+            assert "max_disparity" not in said, said
 
 
 def test_a_sparse_method_on_a_pair_too_narrow_for_the_automatic_range_says_so():

@@ -776,12 +776,24 @@ def _floor_view(result: Any) -> tuple[Any, str, str]:
 def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int) -> Any:
     """A ``DepthResult`` from an OpenCV reference matcher (for comparison in the GUI)."""
     from stereovision import baselines
+    from stereovision.baselines import BM_BLOCK_SIZE
 
     if calib is not None and not calib.rectified:
         left, right = calib.rectify(left, right)
         calib = calib.rectified_calibration()
     fn = baselines.opencv_sgbm if method == "opencv-sgbm" else baselines.opencv_bm
     w, h = left.shape[1], left.shape[0]
+    # OpenCV's ranges are multiples of 16 (and BM's block must fit beside them): a pair with
+    # room for none was told "disparity range 16 is not smaller than the image width 12, or
+    # give a max_disparity below 12", a range nobody gave and a max_disparity that fails too
+    need = 16 + (BM_BLOCK_SIZE - 1 if method == "opencv-bm" else 1)
+    if d_max >= w and w < need:
+        block = f" and its {BM_BLOCK_SIZE} px block" if method == "opencv-bm" else ""
+        raise ValueError(
+            f"image too narrow for {method}: {w} px wide, and its disparity range (a multiple "
+            f"of 16, at least 16 px){block} need{'' if block else 's'} images at least {need} "
+            "px wide"
+        )
     if d_max >= w:  # depth_map's words (OpenCV failed to allocate 18446744073709 GB)
         from stereovision.depth import _range_too_wide
 
