@@ -5396,6 +5396,26 @@ def test_a_16_bit_pairs_sparse_pictures_are_drawn_at_8_bits():
     assert not _decode(view.depth_url).any()  # no calibration: black
 
 
+def test_a_12_bit_pairs_warnings_are_said_on_the_page_not_again_in_the_log():
+    """A 12-bit pair in 16 bits: the matching's warnings went on the page, but the pictures'
+    8-bit copies warned again outside it, into the server's log ("right: ..." from the matches
+    picture, "image: uint16 image whose largest value is 4077 ..." from the right image's)."""
+    import warnings
+
+    from stereovision.gui.app import compute_view
+
+    left, right = (
+        cv2.imread(str(CONES / f"{s}.png")).astype(np.uint16) * 16 for s in ("left", "right")
+    )
+    for method in ("mcgm", "fast"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            view = compute_view(left, right, None, method, width=160)
+        assert [str(c.message) for c in caught] == [], method
+        assert "warning: left: uint16 image whose largest value is" in view.stats
+        assert "warning: right: uint16 image whose largest value is" in view.stats
+
+
 def test_a_16_bit_calibrated_pairs_sparse_result_has_8_bit_colours_and_saves(tmp_path):
     """A calibrated 16-bit pair with a sparse (or OpenCV) method: _result_from_disparity cast
     the colours to uint8 (each level's low byte: a cloud of noise) and kept the 16-bit left

@@ -984,6 +984,16 @@ def compute_view(
         # too (it was shown as the cameras gave it, beside a rectified left, and the matches
         # were drawn on the raw pair, off the rows they were found on)
         shown_right = calib_s.rectify(left_s, right_s)[1]
+    if shown_right.dtype != np.uint8 or shown_left.dtype != np.uint8:
+        from stereovision._validate import as_bgr_uint8
+
+        # shown at 8 bits, once and quietly: the matching said the pair's warnings on the page
+        # (a 12-bit pair in 16 bits), and each picture drawn of it said them again in the
+        # server's log ("image: uint16 image whose largest value is 4077 ...")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            shown_left = as_bgr_uint8(shown_left, "left")
+            shown_right = as_bgr_uint8(shown_right, "right")
     disparity_caption = DISPARITY_CAPTION
     disp_lo: float | None = 0.0
     disp_hi = None
