@@ -1173,6 +1173,36 @@ def test_atomic_write_failing_to_put_the_file_in_place_names_the_file(
     assert os.listdir(tmp_path) == ["x.pfm"] and dest.read_bytes() == b"old"
 
 
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+def test_atomic_write_into_a_full_disk_names_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A real full disk fails the buffered write at the flush, and the file's close flushed
+    it again: that second, bare "[Errno 28] No space left on device" replaced the error naming
+    the file (write_pfm of a 4x4 or a 300x300 array into a full 64 KiB tmpfs), and replaced a
+    body's own error too. /dev/full fails every write with ENOSPC, as such a disk does."""
+    import stereovision.io as svio
+
+    def full_disk(dest: Path, suffix: str) -> tuple[int, str]:
+        return os.open("/dev/full", os.O_WRONLY), str(tmp_path / f".{dest.name}.tmp")
+
+    monkeypatch.setattr(svio, "_temp_beside", full_disk)
+    dest = tmp_path / "x.pfm"
+    said = rf"^cannot write {re.escape(str(dest))}: No space left on device$"
+    for n in (4, 300):
+        with pytest.raises(OSError, match=said) as info:
+            write_pfm(dest, np.zeros((n, n), np.float32))
+        assert info.value.errno == errno.ENOSPC
+    with pytest.raises(OSError, match=said):
+        with atomic_write(dest, "w") as fh:
+            fh.write("z = 2.5")
+    with pytest.raises(ValueError, match=r"^the body's own$"):
+        with atomic_write(dest) as fh:
+            fh.write(b"abc")
+            raise ValueError("the body's own")
+    assert not dest.exists()
+
+
 def test_pfm_sizes_and_range_limits(tmp_path: Path) -> None:
     """A PFM of width 0 or an infinite scale is refused; an empty array is not written; a
     float64 holding exactly float32's largest value is written as that value, not refused."""

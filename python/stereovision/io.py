@@ -602,6 +602,15 @@ def _not_written(dest: Path, exc: OSError) -> OSError:
     return failed
 
 
+def _close_quietly(fh: IO[Any]) -> None:
+    """Close ``fh`` whose contents are dropped: its close flushes what is left in its buffer,
+    which fails again on a full disk (the file is closed all the same)."""
+    try:
+        fh.close()
+    except OSError:
+        pass
+
+
 #: Longest file name (bytes) of Linux's and macOS's filesystems, NAME_MAX.
 _NAME_MAX = 255
 
@@ -673,15 +682,19 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         with os.fdopen(fd, mode, encoding=encoding) as fh:
             try:
                 yield fh
-            except OSError as exc:
+            except BaseException as exc:
+                # closed here, what the body wrote dropped: the with's close flushed it again
+                # into a full disk, and its bare "[Errno 28]" replaced this error
+                _close_quietly(fh)
                 # the body's write into a full disk named no file
-                if exc.filename is None and exc.errno in _DISK_FULL:
+                if isinstance(exc, OSError) and exc.filename is None and exc.errno in _DISK_FULL:
                     raise _not_written(dest, exc) from exc
                 raise
             try:
                 fh.flush()
                 os.fsync(fh.fileno())
             except OSError as exc:
+                _close_quietly(fh)  # as above: a full disk fails the flush at close again
                 raise _not_written(dest, exc) from exc
         try:
             # mkstemp creates 0600; give the result the permissions open() would (the
