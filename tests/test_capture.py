@@ -1574,6 +1574,19 @@ def test_collector_checks_its_arguments_when_made() -> None:
     assert ChessboardCollector((9, 6), min_distance=np.float32(0.5)).min_distance == 0.5
 
 
+def test_capture_names_a_charuco_that_is_no_board(tmp_path: Path) -> None:
+    """capture(charuco="10x7"), a pattern's words given for the board, was AttributeError
+    "'str' object has no attribute 'inner'" (ChessboardCollector's own check came after):
+    a TypeError naming charuco now, before the camera is read or the folder made."""
+    for bad, kind in (("10x7", "str"), ((10, 7), "tuple")):
+        with pytest.raises(
+            TypeError,
+            match=rf"^charuco: expected a stereovision\.charuco\.CharucoBoard, got {kind}$",
+        ):
+            capmod.capture(None, tmp_path / "out", count=1, charuco=bad)  # type: ignore[arg-type]
+    assert not (tmp_path / "out").exists()
+
+
 #: 10x7 squares: the same 9x6 inner corners as the chessboard above.
 CHARUCO = CharucoBoard("10x7", SQUARE, 0.022, "DICT_5X5_100")
 #: POSE_B moved right until a quarter of the board leaves the left image.

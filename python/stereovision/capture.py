@@ -3028,6 +3028,8 @@ def capture(
         If a source fails (a frame that does not decode or of another shape, with or without
         ``count``), ends before ``count`` pairs were saved, or ends before a first pair could
         be read; the pairs saved so far stay on disk, and the message says how many.
+    TypeError
+        If ``charuco`` is not a :class:`~stereovision.charuco.CharucoBoard`.
     ValueError
         For an invalid ``count``, ``every``, ``temporal``, ``ext`` or pattern, a ``directory``
         that is a file (or below one), or one whose saved pairs an image-sequence source would
@@ -3062,6 +3064,10 @@ def capture(
         tf = TemporalFilter(max_frames=int(temporal))
     collector = None
     if charuco is not None:
+        from stereovision.charuco import _require_board
+
+        # "10x7" was AttributeError "'str' object has no attribute 'inner'" here
+        _require_board(charuco, "charuco")
         collector = ChessboardCollector(charuco.inner, min_distance, board=charuco)
     elif chessboard:
         collector = ChessboardCollector(parse_pattern(chessboard), min_distance)

@@ -108,13 +108,13 @@ def _dictionary(name: str) -> Any:
     return cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, name))
 
 
-def _require_board(board: object) -> None:
-    """A TypeError naming ``board`` when it is no :class:`CharucoBoard` (calibrate's words): a
-    pattern string or None failed deep inside, AttributeError "'str' object has no attribute
-    'resolved'"."""
+def _require_board(board: object, name: str = "board") -> None:
+    """A TypeError naming ``board`` (as the parameter ``name``) when it is no
+    :class:`CharucoBoard` (calibrate's words): a pattern string or None failed deep inside,
+    AttributeError "'str' object has no attribute 'resolved'"."""
     if not isinstance(board, CharucoBoard):
         raise TypeError(
-            f"board: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
+            f"{name}: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
         )
 
 
