@@ -2141,6 +2141,29 @@ def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_
     assert cam.closed == 1
 
 
+def test_calibration_from_a_camera_names_a_min_distance_that_is_no_number() -> None:
+    """calibrate_from_video(..., min_distance="abc") (calibrate_from_bag's too) said "could
+    not convert string to float: 'abc'", naming nothing: its float() came before the
+    collector's check of it, which names it; the camera is closed."""
+
+    class Cam:
+        closed = 0
+
+        def read(self) -> Any:
+            raise AssertionError("not read")
+
+        def close(self) -> None:
+            self.closed += 1
+
+    cam = Cam()
+    with pytest.raises(ValueError, match=r"^min_distance: expected a finite number, got 'abc'$"):
+        calmod._calibrate_from_camera(
+            cam, pattern=(9, 6), square_size=1.0, board=None, max_pairs=60, min_distance="abc",
+            log=None,
+        )  # fmt: skip
+    assert cam.closed == 1
+
+
 class _HungDevice:
     """A ``cv2.VideoCapture`` stand-in of a hung camera: its open (``opens`` False) or its grab
     never returns until ``unplug`` is set (3 s at most, so that the old code's test ends)."""

@@ -2160,8 +2160,10 @@ def _calibrate_from_camera(
     total = _frames_announced(cam) if progress is not None else 0
     try:
         pat = board.inner if board is not None else parse_pattern(pattern)
+        # as given: the collector names a min_distance that is no number (a float() here said
+        # "could not convert string to float: 'abc'")
         collector = ChessboardCollector(
-            pat, MIN_POSE_DISTANCE if min_distance is None else float(min_distance), board=board
+            pat, MIN_POSE_DISTANCE if min_distance is None else min_distance, board=board
         )
         while len(lefts) < max_pairs:
             try:
