@@ -2092,6 +2092,30 @@ def test_depth_failing_while_staging_removes_only_the_folders_it_made(
     assert there.is_dir() and list(there.iterdir()) == []
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (Linux)")
+def test_depth_into_a_full_disk_names_the_output_file_not_the_staging_one(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """depth -o full/d on a full disk said "cannot write full/d/.stereovision-partial-wex201ov/
+    disparity.png: ...", a hidden folder removed by then: the file is named where it goes."""
+    import os
+
+    import stereovision.io as svio
+
+    def full_disk(dest: Path, suffix: str) -> tuple[int, str]:
+        return os.open("/dev/full", os.O_WRONLY), str(dest.with_name(f".{dest.name}.tmp"))
+
+    monkeypatch.setattr(svio, "_temp_beside", full_disk)
+    out = tmp_path / "d"
+    assert main(_tsukuba_depth_argv(data_dir, out)) == 2
+    err = capsys.readouterr().err
+    said = rf"^stereovision: error: cannot write {re.escape(str(out))}/\w+\.\w+: No space left "
+    assert re.match(said + r"on device\n$", err), err
+
+
 def test_depth_records_the_manifest_before_moving_a_file_in(
     data_dir: Path,
     tmp_path: Path,

@@ -609,10 +609,17 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
     try:
         _remove_orphan_stages(out_dir, stage)
         yield stage
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(stage, ignore_errors=True)
         # only while empty: nothing else is touched (-o new/o left new/ behind)
         remove_empty_folders(made)
+        if isinstance(exc, OSError) and str(stage) in str(exc):
+            # a write's error named the file in this folder, gone now ("cannot write
+            # o/.stereovision-partial-wex201ov/disparity.png: No space left on device"): the
+            # file is named where it goes
+            failed = type(exc)(str(exc).replace(str(stage), str(out_dir)))
+            failed.errno = exc.errno
+            raise failed from exc
         raise
     finally:
         if held is not None:
