@@ -16,12 +16,36 @@ from stereovision.calibration import Calibration
 from stereovision.cli import depth_outputs, main
 from stereovision.io import read_pfm, read_ply
 
+# A crop of ETH3D terrace, its calibration's principal point and size made the crop's: a real
+# scene, holes and all, at a fifth of the pixels (the tests are about the files, not the size).
+_CROP_ROWS, _CROP_COLS = slice(200, 400), slice(300, 600)
 
-def test_depth_files_hold_the_results_values(data_dir: Path, tmp_path: Path) -> None:
+
+@pytest.fixture(scope="module")
+def terrace(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder of ``left.png``, ``right.png`` and ``calib.txt``: the crop of terrace."""
+    src, dst = data_dir / "eth3d" / "terrace", tmp_path_factory.mktemp("terrace")
+    for name in ("left.png", "right.png"):
+        image = cv2.imread(str(src / name))
+        assert cv2.imwrite(str(dst / name), image[_CROP_ROWS, _CROP_COLS])
+    x0, y0 = _CROP_COLS.start, _CROP_ROWS.start
+    w, h = _CROP_COLS.stop - x0, _CROP_ROWS.stop - y0
+    text = (src / "calib.txt").read_text()
+    for old, new in [
+        ("376.135", f"{376.135 - x0:.3f}"), ("227.447", f"{227.447 - y0:.3f}"),
+        ("width=713", f"width={w}"), ("height=434", f"height={h}"),
+    ]:  # fmt: skip
+        assert old in text
+        text = text.replace(old, new)
+    (dst / "calib.txt").write_text(text)
+    return dst
+
+
+def test_depth_files_hold_the_results_values(terrace: Path, tmp_path: Path) -> None:
     """On a real metric scene: disparity.pfm and depth.npy bit for bit (NaN where none),
     depth_mm.png to the millimetre (0 where none), cloud.ply the result's points and colours
     in its order, disparity.png black exactly where there is no disparity."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = terrace
     left, right = cv2.imread(str(scene / "left.png")), cv2.imread(str(scene / "right.png"))
     calib = Calibration.from_file(scene / "calib.txt")
     res, written = depth_outputs(left, right, calib, tmp_path, method="gabor", max_disparity=32)
@@ -49,9 +73,9 @@ def test_depth_files_hold_the_results_values(data_dir: Path, tmp_path: Path) -> 
 
 
 @pytest.mark.parametrize("name", ["disparity.pfm", "depth.npy"])
-def test_depth_files_are_the_filtered_results(data_dir: Path, tmp_path: Path, name: str) -> None:
+def test_depth_files_are_the_filtered_results(terrace: Path, tmp_path: Path, name: str) -> None:
     """--max-depth: the written maps are the filtered result's, not the unfiltered one's."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = terrace
     left, right = cv2.imread(str(scene / "left.png")), cv2.imread(str(scene / "right.png"))
     calib = Calibration.from_file(scene / "calib.txt")
     res, written = depth_outputs(
@@ -70,10 +94,7 @@ def _files(folder: Path) -> dict[str, bytes]:
     return {p.name: (b"<dir>" if p.is_dir() else p.read_bytes()) for p in sorted(folder.iterdir())}
 
 
-def _terrace_argv(
-    data_dir: Path, out: Path, calib: bool = True, max_disparity: int = 32
-) -> list[str]:
-    scene = data_dir / "eth3d" / "terrace"
+def _terrace_argv(scene: Path, out: Path, calib: bool = True, max_disparity: int = 32) -> list[str]:
     argv = ["depth", str(scene / "left.png"), str(scene / "right.png")]
     argv += ["--max-disparity", str(max_disparity)]
     if calib:
@@ -86,7 +107,7 @@ def _terrace_argv(
     [(OSError("disk full"), 2), (KeyboardInterrupt(), 130), (Terminated("signal 15"), 143)],
 )
 def test_a_run_failing_midway_leaves_the_earlier_outputs_whole(
-    data_dir: Path,
+    terrace: Path,
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
@@ -99,7 +120,7 @@ def test_a_run_failing_midway_leaves_the_earlier_outputs_whole(
     at the end: the earlier set stays byte for byte, manifest included, and no temporary
     folder is left."""
     out = tmp_path / "o"
-    assert main(_terrace_argv(data_dir, out)) == 0
+    assert main(_terrace_argv(terrace, out)) == 0
     before = _files(out)
     assert "cloud.ply" in before and "overview.png" in before
 
@@ -109,13 +130,13 @@ def test_a_run_failing_midway_leaves_the_earlier_outputs_whole(
     monkeypatch.setattr(cli, "write_overview", fails)  # after the maps, the cloud, the render
     capsys.readouterr()
     # another run: no calibration, another range (other disparity bytes), a stale cloud.ply
-    assert main(_terrace_argv(data_dir, out, calib=False, max_disparity=48)) == status
+    assert main(_terrace_argv(terrace, out, calib=False, max_disparity=48)) == status
     assert capsys.readouterr().err.startswith("stereovision: ")
     assert _files(out) == before
 
 
 def test_a_new_folder_is_not_left_behind_by_a_failing_run(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    terrace: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The -o folder a failing run created is removed with its temporary folder (it was left,
     holding the files written before the error)."""
@@ -125,30 +146,30 @@ def test_a_new_folder_is_not_left_behind_by_a_failing_run(
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli, "write_overview", fails)
-    assert main(_terrace_argv(data_dir, out)) == 130
+    assert main(_terrace_argv(terrace, out)) == 130
     assert not out.exists()
     # the folders above it that the run made go too (new/ was left): tmp_path as it was
     assert not (tmp_path / "new").exists()
     # a path through ".." (mkdir -p makes new2/ and b/, not "new2/..")
     out = tmp_path / "new2" / ".." / "b"
-    assert main(_terrace_argv(data_dir, out)) == 130
+    assert main(_terrace_argv(terrace, out)) == 130
     assert not (tmp_path / "new2").exists() and not (tmp_path / "b").exists()
 
 
 def test_a_complete_run_replaces_the_whole_earlier_set(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    terrace: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A run that completes leaves exactly its own files, those a run into an empty folder
     writes, byte for byte: the earlier run's files it did not write removed (said), a file of
     the user's kept, no temporary folder."""
     out, fresh = tmp_path / "o", tmp_path / "fresh"
-    assert main(_terrace_argv(data_dir, out)) == 0
+    assert main(_terrace_argv(terrace, out)) == 0
     (out / "notes.txt").write_text("mine")
-    argv = _terrace_argv(data_dir, out, calib=False)
+    argv = _terrace_argv(terrace, out, calib=False)
     capsys.readouterr()
     assert main(argv) == 0
     said = capsys.readouterr().out
-    assert main(_terrace_argv(data_dir, fresh, calib=False)) == 0
+    assert main(_terrace_argv(terrace, fresh, calib=False)) == 0
     got = _files(out)
     assert got.pop("notes.txt") == b"mine"
     assert got == _files(fresh)
@@ -172,16 +193,16 @@ sys.exit(cli.main(sys.argv[1:]))
 
 
 def test_sigterm_while_writing_leaves_the_earlier_outputs_whole(
-    data_dir: Path, tmp_path: Path
+    terrace: Path, tmp_path: Path
 ) -> None:
     """SIGTERM (kill, a container's stop) arriving while the files are written (another
     range: other disparity bytes; no calibration: a stale cloud.ply): one line, exit 143, the
     earlier run's set as it was and no temporary folder."""
     out = tmp_path / "o"
-    assert main(_terrace_argv(data_dir, out)) == 0
+    assert main(_terrace_argv(terrace, out)) == 0
     before = _files(out)
     proc = subprocess.run(
-        [sys.executable, "-c", _SIGTERM_MIDWAY, *_terrace_argv(data_dir, out, False, 48)],
+        [sys.executable, "-c", _SIGTERM_MIDWAY, *_terrace_argv(terrace, out, False, 48)],
         capture_output=True, text=True, check=False, timeout=120,
     )  # fmt: skip
     assert proc.returncode == 143, proc.stderr
@@ -190,18 +211,18 @@ def test_sigterm_while_writing_leaves_the_earlier_outputs_whole(
 
 
 def test_a_folder_under_a_listed_output_name_is_refused_before_any_file_moves(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    terrace: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """An earlier run's cloud.ply replaced by a folder of that name: the rerun wrote the new
     disparity and depth files, then failed at the cloud, leaving a mix. It is refused in one
     line naming the folder, before any file moves in."""
     out = tmp_path / "o"
-    assert main(_terrace_argv(data_dir, out)) == 0
+    assert main(_terrace_argv(terrace, out)) == 0
     (out / "cloud.ply").unlink()
     (out / "cloud.ply").mkdir()
     before = _files(out)
     capsys.readouterr()
-    assert main(_terrace_argv(data_dir, out, max_disparity=48)) == 2
+    assert main(_terrace_argv(terrace, out, max_disparity=48)) == 2
     assert capsys.readouterr().err == (
         f"stereovision: error: {out / 'cloud.ply'} is a folder, where the run's cloud.ply goes: "
         "move it away (the earlier outputs are kept as they were)\n"
@@ -210,7 +231,7 @@ def test_a_folder_under_a_listed_output_name_is_refused_before_any_file_moves(
 
 
 def test_a_folder_under_a_listed_output_name_is_refused_before_the_matching(
-    data_dir: Path,
+    terrace: Path,
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
@@ -221,7 +242,7 @@ def test_a_folder_under_a_listed_output_name_is_refused_before_the_matching(
     import stereovision.depth
 
     out = tmp_path / "o"
-    assert main(_terrace_argv(data_dir, out)) == 0
+    assert main(_terrace_argv(terrace, out)) == 0
     (out / "depth.png").unlink()
     (out / "depth.png").mkdir()
     before = _files(out)
@@ -231,7 +252,7 @@ def test_a_folder_under_a_listed_output_name_is_refused_before_the_matching(
         raise AssertionError("the pair was matched before the outputs were checked")
 
     monkeypatch.setattr(stereovision.depth, "depth_map", matched)
-    assert main(_terrace_argv(data_dir, out, max_disparity=48)) == 2
+    assert main(_terrace_argv(terrace, out, max_disparity=48)) == 2
     assert capsys.readouterr().err == (
         f"stereovision: error: {out / 'depth.png'} is a folder, where the run's depth.png goes: "
         "move it away (the earlier outputs are kept as they were)\n"
@@ -241,7 +262,7 @@ def test_a_folder_under_a_listed_output_name_is_refused_before_the_matching(
 
 @pytest.mark.skipif(sys.platform == "win32", reason="no flock: the folders are left there")
 def test_a_killed_runs_hidden_folder_is_removed_by_the_next_run(
-    data_dir: Path, tmp_path: Path
+    terrace: Path, tmp_path: Path
 ) -> None:
     """A run killed outright (SIGKILL, power loss) left its .stereovision-partial-* folder,
     4 MB of half-written files, in -o for good: no later run removed it. The next run removes
@@ -258,7 +279,7 @@ def test_a_killed_runs_hidden_folder_is_removed_by_the_next_run(
     fd = os.open(busy, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # as a run in progress holds its own
-        assert main(_terrace_argv(data_dir, out)) == 0
+        assert main(_terrace_argv(terrace, out)) == 0
         hidden = sorted(p.name for p in out.iterdir() if p.name.startswith(cli.STAGING_PREFIX))
         assert hidden == [busy.name]
     finally:
