@@ -20,19 +20,50 @@ SV = [sys.executable, "-m", "stereovision.cli"]
 TIME_KEYS = ("ours_ms", "bm_ms", "sgbm_ms", "runs")
 
 
+# A crop of ETH3D terrace, its calibration's principal point and size made the crop's: a real
+# metric scene with its GT, at a fifth of the pixels, in a folder eth3d/terrace as the original.
+_CROP_ROWS, _CROP_COLS = slice(200, 400), slice(300, 600)
+
+
+@pytest.fixture(scope="module")
+def terrace(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``eth3d/terrace`` (left.png, right.png, calib.txt, gt_disp.pfm) cropped."""
+    import cv2
+
+    from stereovision.io import read_pfm, write_pfm
+
+    src = data_dir / "eth3d" / "terrace"
+    dst = tmp_path_factory.mktemp("crop") / "eth3d" / "terrace"
+    dst.mkdir(parents=True)
+    for name in ("left.png", "right.png"):
+        image = cv2.imread(str(src / name))
+        assert cv2.imwrite(str(dst / name), image[_CROP_ROWS, _CROP_COLS])
+    write_pfm(dst / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[_CROP_ROWS, _CROP_COLS])
+    x0, y0 = _CROP_COLS.start, _CROP_ROWS.start
+    w, h = _CROP_COLS.stop - x0, _CROP_ROWS.stop - y0
+    text = (src / "calib.txt").read_text()
+    for old, new in [
+        ("376.135", f"{376.135 - x0:.3f}"), ("227.447", f"{227.447 - y0:.3f}"),
+        ("width=713", f"width={w}"), ("height=434", f"height={h}"),
+    ]:  # fmt: skip
+        assert old in text
+        text = text.replace(old, new)
+    (dst / "calib.txt").write_text(text)
+    return dst
+
+
 def _rows(out: str) -> list[dict[str, Any]]:
     return [json.loads(line) for line in out.splitlines() if line.strip()]
 
 
 def test_eval_runs_reports_the_count_and_keeps_accuracy(
-    data_dir: Path, capsys: pytest.CaptureFixture[str]
+    terrace: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """`--runs N` times every method N times (the median is reported, `runs` says N); every
     accuracy figure (dense, depth, Table-1, validated matches) is the same as with one run."""
-    terrace = str(data_dir / "eth3d" / "terrace")
-    assert main(["eval", terrace, "--json"]) == 0
+    assert main(["eval", str(terrace), "--json"]) == 0
     (one,) = _rows(capsys.readouterr().out)
-    assert main(["eval", terrace, "--json", "--runs", "3"]) == 0
+    assert main(["eval", str(terrace), "--json", "--runs", "3"]) == 0
     (three,) = _rows(capsys.readouterr().out)
     assert (one["runs"], three["runs"]) == (1, 3)
     for row in (one, three):
@@ -40,7 +71,7 @@ def test_eval_runs_reports_the_count_and_keeps_accuracy(
     strip = [{k: v for k, v in r.items() if k not in TIME_KEYS} for r in (one, three)]
     assert strip[0] == strip[1]
     # the figures are there, not two empty rows
-    assert strip[0]["ours"]["n_gt"] == 164541
+    assert strip[0]["ours"]["n_gt"] == 29866  # the crop's GT pixels
     assert {"depth", "sgbm_depth", "table1", "members_depth"} <= set(strip[0])
 
 
@@ -156,7 +187,7 @@ def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
     ]
 
 
-def test_eval_of_a_scene_where_ours_has_no_gt_depth(data_dir: Path, tmp_path: Path) -> None:
+def test_eval_of_a_scene_where_ours_has_no_gt_depth(terrace: Path, tmp_path: Path) -> None:
     """A metric scene whose GT is known only where our depth map has holes: the Table-1 draw
     raised 'no pixel has both an estimated and a ground-truth distance' (without the scene's
     name) and the whole scene was refused, its valid dense figures with it."""
@@ -166,7 +197,7 @@ def test_eval_of_a_scene_where_ours_has_no_gt_depth(data_dir: Path, tmp_path: Pa
     from stereovision.io import load_scene, read_pfm, write_pfm
 
     scene_dir = tmp_path / "terrace"
-    shutil.copytree(data_dir / "eth3d" / "terrace", scene_dir)
+    shutil.copytree(terrace, scene_dir)
     gt_path = scene_dir / "gt_disp.pfm"
     scene_dir.chmod(0o755)
     gt_path.chmod(0o644)
@@ -190,7 +221,7 @@ def test_eval_of_a_scene_where_ours_has_no_gt_depth(data_dir: Path, tmp_path: Pa
 
 
 def test_eval_text_says_when_sgbm_or_the_members_have_no_gt_depth(
-    data_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    terrace: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """SGBM-3WAY without a pixel on GT (a textureless pair: all invalid) and validated matches
     none of which has a GT depth printed 'SGBM-3WAY over 0: nan %, nan %' and 'with GT depth:
@@ -212,7 +243,7 @@ def test_eval_text_says_when_sgbm_or_the_members_have_no_gt_depth(
     monkeypatch.setattr(baselines, "opencv_sgbm", no_sgbm)
     monkeypatch.setattr(fusion, "fuse_pair", no_members)
     capsys.readouterr()
-    assert main(["eval", str(data_dir / "eth3d" / "terrace"), "--method", "fast"]) == 0
+    assert main(["eval", str(terrace), "--method", "fast"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert "nan" not in "\n".join(lines)
     depth = next(line for line in lines if line.startswith("eth3d/terrace: depth over our "))
@@ -289,7 +320,7 @@ def test_the_members_line_says_those_under_a_pixel_of_disparity_apart() -> None:
     assert _members_line("x", row).endswith("RMSE without them: none left)")
 
 
-def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> None:
+def test_eval_scene_figures_are_the_metrics_of_each_output(terrace: Path) -> None:
     """Each block of an ``eval`` row is evaluation.md's metric of its own output, reproducible
     from the public functions: ``ours+fill`` of the row-filled map, ``members_depth`` of the
     validated matches' depth against the GT depth (not the reverse), Table-1 drawn with seed 0,
@@ -304,7 +335,7 @@ def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> No
     from stereovision.io import load_scene
     from stereovision.matching.fusion import fuse_pair
 
-    scene = load_scene(data_dir / "eth3d" / "terrace")
+    scene = load_scene(terrace)
     calib, md = scene.calib, scene.max_disparity
     row = json_ready(_eval_scene(scene, "gabor", with_opencv=True))  # gabor leaves holes
     keys = ["bad_0.5", "bad_1.0", "bad_2.0", "bad_4.0", "density", "avgerr", "rms"]
@@ -330,7 +361,7 @@ def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> No
 
 
 def test_eval_scene_uses_only_a_rectified_calibration(
-    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+    terrace: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A scene whose calibration does not rectify the pair as given is matched without it (no
     depth figures), as bench does; its dense figures stand."""
@@ -348,10 +379,10 @@ def test_eval_scene_uses_only_a_rectified_calibration(
         return real(left, right, calib, **k)
 
     monkeypatch.setattr(depth, "depth_map", spy)
-    scene = load_scene(data_dir / "eth3d" / "terrace")
+    scene = load_scene(terrace)
     fake = SimpleNamespace(**{**vars(scene), "calib": SimpleNamespace(rectified=False)})
     row = _eval_scene(fake, "fast", with_opencv=False)
-    assert seen == [None] and "depth" not in row and row["ours"]["n_gt"] == 164541
+    assert seen == [None] and "depth" not in row and row["ours"]["n_gt"] == 29866
 
 
 def test_eval_of_a_scene_narrower_than_bms_range_plus_its_block(
