@@ -681,7 +681,16 @@ def test_batch_redoes_the_pairs_when_the_grid_cell_changes(data_dir: Path, tmp_p
     from stereovision.batch import run_batch
 
     root, out = tmp_path / "in", tmp_path / "out"
-    shutil.copytree(data_dir / "kitti2015" / "000005_10", root / "k")
+    # columns 400-799 of the KITTI pair (its road ahead), the calibration's centre and width
+    # made the crop's: the grid is the point, not the image's size
+    kitti, k = data_dir / "kitti2015" / "000005_10", root / "k"
+    k.mkdir(parents=True)
+    for name in ("left.png", "right.png"):
+        assert cv2.imwrite(str(k / name), cv2.imread(str(kitti / name))[:, 400:800])
+    calib = (kitti / "calib.txt").read_text()
+    assert "609.5593" in calib and "width=1242" in calib
+    calib = calib.replace("609.5593", "209.5593").replace("width=1242", "width=400")
+    (k / "calib.txt").write_text(calib)
     first = run_batch(root, out, workers=1, ground=True, grid=0.2, progress=False)
     assert first.processed == ["k"]
     lines: list[str] = []
