@@ -144,15 +144,22 @@ def test_run_count_takes_one_to_the_limit() -> None:
     assert (run_count("1"), run_count("5"), run_count("1000")) == (1, 5, 1000) == (1, 5, MAX_RUNS)
 
 
-def _eval(*argv: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([*SV, "eval", *argv], capture_output=True, text=True, check=False)
+def _eval(capfd: pytest.CaptureFixture[str], *argv: str) -> subprocess.CompletedProcess[str]:
+    """``stereovision eval *argv`` run in this process (a process start each cost a second):
+    its status and all it wrote on file descriptors 1 and 2 (capfd: native writes too)."""
+    capfd.readouterr()
+    status = main(["eval", *argv])
+    out, err = capfd.readouterr()
+    return subprocess.CompletedProcess(["eval", *argv], status, out, err)
 
 
-def test_eval_of_a_scene_without_gt_prints_no_table_header(data_dir: Path) -> None:
+def test_eval_of_a_scene_without_gt_prints_no_table_header(
+    data_dir: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     """The table's two header lines went to stdout before the one-line error of a lone scene
     without ground truth: a table of nothing above the error."""
     photo = data_dir / "stereopi_rig" / "scene_photo"
-    proc = _eval(str(photo), "--method", "fast", "--no-opencv")
+    proc = _eval(capfd, str(photo), "--method", "fast", "--no-opencv")
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [
         f"stereovision: error: {photo}: no ground truth (gt_disp.pfm) to evaluate against"
@@ -160,7 +167,7 @@ def test_eval_of_a_scene_without_gt_prints_no_table_header(data_dir: Path) -> No
 
 
 def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """'no scene (left.png + right.png) under X' for a folder holding left.png alone, or a
     JPEG pair: it did not say which file was missing or that the pair was not PNG."""
@@ -168,13 +175,13 @@ def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
     half = tmp_path / "half"
     half.mkdir()
     (half / "left.png").write_bytes((tsukuba / "left.png").read_bytes())
-    proc = _eval(str(half))
+    proc = _eval(capfd, str(half))
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [
         f"stereovision: error: {half}: has left.png but no right.png (a scene folder holds both)"
     ]
     books = data_dir / "opencv_uncalibrated" / "books"
-    proc = _eval(str(books))
+    proc = _eval(capfd, str(books))
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [
         f"stereovision: error: no scene (left.png + right.png) under {books} "
@@ -182,12 +189,14 @@ def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
     ]
     empty = tmp_path / "empty"
     empty.mkdir()
-    assert _eval(str(empty)).stderr.splitlines() == [
+    assert _eval(capfd, str(empty)).stderr.splitlines() == [
         f"stereovision: error: no scene (left.png + right.png) under {empty}"
     ]
 
 
-def test_eval_of_a_scene_where_ours_has_no_gt_depth(terrace: Path, tmp_path: Path) -> None:
+def test_eval_of_a_scene_where_ours_has_no_gt_depth(
+    terrace: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     """A metric scene whose GT is known only where our depth map has holes: the Table-1 draw
     raised 'no pixel has both an estimated and a ground-truth distance' (without the scene's
     name) and the whole scene was refused, its valid dense figures with it."""
@@ -210,12 +219,12 @@ def test_eval_of_a_scene_where_ours_has_no_gt_depth(terrace: Path, tmp_path: Pat
     assert 0 < holes.sum() < holes.size
     write_pfm(gt_path, np.where(holes, np.float32(10.0), np.float32(np.inf)))
     argv = [str(scene_dir), "--method", "fast", "--no-opencv"]
-    proc = _eval(*argv, "--json")
+    proc = _eval(capfd, *argv, "--json")
     assert proc.returncode == 0, proc.stderr
     (row,) = _rows(proc.stdout)
     assert row["ours"]["n_gt"] == int(holes.sum()) and row["depth"]["n"] == 0
     assert row["depth"]["median_rel"] is None and "table1" not in row
-    text = _eval(*argv)
+    text = _eval(capfd, *argv)
     assert text.returncode == 0, text.stderr
     assert f"{row['scene']}: depth: none of our pixels has a GT depth" in text.stdout.splitlines()
 
@@ -277,14 +286,14 @@ def test_eval_runs_prints_the_times_it_measured(
 
 @pytest.mark.parametrize(("height", "width"), [(1, 1), (3, 8), (1, 16), (64, 2)])
 def test_eval_of_a_scene_narrower_than_its_range_names_the_width_needed(
-    tmp_path: Path, height: int, width: int
+    tmp_path: Path, height: int, width: int, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """A scene at most 16 px wide: its range (evaluation.md's, 16 at least) was named as if
     given ("disparity range 16 is not smaller than the image width 8"); the error names the
     images' width and the width a scene needs, one line, nothing on stdout."""
 
     scene = syn.narrow_scene(tmp_path, height, width)
-    proc = _eval(str(scene), "--no-opencv", "--method", "fast")
+    proc = _eval(capfd, str(scene), "--no-opencv", "--method", "fast")
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [
         f"stereovision: error: {scene}: images {width} px wide, not wider than the scene's "
@@ -386,7 +395,7 @@ def test_eval_scene_uses_only_a_rectified_calibration(
 
 
 def test_eval_of_a_scene_narrower_than_bms_range_plus_its_block(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """A 70 px crop of cones (range 64): StereoBM's 15 px block needs 78 px, so 4f17fb0's
     refusal in opencv_bm refused the whole scene (exit 2); the BM reference now runs on the
@@ -407,7 +416,7 @@ def test_eval_of_a_scene_narrower_than_bms_range_plus_its_block(
     write_pfm(
         scene_dir / "gt_disp.pfm", np.ascontiguousarray(read_pfm(src / "gt_disp.pfm")[:, 300:370])
     )
-    proc = _eval(str(scene_dir), "--json")
+    proc = _eval(capfd, str(scene_dir), "--json")
     assert proc.returncode == 0, proc.stderr
     (row,) = _rows(proc.stdout)
     scene = load_scene(scene_dir)
@@ -418,7 +427,9 @@ def test_eval_of_a_scene_narrower_than_bms_range_plus_its_block(
     assert row["bm"]["density"] == pytest.approx(bm["density"])
 
 
-def test_eval_names_a_narrow_scene_among_several_once(tmp_path: Path) -> None:
+def test_eval_names_a_narrow_scene_among_several_once(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     """A scene too narrow for its range among several was said as 'failed <folder>:
     <folder>: images 8 px wide, ...' (its message names its folder, and the line named it
     again); the folder is said once, as for any other failing scene."""
@@ -427,7 +438,7 @@ def test_eval_names_a_narrow_scene_among_several_once(tmp_path: Path) -> None:
     empty.mkdir()
     for name in ("left.png", "right.png"):
         (empty / name).write_bytes((narrow / name).read_bytes())
-    proc = _eval(str(tmp_path), "--no-opencv", "--method", "fast")
+    proc = _eval(capfd, str(tmp_path), "--no-opencv", "--method", "fast")
     assert proc.returncode == 1 and proc.stdout == ""
     assert proc.stderr.splitlines()[0] == (
         f"failed {narrow}: images 8 px wide, not wider than the scene's disparity range "
@@ -451,7 +462,7 @@ def _low_scene(data_dir: Path, tmp_path: Path, rows: int = 12) -> Path:
 
 
 def test_eval_of_a_scene_no_higher_than_stereobms_block_scores_ours_and_sgbm(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """A scene 12 rows high: since 67b28cf StereoBM's refusal ('needs images at least 16 px
     high') failed the whole scene (exit 2, no figures). Ours and SGBM-3WAY are now scored as
@@ -466,14 +477,14 @@ def test_eval_of_a_scene_no_higher_than_stereobms_block_scores_ours_and_sgbm(
         f"{scene_dir}: no StereoBM figures: StereoBM's 15 px block needs images at least 16 px "
         "high, got 12"
     )
-    proc = _eval(str(scene_dir), "--json", "--method", "fast")
+    proc = _eval(capfd, str(scene_dir), "--json", "--method", "fast")
     assert proc.returncode == 0 and proc.stderr.splitlines() == [note]
     (row,) = _rows(proc.stdout)
     assert "bm" not in row and "bm_ms" not in row and row["sgbm_ms"] > 0
     sgbm = dense_metrics(baselines.opencv_sgbm(scene.left, scene.right, 16), scene.gt).as_dict()
     assert row["sgbm"]["bad_2.0"] == pytest.approx(sgbm["bad_2.0"])
     assert row["ours"]["n_gt"] == sgbm["n_gt"] > 0 and row["ours"]["density"] > 50
-    proc = _eval(str(scene_dir), "--method", "fast", "--runs", "2")
+    proc = _eval(capfd, str(scene_dir), "--method", "fast", "--runs", "2")
     assert proc.returncode == 0 and proc.stderr.splitlines() == [note]
     lines = proc.stdout.splitlines()
     cells = lines[2].split("|")
@@ -482,13 +493,15 @@ def test_eval_of_a_scene_no_higher_than_stereobms_block_scores_ours_and_sgbm(
     assert "StereoBM" not in lines[4] and "SGBM-3WAY" in lines[4]
 
 
-def test_eval_mean_line_says_why_stereobm_has_no_mean(data_dir: Path, tmp_path: Path) -> None:
+def test_eval_mean_line_says_why_stereobm_has_no_mean(
+    data_dir: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     """With one scene StereoBM cannot run on beside one it ran on, the mean line left StereoBM
     out without a word (the other scene's figures dropped from the run's means); it now says
     so after the other columns' means."""
     low = _low_scene(data_dir, tmp_path)
     full = data_dir / "middlebury2001" / "venus"
-    proc = _eval(str(full), str(low), "--method", "fast")
+    proc = _eval(capfd, str(full), str(low), "--method", "fast")
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
     venus, crop = (line.split("|") for line in lines[2:4])  # in the order given
