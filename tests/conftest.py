@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -24,3 +25,43 @@ def data_dir() -> Path:
     if not DATA_DIR.is_dir():
         pytest.skip(f"shared test data not found at {DATA_DIR}")
     return DATA_DIR
+
+
+@pytest.fixture(scope="session")
+def crop_terrace(
+    data_dir: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Callable[[slice, slice], Path]:
+    """``crop_terrace(rows, cols)``: a folder ``eth3d/terrace`` of that crop of the ETH3D scene
+    (left.png, right.png, gt_disp.pfm), its calib.txt's principal point and size made the
+    crop's. A real metric scene with its holes at a fraction of the pixels, made once per
+    session for each crop; read only (copy it to change it)."""
+    made: dict[tuple[int, int, int, int], Path] = {}
+
+    def crop(rows: slice, cols: slice) -> Path:
+        key = (rows.start, rows.stop, cols.start, cols.stop)
+        if key in made:
+            return made[key]
+        import cv2
+
+        from stereovision.io import read_pfm, write_pfm
+
+        src = data_dir / "eth3d" / "terrace"
+        dst = tmp_path_factory.mktemp("crop") / "eth3d" / "terrace"
+        dst.mkdir(parents=True)
+        for name in ("left.png", "right.png"):
+            assert cv2.imwrite(str(dst / name), cv2.imread(str(src / name))[rows, cols])
+        write_pfm(dst / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[rows, cols])
+        text = (src / "calib.txt").read_text()
+        for old, new in [
+            ("376.135", f"{376.135 - cols.start:.3f}"),
+            ("227.447", f"{227.447 - rows.start:.3f}"),
+            ("width=713", f"width={cols.stop - cols.start}"),
+            ("height=434", f"height={rows.stop - rows.start}"),
+        ]:
+            assert old in text
+            text = text.replace(old, new)
+        (dst / "calib.txt").write_text(text)
+        made[key] = dst
+        return dst
+
+    return crop

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -16,29 +17,12 @@ from stereovision.calibration import Calibration
 from stereovision.cli import depth_outputs, main
 from stereovision.io import read_pfm, read_ply
 
-# A crop of ETH3D terrace, its calibration's principal point and size made the crop's: a real
-# scene, holes and all, at a fifth of the pixels (the tests are about the files, not the size).
-_CROP_ROWS, _CROP_COLS = slice(200, 400), slice(300, 600)
-
 
 @pytest.fixture(scope="module")
-def terrace(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A folder of ``left.png``, ``right.png`` and ``calib.txt``: the crop of terrace."""
-    src, dst = data_dir / "eth3d" / "terrace", tmp_path_factory.mktemp("terrace")
-    for name in ("left.png", "right.png"):
-        image = cv2.imread(str(src / name))
-        assert cv2.imwrite(str(dst / name), image[_CROP_ROWS, _CROP_COLS])
-    x0, y0 = _CROP_COLS.start, _CROP_ROWS.start
-    w, h = _CROP_COLS.stop - x0, _CROP_ROWS.stop - y0
-    text = (src / "calib.txt").read_text()
-    for old, new in [
-        ("376.135", f"{376.135 - x0:.3f}"), ("227.447", f"{227.447 - y0:.3f}"),
-        ("width=713", f"width={w}"), ("height=434", f"height={h}"),
-    ]:  # fmt: skip
-        assert old in text
-        text = text.replace(old, new)
-    (dst / "calib.txt").write_text(text)
-    return dst
+def terrace(crop_terrace: Callable[[slice, slice], Path]) -> Path:
+    """A 300 x 200 crop of ETH3D terrace (conftest's crop_terrace): a real metric scene with
+    its holes at a fifth of the pixels (the tests are not about the size)."""
+    return crop_terrace(slice(200, 400), slice(300, 600))
 
 
 def test_depth_files_hold_the_results_values(terrace: Path, tmp_path: Path) -> None:

@@ -7,6 +7,7 @@ import math
 import re
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -20,36 +21,11 @@ SV = [sys.executable, "-m", "stereovision.cli"]
 TIME_KEYS = ("ours_ms", "bm_ms", "sgbm_ms", "runs")
 
 
-# A crop of ETH3D terrace, its calibration's principal point and size made the crop's: a real
-# metric scene with its GT, at a fifth of the pixels, in a folder eth3d/terrace as the original.
-_CROP_ROWS, _CROP_COLS = slice(200, 400), slice(300, 600)
-
-
 @pytest.fixture(scope="module")
-def terrace(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """``eth3d/terrace`` (left.png, right.png, calib.txt, gt_disp.pfm) cropped."""
-    import cv2
-
-    from stereovision.io import read_pfm, write_pfm
-
-    src = data_dir / "eth3d" / "terrace"
-    dst = tmp_path_factory.mktemp("crop") / "eth3d" / "terrace"
-    dst.mkdir(parents=True)
-    for name in ("left.png", "right.png"):
-        image = cv2.imread(str(src / name))
-        assert cv2.imwrite(str(dst / name), image[_CROP_ROWS, _CROP_COLS])
-    write_pfm(dst / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[_CROP_ROWS, _CROP_COLS])
-    x0, y0 = _CROP_COLS.start, _CROP_ROWS.start
-    w, h = _CROP_COLS.stop - x0, _CROP_ROWS.stop - y0
-    text = (src / "calib.txt").read_text()
-    for old, new in [
-        ("376.135", f"{376.135 - x0:.3f}"), ("227.447", f"{227.447 - y0:.3f}"),
-        ("width=713", f"width={w}"), ("height=434", f"height={h}"),
-    ]:  # fmt: skip
-        assert old in text
-        text = text.replace(old, new)
-    (dst / "calib.txt").write_text(text)
-    return dst
+def terrace(crop_terrace: Callable[[slice, slice], Path]) -> Path:
+    """A 300 x 200 crop of ETH3D terrace (conftest's crop_terrace): a real metric scene with
+    its holes at a fifth of the pixels (the tests are not about the size)."""
+    return crop_terrace(slice(200, 400), slice(300, 600))
 
 
 def _rows(out: str) -> list[dict[str, Any]]:
