@@ -806,12 +806,12 @@ def test_check_plot_refuses_to_overwrite_an_input(tmp_path: Path, data_dir: Path
 
 
 def test_depth_removes_its_own_outputs_of_an_earlier_run(
-    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, crop_terrace: Callable[[slice, slice], Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A run without a calibration into a folder of a run with one left the earlier cloud.ply,
     depth maps and render there (``stereovision view DIR`` showed the earlier scene): they go;
     the user's own files, and an output name that is a folder, stay."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     out = tmp_path / "o"
     argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--max-disparity", "32"]
     assert main([*argv, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
@@ -836,11 +836,11 @@ def test_depth_removes_its_own_outputs_of_an_earlier_run(
 
 
 def test_depth_keeps_same_named_files_it_did_not_write(
-    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, crop_terrace: Callable[[slice, slice], Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``-o`` naming a folder of the user's: a ``cloud.ply``, ``map.png`` or ``render.png``
     there that no depth run wrote stays (they were deleted as stale outputs by name)."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     out = tmp_path / "mine"
     out.mkdir()
     own = {"cloud.ply": "my scan", "map.png": "my map", "render.png": "my render"}
@@ -855,12 +855,12 @@ def test_depth_keeps_same_named_files_it_did_not_write(
 
 
 def test_depth_refuses_to_replace_a_file_it_did_not_write(
-    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, crop_terrace: Callable[[slice, slice], Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``-o`` naming a folder holding the user's own ``cloud.ply`` (or ``disparity.png``): the
     run replaced it silently; it now refuses before the matching, in one line naming the file,
     and writes nothing. Its own earlier outputs (listed in its manifest) are replaced."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     out = tmp_path / "mine"
     out.mkdir()
     (out / "cloud.ply").write_text("my scan")
