@@ -1216,12 +1216,12 @@ def _no_constant(name: str) -> float:
 
 
 def test_rectify_with_calib_removes_an_earlier_runs_homographies(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    crop_terrace: Callable[[slice, slice], Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """rectify without --calib, then with it into the same folder: the first run's
     rectification.json stayed beside the new images, and `depth --rectification` would warp
     the calibrated pair by the earlier homographies. A file of that name not ours stays."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     pair = [str(scene / "left.png"), str(scene / "right.png")]
     out = tmp_path / "rect"
     # terrace is rectified already: --force has its homographies found all the same
@@ -1242,7 +1242,10 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
 
 @pytest.mark.parametrize("exc", [OSError("disk full"), KeyboardInterrupt()])
 def test_rectify_failing_midway_leaves_the_earlier_outputs_whole(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, exc: BaseException
+    crop_terrace: Callable[[slice, slice], Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    exc: BaseException,
 ) -> None:
     """rectify --calib into the folder of a --force run, failing (or interrupted) at
     check.png: the new left_rect.png and right_rect.png stood beside the earlier check.png and
@@ -1250,7 +1253,7 @@ def test_rectify_failing_midway_leaves_the_earlier_outputs_whole(
     at the end: the earlier set stays byte for byte, and no temporary folder is left."""
     from stereovision import cli
 
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     pair = [str(scene / "left.png"), str(scene / "right.png")]
     out = tmp_path / "rect"
     assert main(["rectify", *pair, "--force", "-o", str(out)]) == 0
@@ -1270,12 +1273,12 @@ def test_rectify_failing_midway_leaves_the_earlier_outputs_whole(
 
 
 def test_rectify_with_calib_keeps_homographies_it_did_not_write(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    crop_terrace: Callable[[slice, slice], Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A rectification.json of the user's (homographies found elsewhere, copied in) in the -o
     folder of a run with --calib was deleted as an earlier run's, though the manifest did not
     list it: it is kept now, and the line says its homographies do not fit the images."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     pair = [str(scene / "left.png"), str(scene / "right.png")]
     elsewhere = tmp_path / "elsewhere"
     assert main(["rectify", *pair, "--force", "-o", str(elsewhere)]) == 0
@@ -1295,12 +1298,12 @@ def test_rectify_with_calib_keeps_homographies_it_did_not_write(
 
 
 def test_rectify_refuses_to_replace_a_file_it_did_not_write(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    crop_terrace: Callable[[slice, slice], Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``rectify -o DIR`` replaced the user's own left_rect.png (or, without --calib, their
     rectification.json) silently: refused before any work, one line naming it; the command's
     own earlier outputs (its manifest's) are replaced by a rerun."""
-    scene = data_dir / "eth3d" / "terrace"
+    scene = crop_terrace(slice(117, 317), slice(206, 506))  # of eth3d/terrace
     pair = [str(scene / "left.png"), str(scene / "right.png")]
     calib = ["--calib", str(scene / "calib.txt")]
     out = tmp_path / "rect"
