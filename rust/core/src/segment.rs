@@ -704,7 +704,7 @@ pub(crate) mod tests {
     }
 
     /// Run by [`a_plane_fit_too_large_to_allocate_is_an_error`] in a child process: a flat
-    /// 4096x4096 image (one region) with one hole, under an address-space limit of 18 bytes a
+    /// 1024x1024 image (one region) with one hole, under an address-space limit of 18 bytes a
     /// pixel more than is mapped. The cut's labels, its copy of the map and the pixel order
     /// (12 bytes a pixel) fit; the segment's fit points (12 more) do not.
     #[cfg(target_os = "linux")]
@@ -714,7 +714,7 @@ pub(crate) mod tests {
         if std::env::var_os("SV_OOM_CHILD").is_none() {
             return;
         }
-        let (w, h) = (4096usize, 4096usize);
+        let (w, h) = (1024usize, 1024usize);
         let n = w * h;
         let img = vec![0u8; n];
         let mut d = vec![1.0f32; n];
