@@ -2235,7 +2235,7 @@ mod tests {
     }
 
     /// Run by [`row_slots_too_large_to_allocate_are_an_error`] in a child process: a 1 px
-    /// wide, 4 Mi-row pair with one level under an address-space limit of 120 MiB more than is
+    /// wide, 512 Ki-row pair with one level under an address-space limit of 15 MiB more than is
     /// mapped. The map (4 bytes a row), census codes (16) and cost volume (1) fit; the 8-path
     /// passes' row slots (48 bytes a row) do not.
     #[cfg(target_os = "linux")]
@@ -2245,10 +2245,10 @@ mod tests {
         if std::env::var_os("SV_OOM_CHILD").is_none() {
             return;
         }
-        let h = 1usize << 22;
+        let h = 1usize << 19;
         let img = ramp(1, h, 0.0);
         rayon::join(|| (), || ()); // the pool's thread started before the limit
-        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (120 << 20));
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (15 << 20));
         let v = ImageView::new(1, h, &img).unwrap();
         match sgm_disparity(v, v, 0, 0, &SgmParams::default()) {
             Ok(d) => println!("child: matched {}", d.len()),
@@ -2265,8 +2265,8 @@ mod tests {
         let stdout = crate::segment::tests::run_oom_child(
             "matching::sgm::tests::row_slots_under_a_memory_limit",
         );
-        let want = "child: error: out of memory: the census matcher's row slots needs 192.00 MiB \
-                    (201326592 bytes)";
+        let want = "child: error: out of memory: the census matcher's row slots needs 24.00 MiB \
+                    (25165824 bytes)";
         assert!(stdout.contains(want), "{want} not in {stdout}");
     }
 
