@@ -1041,7 +1041,13 @@ fn dynamics_arrays_too_large_to_allocate_are_an_error() {
 /// [`network_tables_under_a_memory_limit`]).
 #[cfg(target_os = "linux")]
 fn lone_neurons() -> Vec<Neuron> {
-    (0..1u32 << 20)
+    lone_neurons_in(1024)
+}
+
+/// [`lone_neurons`] in `rows` rows of 1024.
+#[cfg(target_os = "linux")]
+fn lone_neurons_in(rows: u32) -> Vec<Neuron> {
+    (0..rows << 10)
         .map(|a| {
             let (x, y) = ((a % 1024) as i32, (a / 1024) as i32);
             Neuron {
@@ -1169,8 +1175,10 @@ fn network_orders_too_large_to_allocate_are_an_error() {
 }
 
 /// Run by [`final_stages_too_large_to_allocate_are_an_error`] in a child process: the final
-/// selection and the depth-edge filters of 2^20 lone neurons, all on (the network built
-/// before), under an address-space limit of `SV_OOM_MIB` MiB more than is mapped.
+/// selection and the depth-edge filters of 2^18 lone neurons (256 rows of 1024: building
+/// their network in debug code is most of the child's time), all on (the network built
+/// before), under an address-space limit of `SV_OOM_MIB` MiB more than is mapped. Measured:
+/// the selection fails at 0.25 to 4 MiB, the point grid at 6, the filters at 8 to 14.
 #[cfg(target_os = "linux")]
 #[test]
 #[ignore = "a child of final_stages_too_large_to_allocate_are_an_error"]
@@ -1178,15 +1186,17 @@ fn final_stages_under_a_memory_limit() {
     let Some(mib) = std::env::var_os("SV_OOM_MIB") else {
         return;
     };
-    let mib: usize = mib.to_str().unwrap().parse().unwrap();
-    let neurons = lone_neurons();
+    let mib: f64 = mib.to_str().unwrap().parse().unwrap();
+    let neurons = lone_neurons_in(256);
     let p = HopfieldParams::default();
     let net = Network::new(&neurons, &p.weights).unwrap();
     let state = vec![1u8; neurons.len()];
     let img = vec![0.0f32; 4];
     let v = ImageView::new(2, 2, &img).unwrap();
     rayon::join(|| (), || ()); // the pool's thread started before the limit
-    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (mib << 20));
+    crate::segment::tests::limit_address_space(
+        crate::segment::tests::vm_size() + (mib * f64::from(1 << 20)) as usize,
+    );
     let run = || -> Result<usize> {
         let selected = fallback(&neurons, &net, &state, &p)?;
         let chosen = disambiguate(&neurons, &net, &selected, &p)?;
@@ -1206,9 +1216,9 @@ fn final_stages_too_large_to_allocate_are_an_error() {
     // (PointGrid::new) with collect/vec!/push: a failed allocation aborted the process
     // (SIGABRT) instead of returning OutOfMemory.
     for (mib, want) in [
-        ("1", "the Hopfield matcher's final selection needs "),
-        ("24", "the Hopfield matcher's point grid needs "),
-        ("40", "the Hopfield matcher's depth-edge filters needs "),
+        ("0.25", "the Hopfield matcher's final selection needs "),
+        ("6", "the Hopfield matcher's point grid needs "),
+        ("10", "the Hopfield matcher's depth-edge filters needs "),
     ] {
         let stdout = crate::segment::tests::run_oom_child_with(
             "matching::hopfield::tests::final_stages_under_a_memory_limit",
