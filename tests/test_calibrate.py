@@ -77,7 +77,9 @@ def _chessboard_paths() -> tuple[list[Path], list[Path]]:
 @pytest.fixture(scope="module")
 def chessboard() -> tuple[Calibration, CalibrationReport]:
     left, right = _chessboard_paths()
-    return calibrate(left, right, pattern=(9, 6), square_size=1.0)
+    with pytest.MonkeyPatch.context() as mp:  # fills the corner cache the later tests read
+        mp.setattr(calmod, "find_corners", _cached_find_corners)
+        return calibrate(left, right, pattern=(9, 6), square_size=1.0)
 
 
 def test_swapped_cameras_are_named(cached_corners: None) -> None:
@@ -634,8 +636,9 @@ def test_squares_counted_for_the_inner_corners_are_named(
     was answered 'found in both images of only 0 of 4 pairs' with no word of why; the first
     image's board is tried one fewer each way and named, in the CLI's words too."""
     left, right, _ = synthetic
+    # one pair: the hint reads the first image only, and a pattern not found costs ~2 s a search
     with pytest.raises(ValueError) as err:
-        calibrate(left[:4], right[:4], pattern=(10, 7), square_size=SYN_SQUARE)
+        calibrate(left[:1], right[:1], pattern=(10, 7), square_size=SYN_SQUARE)
     text = str(err.value)
     assert text.startswith("the chessboard 10x7 inner corners was found in both images of only 0")
     assert (
@@ -644,7 +647,7 @@ def test_squares_counted_for_the_inner_corners_are_named(
     ) in text
     assert _cli_words(text).count("(--pattern 9x6)") == 1
     with pytest.raises(ValueError) as err:  # no board one fewer each way either: no hint
-        calibrate(left[:4], right[:4], pattern=(11, 7), square_size=SYN_SQUARE)
+        calibrate(left[:1], right[:1], pattern=(11, 7), square_size=SYN_SQUARE)
     assert "shows a board" not in str(err.value)
 
 
@@ -1007,7 +1010,7 @@ def test_max_pairs_below_the_minimum_is_refused_for_images_too(
 
 
 def test_max_pairs_applies_to_images_spread_over_the_list(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], cached_corners: None
 ) -> None:
     """``--max-pairs N`` with images was ignored without a word (its help said videos and bags
     only): it now keeps N pairs spread evenly over the list (the first and the last among them)
@@ -1033,7 +1036,7 @@ def test_max_pairs_applies_to_images_spread_over_the_list(
 
 
 def test_max_pairs_records_the_pairs_it_left_out(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], cached_corners: None
 ) -> None:
     """``--max-pairs`` with images left pairs out before the board was looked for, and neither
     report.json, report.html nor the summary named them: afterwards no one could tell which
@@ -1232,7 +1235,7 @@ def test_a_grid_read_off_the_image_is_no_board() -> None:
     assert found is not None and found.shape == (54, 2)
 
 
-def test_a_pattern_smaller_than_the_board_is_refused(tmp_path: Path) -> None:
+def test_a_pattern_smaller_than_the_board_is_refused(tmp_path: Path, cached_corners: None) -> None:
     """OpenCV's 9x6 boards given as 8x6: the detector finds an 8x6 part of each board, not the
     same part in every image, and the calibration was written (12 of 13 pairs, right RMS 0.36
     px for 0.19, |dy| up to 3.1 px, one pair flagged an outlier and kept). Now the column of
