@@ -25,6 +25,13 @@ def kitti(data_dir: Path) -> tuple:
     return res, lean
 
 
+@pytest.fixture(scope="module")
+def kitti_filled(data_dir: Path) -> sv.DepthResult:
+    """KITTI's default (filled) map without a cloud, computed once for the tests that read it."""
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    return sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+
+
 def _read(path: Path) -> dict[str, list]:
     from rosbags.rosbag2 import Reader
     from rosbags.typesys import Stores, get_typestore
@@ -37,14 +44,15 @@ def _read(path: Path) -> dict[str, list]:
     return out
 
 
-def test_bag_disparity_only_where_there_is_a_depth(data_dir: Path, tmp_path: Path) -> None:
+def test_bag_disparity_only_where_there_is_a_depth(
+    kitti_filled: sv.DepthResult, tmp_path: Path
+) -> None:
     """The default (filled) map: its filled pixels have no depth, and one at or below its
     uncertainty none either (d near 0). The disparity topic carried them all, some at d = 0
     (Z infinite for a reader computing f t / d)."""
     from stereovision.rosbag import BagWriter
 
-    sc = load_scene(data_dir / "kitti2015" / "000005_10")
-    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+    res = kitti_filled
     assert np.isfinite(res.disparity).all() and not np.isfinite(res.depth).all()
     with BagWriter(tmp_path / "run") as bag:
         bag.write(res, 1)
@@ -656,7 +664,9 @@ def test_bag_of_a_rig_with_doffs_and_its_own_right_camera(data_dir: Path, tmp_pa
     assert right.p[2] - left.p[2] == pytest.approx(20.0)
 
 
-def test_bag_fields_of_a_filled_map_and_its_floor_scan(data_dir: Path, tmp_path: Path) -> None:
+def test_bag_fields_of_a_filled_map_and_its_floor_scan(
+    kitti_filled: sv.DepthResult, tmp_path: Path
+) -> None:
     """Second mutation audit, on the default (filled) map written with a ``ground`` as
     ``stream --bag`` does: the scan is stamped as the frame (to the ns) and carries the
     :func:`laser_scan` of the filled point image (its angles and range limits too); the cloud
@@ -668,8 +678,7 @@ def test_bag_fields_of_a_filled_map_and_its_floor_scan(data_dir: Path, tmp_path:
     from stereovision.ground import fit_ground_plane, laser_scan
     from stereovision.rosbag import BagWriter
 
-    sc = load_scene(data_dir / "kitti2015" / "000005_10")
-    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+    res = kitti_filled
     plane = fit_ground_plane(res.disparity, res.calibration)
     assert plane is not None
     want = laser_scan(res.point_image(filled=True), plane, res.calibration)
@@ -775,7 +784,7 @@ def test_the_disparity_focal_length_is_fx_for_non_square_pixels(
 
 
 def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
-    data_dir: Path, tmp_path: Path
+    kitti_filled: sv.DepthResult, tmp_path: Path
 ) -> None:
     """REP 105: the scan is in the floor frame (``base_footprint``), the images and cloud in the
     camera's optical frame; without a transform between the two (the bag had none), RViz and a
@@ -789,8 +798,7 @@ def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
     from stereovision.ground import fit_ground_plane, laser_scan
     from stereovision.rosbag import BagWriter
 
-    sc = load_scene(data_dir / "kitti2015" / "000005_10")
-    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+    res = kitti_filled
     plane = fit_ground_plane(res.disparity, res.calibration)
     assert plane is not None
     stamp = 1_700_000_000_123_456_789
