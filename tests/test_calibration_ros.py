@@ -264,17 +264,23 @@ def test_writing_refuses_what_ros_cannot_hold(tmp_path: Path) -> None:
     assert (tmp_path / "file").read_text() == "x"
 
 
-def test_cli_calibrate_writes_ros_and_depth_reads_it(data_dir: Path, tmp_path: Path) -> None:
+def test_cli_calibrate_writes_ros_and_depth_reads_it(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`stereovision calibrate --ros DIR` on OpenCV's chessboard pairs writes camera_info that
-    reads back as the calibration it saved, and `depth --calib DIR` uses it."""
+    reads back as the calibration it saved, and `depth --calib DIR` uses it (both in-process;
+    the refusal's exit code and one line are a subprocess's)."""
+    from stereovision.cli import main
+
     board = data_dir / "chessboard"
     out = tmp_path / "rig.yaml"
     cmd = [sys.executable, "-m", "stereovision.cli", "calibrate"]
     args = ["--left", str(board / "left*.jpg"), "--right", str(board / "right*.jpg")]
     args += ["--square", "25", "--unit", "mm", "-o", str(out), "--ros", str(tmp_path / "ros")]
-    run = subprocess.run(cmd + args, capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr
-    assert "ROS camera_info written to" in run.stdout
+    code = main(["calibrate", *args])
+    said = capsys.readouterr()
+    assert code == 0, said.err
+    assert "ROS camera_info written to" in said.out
     saved = Calibration.load(out)
     ros = Calibration.from_file(tmp_path / "ros")
     np.testing.assert_allclose(ros.R, saved.R, atol=1e-12)
@@ -284,17 +290,14 @@ def test_cli_calibrate_writes_ros_and_depth_reads_it(data_dir: Path, tmp_path: P
     right = cv2.imread(str(board / "right01.jpg"))
     cv2.imwrite(str(tmp_path / "l.png"), left)
     cv2.imwrite(str(tmp_path / "r.png"), right)
-    run = subprocess.run(
+    code = main(
         [
-            *(sys.executable, "-m", "stereovision.cli", "depth"),
+            "depth",
             *(str(tmp_path / "l.png"), str(tmp_path / "r.png")),
             *("--calib", str(tmp_path / "ros"), "--method", "gabor", "-o", str(tmp_path / "out")),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
+        ]
     )
-    assert run.returncode == 0, run.stderr
+    assert code == 0, capsys.readouterr().err
     assert (tmp_path / "out" / "cloud.ply").is_file()
     run = subprocess.run(cmd + args[:-1] + [str(out)], capture_output=True, text=True, timeout=60)
     assert run.returncode == 2 and run.stderr.count("\n") == 1
