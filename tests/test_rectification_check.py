@@ -116,35 +116,23 @@ def test_swapped_flat_and_unaligned_pairs(data_dir: Path) -> None:
     assert sv.check_rectification is check_rectification
 
 
-def test_cli_check(data_dir: Path, tmp_path: Path) -> None:
+def test_cli_check(data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from stereovision.cli import main  # in-process but for the refusal's exit 2 and one line
+
     cones = data_dir / "middlebury2003" / "cones"
-    run = subprocess.run(
-        [*SV, "check", str(cones / "left.png"), str(cones / "right.png")],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert run.returncode == 0 and run.stdout.startswith("rectification ok: median |dy| 0.")
+    code = main(["check", str(cones / "left.png"), str(cones / "right.png")])
+    out = capsys.readouterr().out
+    assert code == 0 and out.startswith("rectification ok: median |dy| 0.")
     left = cv2.imread(str(cones / "right.png"))
     cv2.imwrite(str(tmp_path / "low.png"), _warp(left, np.float32([[1, 0, 0], [0, 1, 1.5]])))
-    run = subprocess.run(
-        [*SV, "check", str(cones / "left.png"), str(tmp_path / "low.png"), "--json"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert run.returncode == 1
-    out = json.loads(run.stdout)
+    code = main(["check", str(cones / "left.png"), str(tmp_path / "low.png"), "--json"])
+    assert code == 1
+    out = json.loads(capsys.readouterr().out)
     assert out["ok"] is False and out["offset"] == pytest.approx(-1.5, abs=0.3)
     assert "points" not in out
     plot = tmp_path / "check.png"
-    run = subprocess.run(
-        [*SV, "check", str(cones / "left.png"), str(cones / "right.png"), "--plot", str(plot)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert run.returncode == 0
+    code = main(["check", str(cones / "left.png"), str(cones / "right.png"), "--plot", str(plot)])
+    assert code == 0
     img = cv2.imread(str(plot))
     assert img.shape[1] == 900 and img.shape[0] > 375
     # the summary band on top, then the pair with green dots (matches within tolerance)
@@ -231,27 +219,23 @@ def test_refine_refuses_what_is_not_a_drift(data_dir: Path) -> None:
         refine_rectification(right, left, _rig(w, h, (0.3, 0.0, 0.0)))
 
 
-def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
+def test_cli_check_fix(data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from stereovision.cli import main  # in-process but for the refusals' exit 2 and words
+
     cones = data_dir / "middlebury2003" / "cones"
     img = cv2.imread(str(cones / "left.png"))
     bumped = _rig(img.shape[1], img.shape[0], (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
     pair = [str(cones / "left.png"), str(cones / "right.png")]
     fixed = tmp_path / "fixed.yaml"
-    run = subprocess.run(
-        [*SV, "check", *pair, "--calib", str(bumped), "--fix", str(fixed)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert run.returncode == 0, run.stderr
-    lines = run.stdout.splitlines()
+    code = main(["check", *pair, "--calib", str(bumped), "--fix", str(fixed)])
+    said = capsys.readouterr()
+    assert code == 0, said.err
+    lines = said.out.splitlines()
     assert lines[0].startswith("pair NOT rectified")
     assert lines[1].startswith("corrected (the right camera turned 0.29")
     assert "rectification ok" in lines[1] and lines[2].endswith(str(fixed))
-    run = subprocess.run(
-        [*SV, "check", *pair, "--calib", str(fixed)], capture_output=True, text=True, timeout=120
-    )
-    assert run.returncode == 0 and run.stdout.startswith("rectification ok")
+    code = main(["check", *pair, "--calib", str(fixed)])
+    assert code == 0 and capsys.readouterr().out.startswith("rectification ok")
     run = subprocess.run(
         [*SV, "check", *pair, "--fix", str(tmp_path / "x.yaml")],
         capture_output=True,
@@ -270,17 +254,16 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
     )
     assert bumped.read_bytes() == before
     # a failed check says what to do, as the rig has a calibration or not
-    run = subprocess.run([*SV, "check", *pair, "--calib", str(bumped)], capture_output=True,
-                         text=True, timeout=120)  # fmt: skip
-    assert run.returncode == 1 and "recalibrate, or correct the right camera" in run.stdout
+    code = main(["check", *pair, "--calib", str(bumped)])
+    assert code == 1 and "recalibrate, or correct the right camera" in capsys.readouterr().out
     down = np.float32([[1, 0, 0], [0, 1, 2]])  # the right image 2 px lower
     right = cv2.warpAffine(cv2.imread(pair[1]), down, img.shape[1::-1])
     cv2.imwrite(str(tmp_path / "low.png"), right)
-    run = subprocess.run([*SV, "check", pair[0], str(tmp_path / "low.png")], capture_output=True,
-                         text=True, timeout=120)  # fmt: skip
-    assert run.returncode == 1 and run.stdout.startswith("pair NOT rectified:")
-    assert "give the rig's calibration (--calib), or rectify them" in run.stdout
-    assert "recalibrate" not in run.stdout
+    code = main(["check", pair[0], str(tmp_path / "low.png")])
+    out = capsys.readouterr().out
+    assert code == 1 and out.startswith("pair NOT rectified:")
+    assert "give the rig's calibration (--calib), or rectify them" in out
+    assert "recalibrate" not in out
 
 
 def test_cli_check_cannot_tell(tmp_path: Path) -> None:
