@@ -2125,6 +2125,34 @@ def test_depth_into_a_full_disk_names_the_output_file_not_the_staging_one(
     assert re.match(said + r"on device\n$", err), err
 
 
+def test_depth_whose_move_into_o_fails_names_the_file_once(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A move from the staging folder into -o refused (the folder made read-only meanwhile)
+    said "[Errno 13] Permission denied: 'o/disparity.png' -> 'o/disparity.png'", a file moved
+    onto itself (the staging folder's name replaced by -o's): the file is named where it goes."""
+    import errno
+    import os
+
+    from stereovision import cli
+
+    real_replace = os.replace
+
+    def replace(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> None:
+        if Path(src).parent.name.startswith(cli.STAGING_PREFIX) and Path(dst).parent == out:
+            raise PermissionError(errno.EACCES, "Permission denied", str(src), None, str(dst))
+        real_replace(src, dst)
+
+    out = tmp_path / "o"
+    monkeypatch.setattr(os, "replace", replace)
+    assert main(_tsukuba_depth_argv(data_dir, out)) == 2
+    err = capsys.readouterr().err
+    assert err == f"stereovision: error: cannot write {out}/disparity.png: Permission denied\n"
+
+
 def test_depth_records_the_manifest_before_moving_a_file_in(
     data_dir: Path,
     tmp_path: Path,
@@ -2154,7 +2182,8 @@ def test_depth_records_the_manifest_before_moving_a_file_in(
 
     monkeypatch.setattr(os, "replace", replace)
     assert main(_tsukuba_depth_argv(data_dir, out)) == 2
-    assert capsys.readouterr().err == "stereovision: error: [Errno 5] Input/output error\n"
+    said = f"stereovision: error: cannot write {out}/disparity.pfm: Input/output error\n"
+    assert capsys.readouterr().err == said
     want = ["depth.npy", "disparity.pfm", "disparity.png", "overview.png"]
     assert seen == [("disparity.png", want), ("disparity.pfm", want)]
     assert json.loads((out / cli.DEPTH_MANIFEST).read_text()) == want
@@ -2218,8 +2247,10 @@ def test_depth_failing_before_its_first_move_leaves_no_folder_and_the_old_manife
         real_replace(src, dst)
 
     monkeypatch.setattr(os, "replace", replace)
-    assert main(_tsukuba_depth_argv(data_dir, tmp_path / "new" / "sub")) == 2
-    assert capsys.readouterr().err == "stereovision: error: [Errno 5] Input/output error\n"
+    made = tmp_path / "new" / "sub"
+    assert main(_tsukuba_depth_argv(data_dir, made)) == 2
+    said = f"stereovision: error: cannot write {made}/disparity.png: Input/output error\n"
+    assert capsys.readouterr().err == said
     assert sorted(p.name for p in tmp_path.iterdir()) == []
     out = tmp_path / "o"
     out.mkdir()

@@ -736,7 +736,14 @@ def commit_outputs(
         record_outputs(out_dir, set(earlier) | set(staged), manifest, known)
         try:
             for name, path in staged.items():
-                os.replace(path, out_dir / name)
+                try:
+                    os.replace(path, out_dir / name)
+                except OSError as exc:
+                    # it named the staging folder's file, removed by then; staged_outputs's
+                    # renaming of that folder made it "'o/disparity.png' -> 'o/disparity.png'"
+                    failed = type(exc)(f"cannot write {out_dir / name}: {exc.strerror or exc}")
+                    failed.errno = exc.errno
+                    raise failed from exc
                 written[name] = out_dir / name
         except BaseException:
             # a second Ctrl-C during the first rename is raised once it returns, before the
