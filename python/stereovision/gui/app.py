@@ -513,8 +513,9 @@ def draw_matches(
 
     Parameters
     ----------
-    left, right : ndarray, uint8 (H, W, 3)
-        BGR rectified pair.
+    left, right : ndarray, (H, W, 3) uint8
+        BGR rectified pair; grey, BGRA and 16-bit images are drawn at 8-bit BGR, as the page
+        shows them.
     disparity : ndarray, float32 (H, W)
         NaN where there is no match.
     max_matches : int
@@ -559,8 +560,9 @@ def draw_sparse(
 
     Parameters
     ----------
-    image : ndarray, uint8 (H, W, 3)
-        BGR left (rectified) image, shown dimmed in grey under the dots.
+    image : ndarray, (H, W, 3) uint8
+        BGR left (rectified) image, shown dimmed in grey under the dots; grey, BGRA and 16-bit
+        images are shown at 8 bits, as the page shows them.
     values : ndarray, float (H, W)
         NaN where there is no match.
     lo, hi : float or None
@@ -884,8 +886,8 @@ def compute_view(
 
     Parameters
     ----------
-    left, right : ndarray, uint8 (H, W, 3)
-        BGR pair.
+    left, right : ndarray, (H, W, 3) uint8
+        BGR pair; a grey, BGRA or 16-bit pair is matched as it is and shown at 8-bit BGR.
     calib : Calibration or None
         For the input size; scaled with the images.
     method : str
@@ -948,7 +950,8 @@ def compute_view(
     if d_max is not None and d_max > widest and widest >= (16 if opencv else 1) and w_s > 16:
         # a range that fits the pair at its size, scaled down and rounded up, can reach the
         # smaller width (440 px at full size searched 320 px at width 320: refused); a pair
-        # 16 px wide or less is depth_map's to refuse, one too narrow for BM's block opencv_bm's
+        # 16 px wide or less is the method's to refuse (depth_map's, match's, or
+        # _opencv_result's for the OpenCV methods), one too narrow for BM's block opencv_bm's
         notes.append(f"max disparity {d_max} px at width {w_s} searched as {widest} px ({why})")
         d_max = widest
     t0 = time.perf_counter()
