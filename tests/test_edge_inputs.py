@@ -411,6 +411,32 @@ def test_match_refuses_a_min_disparity_not_below_the_width(
 
 
 @pytest.mark.parametrize("method", MATCH_METHODS)
+@pytest.mark.parametrize(
+    ("name", "value", "shown"),
+    [
+        ("max_disparity", np.array(48), "array(48)"),
+        ("max_disparity", True, "True"),
+        ("max_disparity", "32", "'32'"),
+        ("min_disparity", None, "None"),
+        ("min_disparity", np.array(0), "array(0)"),
+    ],
+)
+def test_match_refuses_a_range_of_another_type_as_depth_map_does(
+    method: str, name: str, value: object, shown: str
+) -> None:
+    """A 0-d array passed "gabor" and was refused by the others as "must be a non-negative
+    number of pixels"; True or None was a ValueError in two wordings: depth_map's TypeError."""
+    left = np.random.default_rng(0).integers(0, 256, (24, 48), dtype=np.uint8)
+    words = f"{name}: expected a number of pixels, got {shown}"
+    with pytest.raises(TypeError) as err:
+        sv.match(left, left.copy(), method=method, **{name: value})
+    assert str(err.value) == words
+    with pytest.raises(TypeError) as err:
+        sv.depth_map(left, left.copy(), **{name: value})
+    assert str(err.value) == words
+
+
+@pytest.mark.parametrize("method", MATCH_METHODS)
 def test_match_names_a_max_disparity_below_min_disparity_first(method: str) -> None:
     """A max_disparity the caller gave below min_disparity is the mistake named, even when the
     min_disparity is past the width too (match()'s docstring: left to the matchers' checks)."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -571,9 +572,7 @@ def test_a_range_read_from_an_array_is_its_number() -> None:
     """max_disparity / min_disparity of np.array([16.0]) passed the range check (finite_number
     reads a size-1 array as its value, as sgm_disparity does) and then failed in float() with
     NumPy's bare TypeError "only 0-dimensional arrays can be converted", naming neither. They
-    give the map of the plain floats, through match(method="gabor") too."""
-    import stereovision as sv
-
+    give the map of the plain floats (match refuses them, as depth_map does: below)."""
     rng = np.random.default_rng(0)
     left = rng.random((48, 80), dtype=np.float32)
     right = np.roll(left, -4, axis=1)
@@ -583,28 +582,25 @@ def test_a_range_read_from_an_array_is_its_number() -> None:
         left, right, max_disparity=np.array([16.0]), min_disparity=np.array([1.0])
     ).disparity
     np.testing.assert_array_equal(got, base)
-    m = sv.match(left, right, method="gabor", max_disparity=np.array([16.0]))
-    plain = sv.match(left, right, method="gabor", max_disparity=16.0)
-    assert len(m) == len(plain) > 1000
-    np.testing.assert_array_equal(m.xr, plain.xr)
 
 
-def test_match_takes_a_gabor_range_read_from_an_array_as_its_number() -> None:
+def test_match_refuses_a_gabor_range_read_from_an_array_as_depth_map_does() -> None:
     """match(method="gabor") with min_disparity=np.array([1.0]) gave NumPy's bare TypeError
     "only 0-dimensional arrays can be converted" (its range filter's float()), and a
     max_disparity of np.array([[4.05]]) a 2-D keep mask, NumPy's IndexError "too many indices
-    for array" once a match was out of range. Both give the matches of the plain floats."""
+    for array" once a match was out of range; 6902f6b0 took them as their number, where the
+    other methods and depth_map refused them. Each is now depth_map's TypeError."""
     import stereovision as sv
 
     rng = np.random.default_rng(0)
     left = rng.random((48, 80), dtype=np.float32)
     right = np.roll(left, -4, axis=1)
-    plain = sv.match(left, right, method="gabor", max_disparity=4.05, min_disparity=1.0)
-    assert len(plain) > 1000 and plain.stats["n_out_of_range"] > 10
-    for lo, hi in ((np.array([1.0]), 4.05), (1.0, np.array([[4.05]]))):
-        m = sv.match(left, right, method="gabor", max_disparity=hi, min_disparity=lo)
-        np.testing.assert_array_equal(m.xr, plain.xr)
-        assert m.stats["n_out_of_range"] == plain.stats["n_out_of_range"]
+    for lo, hi, words in (
+        (np.array([1.0]), 4.05, "min_disparity: expected a number of pixels, got array([1.])"),
+        (1.0, np.array([[4.05]]), "max_disparity: expected a number of pixels, got "),
+    ):
+        with pytest.raises(TypeError, match=re.escape(words)):
+            sv.match(left, right, method="gabor", max_disparity=hi, min_disparity=lo)
 
 
 def test_a_decimal_real_parameter_is_its_number() -> None:

@@ -102,6 +102,9 @@ def match(
 
     Raises
     ------
+    TypeError
+        A ``max_disparity`` or ``min_disparity`` that is not one real number (None, a bool, a
+        string, an array), as :func:`~stereovision.depth_map` refuses it.
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration or rectification
         for another image size, a ``calib`` of another type, an unknown method or parameter, a
@@ -117,6 +120,14 @@ def match(
     # a str first: an array as the method failed in the test ("truth value ... ambiguous")
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
+    # the range's type first, in depth_map's words: a 0-d array, True or None passed "gabor"'s
+    # check (or failed in another class) and was refused by the others as not "non-negative"
+    for name, value in (
+        ("max_disparity", max_disparity),
+        ("min_disparity", params.get("min_disparity", 0)),
+    ):
+        if not (value is None and name == "max_disparity") and not real_number(value):
+            raise TypeError(f"{name}: expected a number of pixels, got {_shown(value)}")
     gl, gr = check_pair(left, right)
     # a negative min_disparity the method cannot search: said as depth_map says it (the
     # matchers' own words named neither the method nor the one that takes it), before the
