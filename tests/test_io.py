@@ -609,6 +609,27 @@ def test_load_scene_errors(tmp_path: Path) -> None:
     assert s.gt is None and s.max_disparity == 16
 
 
+def test_load_scene_of_middleburys_names_says_the_names_a_scene_takes(tmp_path: Path) -> None:
+    """A folder as Middlebury ships a scene (im0.png, im1.png) said only "image file not
+    found: .../left.png": it says what eval and bench say of it (0f66e302), the files to rename.
+    With one of left.png / right.png there, the missing one is named as before."""
+    img = np.zeros((4, 6), np.uint8)
+    for name in ("im0.png", "im1.png"):
+        cv2.imwrite(str(tmp_path / name), img)
+    with pytest.raises(FileNotFoundError) as err:
+        load_scene(tmp_path)
+    assert str(err.value) == (
+        f"image file not found: {tmp_path / 'left.png'}; {tmp_path} has Middlebury's im0.png + "
+        "im1.png: a scene's images are named left.png + right.png and its ground truth "
+        "gt_disp.pfm (rename im0.png, im1.png and disp0.pfm or disp0GT.pfm; calib.txt is read "
+        "as it is)"
+    )
+    cv2.imwrite(str(tmp_path / "left.png"), img)
+    with pytest.raises(FileNotFoundError) as err:
+        load_scene(tmp_path)
+    assert str(err.value) == f"image file not found: {tmp_path / 'right.png'}"
+
+
 @pytest.mark.parametrize("name", ["gt_disp.pfm", "calib.txt", "Q.dat"])
 def test_load_scene_refuses_a_link_to_nothing(tmp_path: Path, name: str) -> None:
     """A scene's GT or calibration that is a link whose target moved (exists() is False) was

@@ -1936,7 +1936,8 @@ def load_scene(directory: PathLike) -> Scene:
     Raises
     ------
     FileNotFoundError
-        If the directory, ``left.png`` or ``right.png`` is missing, or ``gt_disp.pfm``,
+        If the directory, ``left.png`` or ``right.png`` is missing (for a folder of
+        Middlebury's ``im0.png`` + ``im1.png``, naming the files to rename), or ``gt_disp.pfm``,
         ``calib.txt`` or ``Q.dat`` is a link to a file that does not exist.
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
@@ -1948,6 +1949,12 @@ def load_scene(directory: PathLike) -> Scene:
     d = as_path(directory, "directory")
     if not d.is_dir():
         raise FileNotFoundError(f"scene directory not found: {d}")
+    if not any(os.path.lexists(d / n) for n in ("left.png", "right.png")) and all(
+        (d / n).is_file() for n in ("im0.png", "im1.png")
+    ):
+        # a folder as Middlebury ships it: said as eval and bench say it (scan_scenes), not
+        # only "image file not found: .../left.png" with the names to use unsaid
+        raise FileNotFoundError(f"image file not found: {d / 'left.png'}; {d} {_MIDDLEBURY_NAMES}")
     left = imread(d / "left.png")
     right = imread(d / "right.png")
     if left.shape != right.shape:
