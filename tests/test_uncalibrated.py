@@ -1647,6 +1647,38 @@ def test_a_file_with_a_count_that_is_no_whole_number_is_named(
     assert type(back.size[0]) is int and type(back.max_disparity) is int
 
 
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("skew_deg", None, "skew_deg: expected [left, right], got None"),
+        ("aspect", [1.0], "aspect: expected [left, right], got [1.0]"),
+        ("disparity_range", 3, "disparity_range: expected [min, max], got 3"),
+        ("median_dy", "abc", "median_dy: expected a number, got 'abc'"),
+        ("p95_dy", [1], "p95_dy: expected a number, got [1]"),
+        ("skew_deg", [True, 1.0], "skew_deg: expected a number, got True"),
+    ],
+)
+def test_a_file_with_a_figure_that_is_no_number_is_named(
+    tmp_path: Path, field: str, value: object, words: str
+) -> None:
+    """A hand-edited "skew_deg": null said "'NoneType' object is not subscriptable", a
+    one-entry aspect "list index out of range", "abc" float()'s words, none naming the field,
+    and true was read as 1.0. Each is refused naming the field; a null figure is still NaN."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (640, 360), (600, 400), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
+        48, (0.02, 0.03), (1.001, 0.998),
+    )  # fmt: skip
+    raw = rect.as_dict()
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps({**raw, field: value}))
+    with pytest.raises(ValueError) as err:
+        UncalibratedRectification.load(path)
+    assert str(err.value) == f"{path} is not an uncalibrated rectification: {words}"
+    path.write_text(json.dumps({**raw, "skew_deg": [None, 0.03]}))
+    back = UncalibratedRectification.load(path)
+    assert math.isnan(back.skew_deg[0]) and back.skew_deg[1] == 0.03
+
+
 def test_a_12_bit_pair_in_16_bits_is_rectified_from_its_features(data_dir: Path) -> None:
     """A 12-bit camera's pair in uint16 (0-4095) was cut to 8 bits as 16-bit data: 0-16 grey
     levels, no SIFT feature, and rectify_uncalibrated (stereovision rectify) said "only 0

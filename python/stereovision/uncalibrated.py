@@ -638,12 +638,12 @@ class UncalibratedRectification:
                 _size(d["input_size"], "input_size"),
                 mats["F"],
                 _whole(d["matches"], "matches"),
-                _figure(d["median_dy"]),
-                _figure(d["p95_dy"]),
-                (_figure(d["disparity_range"][0]), _figure(d["disparity_range"][1])),
+                _figure(d["median_dy"], "median_dy"),
+                _figure(d["p95_dy"], "p95_dy"),
+                _figures(d["disparity_range"], "disparity_range", "min, max"),
                 _whole(d["max_disparity"], "max_disparity"),
-                (_figure(d["skew_deg"][0]), _figure(d["skew_deg"][1])),
-                (_figure(d["aspect"][0]), _figure(d["aspect"][1])),
+                _figures(d["skew_deg"], "skew_deg", "left, right"),
+                _figures(d["aspect"], "aspect", "left, right"),
                 str(d.get("model", "projective")),
             )
         except (ValueError, KeyError, TypeError, IndexError) as exc:
@@ -689,10 +689,25 @@ def _size(value: Any, field: str) -> tuple[int, int]:
     return _whole(value[0], field), _whole(value[1], field)
 
 
-def _figure(value: Any) -> float:
+def _figure(value: Any, field: str) -> float:
     """A figure of a rectification file: :meth:`UncalibratedRectification.save` writes a NaN
-    or infinite one as null (strict JSON), read back as NaN."""
-    return math.nan if value is None else float(value)
+    or infinite one as null (strict JSON), read back as NaN. Anything but a JSON number or
+    null is refused naming the field (float() said "could not convert string to float: 'abc'"
+    and read true as 1.0)."""
+    if value is None:
+        return math.nan
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{field}: expected a number, got {value!r}")
+    return float(value)
+
+
+def _figures(value: Any, field: str, names: str) -> tuple[float, float]:
+    """A pair of figures of a rectification file (``names``: ``"left, right"``), each
+    :func:`_figure`: a null or one-entry pair (hand-edited) said "'NoneType' object is not
+    subscriptable" or "list index out of range", the field unnamed."""
+    if not isinstance(value, list) or len(value) != 2:
+        raise ValueError(f"{field}: expected [{names}], got {value!r}")
+    return _figure(value[0], field), _figure(value[1], field)
 
 
 def _damaged(rect: UncalibratedRectification) -> str | None:
