@@ -2167,6 +2167,40 @@ def test_calibration_from_a_camera_names_a_min_distance_that_is_no_number() -> N
     assert cam.closed == 1
 
 
+@pytest.mark.parametrize(
+    ("value", "words"),
+    [
+        (True, "min_distance: expected a finite number, got True"),
+        (-0.5, "min_distance: expected a finite number of 0 or more, got -0.5"),
+        ("abc", "min_distance: expected a finite number, got 'abc'"),
+    ],
+)
+def test_calibration_from_a_camera_checks_min_distance_before_opening_it(
+    monkeypatch: pytest.MonkeyPatch, value: object, words: str
+) -> None:
+    """calibrate_from_video and calibrate_from_bag checked board and max_pairs up front but
+    min_distance only in the collector, once both cameras (or the bag) were open: a bad one
+    came after the open's wait or its error. It is refused first, in the collector's words."""
+    import stereovision.capture as capmod
+    import stereovision.rosbag as rosmod
+
+    opened: list[object] = []
+
+    def opener(*args: Any, **kwargs: Any) -> Any:
+        opened.append(args)
+        raise AssertionError("opened")
+
+    monkeypatch.setattr(capmod, "StereoCamera", opener)
+    monkeypatch.setattr(rosmod, "BagCamera", opener)
+    with pytest.raises(ValueError) as err:
+        calibrate_from_video(0, 1, square_size=1.0, min_distance=value)  # type: ignore[arg-type]
+    assert str(err.value) == words
+    with pytest.raises(ValueError) as err:
+        calmod.calibrate_from_bag("x.bag", square_size=1.0, min_distance=value)  # type: ignore[arg-type]
+    assert str(err.value) == words
+    assert opened == []
+
+
 class _HungDevice:
     """A ``cv2.VideoCapture`` stand-in of a hung camera: its open (``opens`` False) or its grab
     never returns until ``unplug`` is set (3 s at most, so that the old code's test ends)."""

@@ -2024,15 +2024,18 @@ def calibrate_from_video(
         If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`.
     ValueError
         As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
-        a ``max_pairs`` below :data:`MIN_PAIRS` or a ``read_timeout`` that is not a positive
-        number of seconds (or None).
+        a ``max_pairs`` below :data:`MIN_PAIRS`, a ``min_distance`` that is not a finite number
+        of 0 or more, or a ``read_timeout`` that is not a positive number of seconds (or None),
+        each before a camera is opened.
     """
-    from stereovision.capture import StereoCamera, check_read_timeout
+    from stereovision.capture import StereoCamera, check_min_distance, check_read_timeout
 
     # a pattern string '10x7' as board was AttributeError "'str' object has no attribute
     # 'inner'", after the cameras were opened
     _check_board(board)
     max_pairs = _check_max_pairs(max_pairs)
+    if min_distance is not None:  # as board: a negative one was refused once both were open
+        check_min_distance(min_distance)
     check_read_timeout(read_timeout)
 
     # as given: StereoCamera takes paths and indexes (a str() made np.int64(1) the file "1")
@@ -2092,10 +2095,13 @@ def calibrate_from_bag(
     ValueError
         As :class:`~stereovision.rosbag.BagCamera` and :func:`calibrate`.
     """
+    from stereovision.capture import check_min_distance
     from stereovision.rosbag import BagCamera
 
     _check_board(board)  # '10x7' was AttributeError "'str' object has no attribute 'inner'"
     max_pairs = _check_max_pairs(max_pairs)
+    if min_distance is not None:  # before the bag is read, as board
+        check_min_distance(min_distance)
     cam = BagCamera(path, left_topic=left_topic, right_topic=right_topic, max_skew_ms=max_skew_ms)
     return _calibrate_from_camera(
         cam,

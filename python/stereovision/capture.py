@@ -631,6 +631,19 @@ def check_read_timeout(timeout: float | None, name: str = "read_timeout") -> Non
         )
 
 
+def check_min_distance(min_distance: object) -> float:
+    """``min_distance`` of :class:`ChessboardCollector` as a float, refused unless a finite
+    number of 0 or more (checked by the collector, and by
+    :func:`~stereovision.calibrate.calibrate_from_video` and
+    :func:`~stereovision.calibrate.calibrate_from_bag` before they open anything)."""
+    from stereovision._validate import finite_number
+
+    value = finite_number(min_distance, "min_distance")
+    if value < 0:
+        raise ValueError(f"min_distance: expected a finite number of 0 or more, got {value!r}")
+    return value
+
+
 def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
     """``camera.read()``, its native grab given up after ``timeout`` seconds.
 
@@ -2805,18 +2818,13 @@ class ChessboardCollector:
         # raw cv2.error, board="9x6" was AttributeError "'str' object has no attribute
         # 'resolved'", min_distance NaN kept every pair (the same pose over and over) and "0.2"
         # was TypeError "'<=' not supported" once a second board was seen.
-        from stereovision._validate import finite_number
         from stereovision.charuco import _require_board
 
         if self.board is not None:
             _require_board(self.board)
         else:
             self.pattern = parse_pattern(self.pattern)
-        self.min_distance = finite_number(self.min_distance, "min_distance")
-        if self.min_distance < 0:
-            raise ValueError(
-                f"min_distance: expected a finite number of 0 or more, got {self.min_distance!r}"
-            )
+        self.min_distance = check_min_distance(self.min_distance)
 
     def _charuco_pose(self, frame: StereoFrame) -> tuple[float, float, float, float] | str:
         from stereovision.calibrate import CHARUCO_MIN_COMMON
