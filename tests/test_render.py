@@ -919,10 +919,27 @@ def test_view_shows_a_big_cloud_decimated_and_leaves_the_file(tmp_path, capsys):
     kept = tmp_path / "shot.previous.png"
     assert io.out == f"1000 points -> {shot} (the one it replaced kept as {kept})\n"
     assert "note" not in io.err
-    assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "-1"]) == 2
-    assert capsys.readouterr().err == (
-        "stereovision: error: --max-points: expected 0 (all) or more, got -1\n"
-    )
+    # -1 and 1.5 in one wording (-1 was the command's "expected 0 (all) or more, got -1", 1.5
+    # argparse's "expected a whole number")
+    for bad in ("-1", "1.5"):
+        with pytest.raises(SystemExit) as exit_:
+            cli.main(["view", str(ply), "-o", str(shot), "--max-points", bad])
+        assert exit_.value.code == 2
+        assert capsys.readouterr().err.splitlines()[-1] == (
+            "stereovision view: error: argument --max-points: expected a whole number of "
+            f"points, 0 (all) or more, got '{bad}' (see stereovision view --help)"
+        )
+
+
+def test_view_of_one_point_says_one_point(tmp_path, capsys):
+    """A one-point cloud's shot was said as "1 points -> shot.png"."""
+    from stereovision import cli
+    from stereovision.io import write_ply
+
+    ply = write_ply(tmp_path / "one.ply", np.array([[0.0, 0.0, 4.0]], np.float32))
+    shot = tmp_path / "shot.png"
+    assert cli.main(["view", str(ply), "-o", str(shot)]) == 0
+    assert capsys.readouterr().out == f"1 point -> {shot}\n"
 
 
 # ----------------------------------------------------------------------------- real scene

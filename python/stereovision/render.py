@@ -1730,8 +1730,9 @@ def cmd_view(args: argparse.Namespace) -> int:
         total = int(geometry.field_data[POINTS_IN_SOURCE][0])
         what = f"{shown} of {total} points shown"
     else:
-        what = f"{shown} points"
-    what += f", {geometry.n_faces} triangles" if geometry.n_faces else ""
+        what = f"{shown} point{'s' if shown != 1 else ''}"  # a one-point cloud: "1 points"
+    faces = geometry.n_faces
+    what += f", {faces} triangle{'s' if faces != 1 else ''}" if faces else ""
     replaced = f" (the one it replaced kept as {kept})" if kept else ""
     print(f"{what} -> {out}{replaced}", file=sys.stdout)
     return 0
@@ -1753,6 +1754,21 @@ def _camera_move(text: str) -> float:
     if not (math.isfinite(value) and abs(value) <= VIEW_MAX_MOVE_M):
         raise argparse.ArgumentTypeError(
             f"expected metres from -{VIEW_MAX_MOVE_M:g} to {VIEW_MAX_MOVE_M:g}, got {text!r}"
+        )
+    return value
+
+
+def _point_count(text: str) -> int:
+    """argparse type of ``view``'s ``--max-points``: a whole number of 0 or more, refused in
+    one wording (-1 was the command's "--max-points: expected 0 (all) or more", 1.5 argparse's
+    "expected a whole number")."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number of points, 0 (all) or more, got {text!r}"
         )
     return value
 
@@ -1793,7 +1809,7 @@ def add_cli(subparsers: Any) -> None:
         )
     p.add_argument(
         "--max-points",
-        type=int,
+        type=_point_count,
         default=VIEW_MAX_POINTS,
         metavar="N",
         help="show a cloud of more points as an evenly spaced subset of N "
