@@ -1046,6 +1046,24 @@ def test_scale_pair_keeps_a_16_bit_pair_16_bit() -> None:
     assert "unrectified" not in view16.stats
 
 
+def test_video_pair_keeps_a_16_bit_sequence_16_bit(tmp_path: Path) -> None:
+    """VideoPair (the fallback without stereovision.capture) cast a 16-bit sequence's frame to
+    uint8, its levels wrapped modulo 256 (300 read as 44); the capture path keeps it uint16,
+    and so does it now (grey made BGR as before)."""
+    grey = (np.arange(12 * 16).reshape(12, 16) * 300).astype(np.uint16)
+    for i in range(5, 7):  # from 5: read by capture's _ImageSequence, IMREAD_UNCHANGED
+        for side in ("l", "r"):
+            assert cv2.imwrite(str(tmp_path / f"{side}_{i:03d}.png"), grey)
+    pair = VideoPair(str(tmp_path / "l_%03d.png"), str(tmp_path / "r_%03d.png"))
+    try:
+        left, right = pair.read()
+    finally:
+        pair.close()
+    assert left.dtype == right.dtype == np.uint16 and left.shape == (12, 16, 3)
+    np.testing.assert_array_equal(left[..., 0], grey)
+    np.testing.assert_array_equal(right[..., 2], grey)
+
+
 def test_scaled_calibration_passes_none_and_unscaled_through() -> None:
     asked: list[Any] = []
 

@@ -469,7 +469,9 @@ class VideoPair:
             raise OSError(f"camera {self._name(i)!r} gave no frame")
         if frame.ndim == 2:
             frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
-        return np.ascontiguousarray(frame, dtype=np.uint8)
+        # in its own type, as the capture path gives it: a 16-bit sequence's frame was cast to
+        # uint8, its levels wrapped modulo 256 (300 read as 44)
+        return np.ascontiguousarray(frame)
 
     def _pair(self) -> tuple[npt.NDArray[np.uint8] | None, npt.NDArray[np.uint8] | None]:
         # Both grabbed before either is decoded: read() one after the other took the right
