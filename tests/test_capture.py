@@ -1680,7 +1680,7 @@ def test_cli_capture(
         run(*src, "--square", "0.03")
     with pytest.raises(ValueError, match="give one calibration target, not both"):
         run(*src, "--charuco", "10x7", "--chessboard", "9x6", "--square", "3", "--marker", "2")
-    with pytest.raises(ValueError, match="--charuco: marker_size"):
+    with pytest.raises(ValueError, match=r"^--marker: 4 must be smaller than --square 3"):
         run(*src, "--charuco", "10x7", "--square", "3", "--marker", "4")
     with pytest.raises(SourceError, match="both sources ended after 6 frames; 6 of 9 pairs"):
         run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))

@@ -427,7 +427,7 @@ def test_cli_board_then_calibrate(rig: dict[str, Any], tmp_path: Path) -> None:
         (["--marker", "0.02"], "--marker, --dictionary and --legacy are for --board charuco"),
         (
             ["--board", "charuco", "--pattern", "10x7", "--marker", "0.04"],
-            "--board charuco: marker_size: 0.04 must be smaller than square_size 0.03",
+            "--marker: 0.04 must be smaller than --square 0.03",
         ),
     ],
 )

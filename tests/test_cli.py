@@ -3243,10 +3243,44 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
             ["batch", "{tmp}", "-o", "{tmp}/out", "--ground", "--grid", "nan"],
             "stereovision: error: --grid: expected a cell side from 0.01 to 10 m, got nan",
         ),
+        # a ChArUco board's refusal named CharucoBoard's parameters (marker_size, square_size,
+        # squares, dictionary) after "--board charuco:" (board, calibrate) / "--charuco:"
+        (
+            ["board", "-o", "b.png", "--board", "charuco", "--pattern", "10x7", "--square",
+             "0.03", "--marker", "0.05"],
+            "stereovision: error: --marker: 0.05 must be smaller than --square 0.03 (the marker "
+            "sits inside a white square)",
+        ),
+        (
+            ["board", "-o", "b.png", "--board", "charuco", "--pattern", "2x7", "--square",
+             "0.03", "--marker", "0.02"],
+            "stereovision: error: --pattern: expected a ChArUco board's squares as COLSxROWS, "
+            "each at least 3 (e.g. 7x5), got '2x7'",
+        ),
+        (
+            ["board", "-o", "b.png", "--board", "charuco", "--pattern", "20x20", "--square",
+             "0.03", "--marker", "0.02", "--dictionary", "DICT_4X4_50"],
+            "stereovision: error: --dictionary: DICT_4X4_50 has 50 markers, but a 20x20 board "
+            "needs 200",
+        ),
+        (
+            ["capture", "--left", "l.avi", "--right", "r.avi", "--charuco", "2x7", "--square",
+             "30", "--marker", "20", "-o", "out"],
+            "stereovision: error: --charuco: expected a ChArUco board's squares as COLSxROWS, "
+            "each at least 3 (e.g. 7x5), got '2x7'",
+        ),
+        (
+            ["capture", "--left", "l.avi", "--right", "r.avi", "--charuco", "10x7", "--square",
+             "20", "--marker", "30", "-o", "out"],
+            "stereovision: error: --marker: 30 must be smaller than --square 20 (the marker sits "
+            "inside a white square)",
+        ),
     ],
     ids=["calibrate-square", "calibrate-unit", "board-square", "info-baseline", "check-tolerance",
          "capture-square-unit", "capture-marker-nan", "info-hfov-tiny", "info-hfov-unit",
-         "bench-file", "batch-grid-ground", "batch-grid-range"],
+         "bench-file", "batch-grid-ground", "batch-grid-range", "board-charuco-marker",
+         "board-charuco-squares", "board-charuco-dictionary", "capture-charuco-squares",
+         "capture-charuco-marker"],
 )  # fmt: skip
 def test_a_bad_option_value_is_said_in_the_option_s_name(
     tmp_path: Path,

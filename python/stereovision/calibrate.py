@@ -3167,7 +3167,7 @@ def _cli_board(args: argparse.Namespace, *, printing: bool) -> CharucoBoard | No
         if args.marker is not None or args.dictionary != "auto" or args.legacy is not None:
             raise ValueError("--marker, --dictionary and --legacy are for --board charuco")
         return None
-    from stereovision.charuco import DICTIONARY_FAMILIES, CharucoBoard
+    from stereovision.charuco import DICTIONARY_FAMILIES, CharucoBoard, board_error_words
 
     if args.pattern is None:
         raise ValueError("--pattern: give the ChArUco board's squares as COLSxROWS (e.g. 7x5)")
@@ -3187,7 +3187,7 @@ def _cli_board(args: argparse.Namespace, *, printing: bool) -> CharucoBoard | No
         if printing and board.legacy is None:
             board = replace(board, legacy=False)
     except ValueError as exc:
-        raise ValueError(f"--board charuco: {exc}") from None
+        raise ValueError(board_error_words(exc, "--pattern", "--board charuco")) from None
     return board
 
 

@@ -3370,7 +3370,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
     pattern = parse_pattern(args.chessboard, "--chessboard") if args.chessboard else None
     board = None
     if args.charuco:
-        from stereovision.charuco import CharucoBoard
+        from stereovision.charuco import CharucoBoard, board_error_words
 
         if pattern is not None:
             raise ValueError("--chessboard and --charuco: give one calibration target, not both")
@@ -3379,7 +3379,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         try:
             board = CharucoBoard(args.charuco, args.square, args.marker, args.dictionary)
         except ValueError as exc:
-            raise ValueError(f"--charuco: {exc}") from None
+            raise ValueError(board_error_words(exc, "--charuco", "--charuco")) from None
     elif args.square is not None or args.marker is not None or args.dictionary != "auto":
         raise ValueError("--square, --marker and --dictionary are for --charuco")
     if args.count is not None and args.count <= 0:

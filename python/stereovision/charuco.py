@@ -118,6 +118,28 @@ def _require_board(board: object, name: str = "board") -> None:
         )
 
 
+#: CharucoBoard's parameters as the command line's options give them (the squares: a
+#: command's own option, board/calibrate --pattern, capture --charuco).
+_OPTION_OF = {
+    "square_size": "--square",
+    "marker_size": "--marker",
+    "dictionary": "--dictionary",
+    "legacy": "--legacy",
+}
+
+
+def board_error_words(exc: ValueError, squares_option: str, context: str) -> str:
+    """A :class:`CharucoBoard` refusal in the command line's words: the parameter it names
+    (``marker_size: 0.05 must be smaller than square_size 0.03``) said as the option that gave
+    it (``--marker: 0.05 must be smaller than --square 0.03``); any other text after
+    ``context`` (the option that asked for the board)."""
+    names = {**_OPTION_OF, "squares": squares_option}
+    head, sep, rest = str(exc).partition(": ")
+    if not sep or head not in names:
+        return f"{context}: {exc}"
+    return f"{names[head]}: {rest.replace('than square_size ', 'than --square ')}"
+
+
 @dataclass(frozen=True)
 class CharucoBoard:
     """A ChArUco board's geometry and marker dictionary.
