@@ -1337,6 +1337,30 @@ def test_a_ros2_bag_without_its_metadata_is_read(
     assert code == 0 and out.splitlines()[-1].startswith(f"{len(kept)} pairs saved in ")
 
 
+def test_a_folder_holding_no_bag_is_said_so_not_as_its_metadata_file(
+    tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A folder of images given as the bag (capture --from-bag pairs/): rosbags' "Expected
+    metadata file 'pairs' does not exist." named the folder as the file. It says what a bag
+    folder holds, in the library and on the command line."""
+    from stereovision.rosbag import bag_topics
+
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    (pairs / "left_0001.png").write_bytes(b"")
+    said = (
+        f"{pairs} is not a readable ROS 1 or ROS 2 bag: a folder without a ROS 2 bag's "
+        "metadata.yaml (or its .db3 / .mcap files) nor a ROS 1 recording's .bag files"
+    )
+    for open_it in (BagCamera, bag_topics):
+        with pytest.raises(ValueError) as err:
+            open_it(pairs)
+        assert str(err.value) == said
+    code, out, err_text = run("capture", "--from-bag", str(pairs), "-o", str(tmp_path / "o"))
+    assert (code, out, err_text) == (2, "", f"stereovision: error: {said}\n")
+    assert not (tmp_path / "o").exists()
+
+
 def test_a_size_of_another_shape_does_not_stretch_a_recording(cones: Any, tmp_path: Path) -> None:
     """--size 450x200 for 450x375 frames: kept at 450x375 with a warning, as for cameras
     (`capture --size`: "frames of the same shape are resized"); they were stretched."""

@@ -782,7 +782,8 @@ def _bag_paths(path: Path) -> list[Path]:
     ``.bag`` files (a recording split by ``rosbag record --split``) as all of them, in name
     order; a ROS 2 bag folder without its ``metadata.yaml`` (a recorder killed before writing
     it) as its ``.db3`` or ``.mcap`` files (it was "not a readable bag": ``ros2 bag reindex``
-    needs ROS); a ``.bag`` file alone."""
+    needs ROS); a ``.bag`` file alone. A folder holding none of them is a ValueError saying what
+    a bag folder holds."""
     if path.is_dir() and not (path / "metadata.yaml").is_file():
         parts = sorted(path.glob("*.bag"))
         if parts:
@@ -790,6 +791,12 @@ def _bag_paths(path: Path) -> list[Path]:
         parts = sorted(path.glob("*.db3")) or sorted(path.glob("*.mcap"))
         if parts:
             return parts
+        # rosbags said "Expected metadata file 'DIR' does not exist.", the folder named as
+        # the file (a folder of images, a mistyped run folder)
+        raise ValueError(
+            "a folder without a ROS 2 bag's metadata.yaml (or its .db3 / .mcap files) nor a "
+            "ROS 1 recording's .bag files"
+        )
     return [path]
 
 
