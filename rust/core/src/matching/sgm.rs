@@ -1985,8 +1985,9 @@ mod tests {
     #[test]
     fn the_avx2_path_step_gives_the_compilers_integers() {
         // The hand-written AVX2 step against the portable loop, through whole passes in both
-        // directions (all eight paths), for every level count 1..=200 (below 32 the loop runs;
-        // above, the last block overlaps the one before), on census and random cost volumes,
+        // directions (all eight paths), for every level count 1..=66 (below 32 the loop runs;
+        // above, the last block of 32 overlaps the one before by every amount 0..=31) and for
+        // three to seven blocks, aligned or not, up to 200, on census and random cost volumes,
         // with P1 and P2 at their u8 extremes and gammas that take every P2 level or none.
         let Some(avx2) = Avx2::detect() else {
             eprintln!("no AVX2 on this CPU: nothing to compare");
@@ -2035,7 +2036,7 @@ mod tests {
             pass_impl::<u8>(c, &img, w, h, n, p, forward, &mut row, &mut emit, a).unwrap();
             rows
         };
-        for n in 1..=200 {
+        for n in (1..=66).chain([95, 96, 97, 127, 128, 129, 160, 199, 200]) {
             // Random costs, a tenth of them OUTSIDE (the largest a cost can be).
             let random: Vec<u8> = (0..w * h * n)
                 .map(|_| match rand() % 10 {
