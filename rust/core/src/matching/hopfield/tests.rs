@@ -1122,11 +1122,14 @@ fn initial_net_inputs_too_large_to_allocate_are_an_error() {
     }
 }
 
-/// Run by [`network_orders_too_large_to_allocate_are_an_error`] in a child process: 2^20
-/// lone neurons under an address-space limit of `SV_OOM_MIB` MiB more than is mapped. The
-/// checked per-point and per-neuron tables before the orders take 28 MiB; then (one rayon
-/// thread) the strip order (4 MiB sorts, 4 MiB coordinates), the point windows (56 MiB) and
-/// the right-pixel groups (8 MiB indices and keys, 4 MiB order, 8 + 4 MiB groups and ranks).
+/// Run by [`network_orders_too_large_to_allocate_are_an_error`] in a child process: 2^18
+/// lone neurons (256 rows of 1024: building their network in debug code is most of the
+/// child's time) under an address-space limit of `SV_OOM_MIB` MiB more than is mapped. The
+/// checked per-point and per-neuron tables before the orders take 7 MiB; then (one rayon
+/// thread) the strip order (1 MiB sorts, 1 MiB coordinates), the point windows (14 MiB) and
+/// the right-pixel groups (2 MiB indices and keys, 1 MiB order, 2 + 1 MiB groups and ranks).
+/// Measured: the strip order fails at 7.5 to 11 MiB, the point windows at 12 to 24, the
+/// groups' 2 MiB at 24.5 to 26.
 #[cfg(target_os = "linux")]
 #[test]
 #[ignore = "a child of network_orders_too_large_to_allocate_are_an_error"]
@@ -1134,10 +1137,12 @@ fn network_orders_under_a_memory_limit() {
     let Some(mib) = std::env::var_os("SV_OOM_MIB") else {
         return;
     };
-    let mib: usize = mib.to_str().unwrap().parse().unwrap();
-    let neurons = lone_neurons();
+    let mib: f64 = mib.to_str().unwrap().parse().unwrap();
+    let neurons = lone_neurons_in(256);
     rayon::join(|| (), || ()); // the pool's thread started before the limit
-    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (mib << 20));
+    crate::segment::tests::limit_address_space(
+        crate::segment::tests::vm_size() + (mib * f64::from(1 << 20)) as usize,
+    );
     match Network::new(&neurons, &HopfieldParams::default().weights) {
         Ok(net) => println!("child: network of {}", net.n()),
         Err(e) => println!("child: error: {e}"),
@@ -1153,16 +1158,16 @@ fn network_orders_too_large_to_allocate_are_an_error() {
     // aborted the process (SIGABRT) instead of returning OutOfMemory.
     for (mib, want) in [
         (
-            "34",
-            "the Hopfield network's strip order needs 4.00 MiB (4194304 bytes)",
+            "8.5",
+            "the Hopfield network's strip order needs 1.00 MiB (1048576 bytes)",
         ),
         (
-            "70",
-            "the Hopfield network's point windows needs 56.00 MiB (58720256 bytes)",
+            "17.5",
+            "the Hopfield network's point windows needs 14.00 MiB (14680064 bytes)",
         ),
         (
-            "101",
-            "the Hopfield network's right-pixel groups needs 8.00 MiB (8388608 bytes)",
+            "25.25",
+            "the Hopfield network's right-pixel groups needs 2.00 MiB (2097152 bytes)",
         ),
     ] {
         let stdout = crate::segment::tests::run_oom_child_with(
