@@ -1067,9 +1067,10 @@ fn lone_neurons_in(rows: u32) -> Vec<Neuron> {
 }
 
 /// Run by [`initial_net_inputs_too_large_to_allocate_are_an_error`] in a child process:
-/// 2^20 neurons (stored weights, then the channel's implicit ones) under an address-space
-/// limit of 3 MiB more than is mapped. The state (1 MiB) fits; the initial net inputs (8 MiB,
-/// the implicit weights' lane states 4 MiB first) do not.
+/// 2^18 neurons (stored weights, then the channel's implicit ones: building their network in
+/// debug code is most of the child's time) under an address-space limit of 0.75 MiB more than
+/// is mapped. The state (0.25 MiB) fits; the initial net inputs (2 MiB, the implicit weights'
+/// lane states 1 MiB first) do not.
 #[cfg(target_os = "linux")]
 #[test]
 #[ignore = "a child of initial_net_inputs_too_large_to_allocate_are_an_error"]
@@ -1077,16 +1078,17 @@ fn initial_net_inputs_under_a_memory_limit() {
     if std::env::var_os("SV_OOM_CHILD").is_none() {
         return;
     }
-    let m = 1usize << 20;
+    let m = 1usize << 18;
     let (input, init) = (vec![0.5f64; m], vec![0u8; m]);
     let implicit = std::env::var_os("SV_OOM_IMPLICIT").is_some();
-    let net = implicit.then(|| Network::new(&lone_neurons(), &HopfieldParams::default().weights));
+    let net =
+        implicit.then(|| Network::new(&lone_neurons_in(256), &HopfieldParams::default().weights));
     let csr = Csr {
         indptr: vec![0; m + 1],
         ..Csr::default()
     };
     rayon::join(|| (), || ()); // the pool's thread started before the limit
-    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (3 << 20));
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (3 << 18));
     let got = match net {
         Some(net) => run_dynamics(&net.unwrap(), &input, &init, 1, 10),
         None => run_dynamics(&csr, &input, &init, 1, 10),
@@ -1105,8 +1107,8 @@ fn initial_net_inputs_too_large_to_allocate_are_an_error() {
     // states, slot-ordered sums and push buffers implicit) were still allocated unchecked: a
     // failed allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
     for (implicit, size) in [
-        (false, "8.00 MiB (8388608 bytes)"),
-        (true, "4.00 MiB (4194336 bytes)"),
+        (false, "2.00 MiB (2097152 bytes)"),
+        (true, "1.00 MiB (1048608 bytes)"),
     ] {
         let stdout = crate::segment::tests::run_oom_child_with(
             "matching::hopfield::tests::initial_net_inputs_under_a_memory_limit",
