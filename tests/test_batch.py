@@ -81,26 +81,6 @@ def scenes(data_dir: Path, tmp_path: Path) -> Path:
     return root
 
 
-@pytest.fixture(scope="module")
-def sched() -> Iterator[str]:
-    """The address of one 2-worker LocalCluster for the tests not about batch's own cluster:
-    a run starting its own cost ~3 s of CPU (a scheduler, and worker processes importing
-    NumPy, OpenCV and stereovision), its tiny pairs a fraction of that. Started as batch's
-    ``_Dask.start`` starts its own, the workers' environment included."""
-    threads = str(max(1, (os.cpu_count() or 1) // 2))
-    env = {"RAYON_NUM_THREADS": threads, "OMP_NUM_THREADS": threads, "OPENCV_LOG_LEVEL": "ERROR"}
-    with distributed.LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-        silence_logs=logging.CRITICAL,
-        env=env,
-    ) as cluster:
-        yield cluster.scheduler_address
-
-
 def _summary(out: Path) -> dict:
     return json.loads((out / SUMMARY_NAME).read_text())
 
@@ -593,7 +573,7 @@ def test_batch_workers_must_be_a_whole_number(data_dir: Path, tmp_path: Path) ->
     assert not out.exists()
 
 
-def test_batch_grid_is_a_number(data_dir: Path, tmp_path: Path, sched: str) -> None:
+def test_batch_grid_is_a_number(data_dir: Path, tmp_path: Path) -> None:
     """run_batch(ground=True, grid=numpy.float32(0.25)) crashed at the summary's first write
     ("Object of type float32 is not JSON serializable"); grid="0.2" failed in Python's
     isfinite ("must be real number, not str"). A NumPy float is the number it is; a string is
@@ -603,10 +583,10 @@ def test_batch_grid_is_a_number(data_dir: Path, tmp_path: Path, sched: str) -> N
     root, out = tmp_path / "in", tmp_path / "o"
     _tiny(root, data_dir, "a_left.png", "a_right.png")
     with pytest.raises(TypeError, match=r"^grid: expected a cell side in metres, got '0.2'$"):
-        run_batch(root, out, scheduler=sched, ground=True, grid="0.2", progress=False)  # type: ignore[arg-type]
+        run_batch(root, out, workers=1, ground=True, grid="0.2", progress=False)  # type: ignore[arg-type]
     assert not out.exists()
     # no calibration: the pair fails (ground needs one), recorded with the grid asked for
-    res = run_batch(root, out, scheduler=sched, ground=True, grid=np.float32(0.25), progress=False)  # type: ignore[arg-type]
+    res = run_batch(root, out, workers=1, ground=True, grid=np.float32(0.25), progress=False)  # type: ignore[arg-type]
     assert res.failed == ["a"]
     assert _summary(out)["pairs"]["a"]["options"]["grid"] == 0.25
 
@@ -656,7 +636,7 @@ def test_batch_switches_are_true_or_false(tmp_path: Path) -> None:
 
 
 def test_batch_a_pair_failed_on_an_obstacle_is_done_once_it_is_gone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A file where pair a's output folder goes failed the pair with its fingerprint and
     options recorded: once the file was moved away the rerun skipped a as 'failed before'
@@ -667,7 +647,7 @@ def test_batch_a_pair_failed_on_an_obstacle_is_done_once_it_is_gone(
     _tiny(root, data_dir, "a/left.png", "a/right.png")
     out.mkdir()
     (out / "a").write_text("notes")
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 1
     assert _summary(out)["pairs"]["a"]["status"] == "failed"
     (out / "a").unlink()
@@ -695,9 +675,7 @@ def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Pat
     assert not (tmp_path / "o").exists()
 
 
-def test_batch_redoes_the_pairs_when_the_grid_cell_changes(
-    data_dir: Path, tmp_path: Path, sched: str
-) -> None:
+def test_batch_redoes_the_pairs_when_the_grid_cell_changes(data_dir: Path, tmp_path: Path) -> None:
     """--grid is one of the options a pair was done with: a run with another cell side redoes
     it (it was skipped as done, its map.yaml still of the old cell), said as grid 0.2 -> 0.5."""
     from stereovision.batch import run_batch
@@ -713,12 +691,10 @@ def test_batch_redoes_the_pairs_when_the_grid_cell_changes(
     assert "609.5593" in calib and "width=1242" in calib
     calib = calib.replace("609.5593", "209.5593").replace("width=1242", "width=400")
     (k / "calib.txt").write_text(calib)
-    first = run_batch(root, out, scheduler=sched, ground=True, grid=0.2, progress=False)
+    first = run_batch(root, out, workers=1, ground=True, grid=0.2, progress=False)
     assert first.processed == ["k"]
     lines: list[str] = []
-    again = run_batch(
-        root, out, scheduler=sched, ground=True, grid=0.5, progress=False, log=lines.append
-    )
+    again = run_batch(root, out, workers=1, ground=True, grid=0.5, progress=False, log=lines.append)
     assert again.processed == ["k"] and again.redone == ["k"] and again.skipped == []
     assert "grid: 0.2 -> 0.5" in lines[0]
     assert _summary(out)["pairs"]["k"]["options"]["grid"] == 0.5
@@ -927,7 +903,7 @@ def _change(path: Path) -> None:
 
 
 def test_batch_reports_an_image_without_its_pair(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """left.png without right.png, x_left.png without x_right.png, y_right.png without
     y_left.png: each a failed pair saying which file is missing, exit 1 (they were ignored:
@@ -937,7 +913,7 @@ def test_batch_reports_an_image_without_its_pair(
           "c/y_right.png", "c/.z_left.png")  # fmt: skip
     (root / "c/notes_left.txt").write_text("not an image")
     assert [j.name for j in find_pairs(root)] == ["a"]
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 1
     said = capsys.readouterr()
     assert said.out.startswith(
@@ -1025,7 +1001,6 @@ def test_batch_progress_lines_when_stderr_is_not_a_terminal(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
-    sched: str,
 ) -> None:
     """Without a terminal (a log file, a pipe) a plain line every tenth of the pairs, or every
     PROGRESS_SECONDS (there was none: tqdm only shows on a terminal)."""
@@ -1033,7 +1008,7 @@ def test_batch_progress_lines_when_stderr_is_not_a_terminal(
 
     root = tmp_path / "in"
     _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(12) for s in ("left", "right")))
-    args = ["batch", str(root), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "--workers", "1", "--max-disparity", "16"]
     line = re.compile(r"batch: (\d+)/12 pairs, \d+ s, about \d+ s left")
 
     def counts() -> list[int]:
@@ -1056,7 +1031,6 @@ def test_batch_output_folder_moved_during_the_run(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
-    sched: str,
 ) -> None:
     """The output folder moved away after two pairs: the pairs written before are counted as
     missing (pending in the summary), exit 1, and a re-run redoes them (the summary said all
@@ -1076,7 +1050,7 @@ def test_batch_output_folder_moved_during_the_run(
         return dest
 
     monkeypatch.setattr(batch, "_commit_pair", commit_then_move)
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 1
     said = capsys.readouterr()
     assert said.out.splitlines()[1] == (
@@ -1100,14 +1074,14 @@ def test_batch_output_folder_moved_during_the_run(
 
 
 def test_batch_says_when_other_options_redo_finished_pairs(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Another --method redoes every finished pair: one line says so before (it was silent)."""
     from stereovision.batch import _changes
 
     root, out = tmp_path / "in", tmp_path / "out"
     _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(2) for s in ("left", "right")))
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main([*args, "--method", "fast"]) == 0
     assert "other options" not in capsys.readouterr().err
     assert main([*args, "--method", "census"]) == 0
@@ -1130,7 +1104,7 @@ def test_batch_says_when_other_options_redo_finished_pairs(
 
 
 def test_batch_never_deletes_what_an_output_folder_already_holds(
-    data_dir: Path, tmp_path: Path, sched: str
+    data_dir: Path, tmp_path: Path
 ) -> None:
     """A pair's outputs go into a folder that holds other things: the input images (-o given as
     the input folder), the outputs of a pair nested in it, a user's file. They are kept; a pair
@@ -1141,7 +1115,7 @@ def test_batch_never_deletes_what_an_output_folder_already_holds(
     _tiny(root, data_dir, "a/left.png", "a/right.png", "a/b/left.png", "a/b/right.png")
     images = {p: p.read_bytes() for p in root.rglob("*.png")}
     (root / "a/notes.txt").write_text("mine")
-    args = ["batch", str(root), "-o", str(root), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(root), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     assert {p: p.read_bytes() for p in images} == images  # the inputs are all there
     assert (root / "a/notes.txt").read_text() == "mine"
@@ -1216,7 +1190,7 @@ def test_a_large_summary_is_not_rewritten_after_every_pair(
 
 
 def test_batch_refuses_to_replace_the_outputs_of_another_input(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A second drive whose pairs have the first one's names, into the same -o: refused before
     any work, one line (the first drive's outputs were replaced without a word). The same input
@@ -1227,7 +1201,7 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     _tiny(two, data_dir, *names)
     cv2.imwrite(str(two / "seq/0001_left.png"), np.zeros((64, 96, 3), np.uint8))
     _change(two / "seq/0000_left.png")  # other images (the same bytes are the same pair)
-    args = ["--scheduler", sched, "--max-disparity", "16"]
+    args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     before = _tree(out)
     capsys.readouterr()
@@ -1249,7 +1223,7 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
 
 
 def test_batch_skipped_pairs_record_where_their_images_are_now(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """An input folder moved (its images' times kept) and run again: its pairs are skipped,
     and their records name the images where they are now. They named the old place, a path
@@ -1259,7 +1233,7 @@ def test_batch_skipped_pairs_record_where_their_images_are_now(
     one, out = tmp_path / "drive1", tmp_path / "out"
     names = [f"seq/{i:04d}_{s}.png" for i in range(2) for s in ("left", "right")]
     _tiny(one, data_dir, *names)
-    args = ["--scheduler", sched, "--max-disparity", "16"]
+    args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     moved = tmp_path / "moved"
     shutil.move(one, moved)  # mv keeps the times: the pairs are skipped
@@ -1288,7 +1262,7 @@ def test_batch_skipped_pairs_record_where_their_images_are_now(
 
 
 def test_batch_a_skip_through_a_link_keeps_the_images_it_recorded(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A drive run as it is, then through a link to it (its pairs skipped): the skip rewrote
     the records to name the images through the link, so once the link was pointed at another
@@ -1303,7 +1277,7 @@ def test_batch_a_skip_through_a_link_keeps_the_images_it_recorded(
     _change(two / "a/left.png")
     link = tmp_path / "current"
     link.symlink_to(one)
-    args = ["--scheduler", sched, "--max-disparity", "16"]
+    args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     assert main(["batch", str(link), "-o", str(out), *args]) == 0
     assert _summary(out)["run"]["skipped"] == 1
@@ -1323,7 +1297,7 @@ def test_batch_a_skip_through_a_link_keeps_the_images_it_recorded(
 
 
 def test_batch_refuses_to_replace_a_file_it_did_not_write(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair's output folder holding the user's own disparity.png (no run recorded writing it):
     it was replaced silently; now refused before any work, one line naming it, exit 2. A rerun
@@ -1332,7 +1306,7 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     _tiny(src, data_dir, "a/left.png", "a/right.png")
     (out / "a").mkdir(parents=True)
     (out / "a" / "disparity.png").write_text("mine")
-    args = ["--scheduler", sched, "--max-disparity", "16"]
+    args = ["--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(["batch", str(src), "-o", str(out), *args]) == 2
     assert capsys.readouterr().err.splitlines() == [_not_ours(out, "a", "disparity.png")]
@@ -1347,14 +1321,14 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
 
 
 def test_batch_refuses_to_replace_a_link_put_under_an_output_name_it_wrote(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair's disparity.png (recorded as written) that the user replaced by a link to a file
     of theirs: the redo replaced the link with its own file, unsaid (a redo that does not write
     the name keeps such a link). Refused before any work, one line naming it, exit 2."""
     src, out = tmp_path / "drive", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png")
-    args = ["--scheduler", sched, "--max-disparity", "16"]
+    args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(src), "-o", str(out), *args]) == 0
     mine = tmp_path / "mine.png"
     mine.write_bytes(b"mine")
@@ -1395,7 +1369,7 @@ def test_batch_resumes_a_pair_written_by_a_run_killed_before_recording_it(
 
 
 def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """-o naming a folder with the user's own summary.json (not a batch summary): it was read
     as unreadable and replaced by the run's. Refused before any work, one line naming it."""
@@ -1405,7 +1379,7 @@ def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
     for text in ("my notes", '{"mine": 1}'):
         (out / SUMMARY_NAME).write_text(text)
         capsys.readouterr()
-        assert main(["batch", str(src), "-o", str(out), "--scheduler", sched]) == 2
+        assert main(["batch", str(src), "-o", str(out), "--workers", "1"]) == 2
         assert capsys.readouterr().err.splitlines() == [
             f"stereovision: error: output folder {out}: {out / SUMMARY_NAME} is not a batch "
             "summary and would be replaced: give another output folder, or move or remove that "
@@ -1416,7 +1390,7 @@ def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
 
 
 def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Two input folders with pairs of other names share one -o; a changed image of the first
     is redone when the first is run again (it was refused as 'made from other images, in
@@ -1424,7 +1398,7 @@ def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
     one, two, out = tmp_path / "drive1", tmp_path / "drive2", tmp_path / "out"
     _tiny(one, data_dir, "a/left.png", "a/right.png")
     _tiny(two, data_dir, "b/left.png", "b/right.png")
-    args = ["--scheduler", sched, "--max-disparity", "16"]
+    args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     assert main(["batch", str(two), "-o", str(out), *args]) == 0
     _change(one / "a/left.png")
@@ -1488,7 +1462,7 @@ def test_a_pair_folder_linked_to_another_disk_is_written(tmp_path: Path) -> None
 
 
 def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """OUT/a is a user's file: pair a fails naming it, the file is kept, pair b is done (the
     run stopped at '[Errno 20] Not a directory: .../.a.partial-.../disparity.png', b undone;
@@ -1497,7 +1471,7 @@ def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
     _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
     out.mkdir()
     (out / "a").write_text("notes")
-    assert main(["batch", str(root), "-o", str(out), "--scheduler", sched]) == 1
+    assert main(["batch", str(root), "-o", str(out), "--workers", "1"]) == 1
     err = capsys.readouterr().err
     assert (
         f"failed a: NotADirectoryError: {out / 'a'} is a file, where the pair's output folder "
@@ -1511,7 +1485,7 @@ def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
 
 
 def test_batch_a_folder_where_an_output_file_goes_fails_that_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A rerun where OUT/a/disparity.pfm is a user's folder: the run stopped there ("cannot
     write the outputs of a ...: Is a directory; ... run again to continue", exit 2, as for a
@@ -1520,7 +1494,7 @@ def test_batch_a_folder_where_an_output_file_goes_fails_that_pair_alone(
     pair's folder goes, pair a fails naming the folder, its files as they were; b is done."""
     root, out = tmp_path / "in", tmp_path / "out"
     _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     (out / "a" / "disparity.pfm").unlink()
     (out / "a" / "disparity.pfm").mkdir()
@@ -1543,7 +1517,7 @@ def test_batch_a_folder_where_an_output_file_goes_fails_that_pair_alone(
     assert pairs["a"]["status"] == "failed" and pairs["b"]["status"] == "done"
 
 
-def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path, sched: str) -> None:
+def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path) -> None:
     """A 12-bit camera's pair in 16-bit PNGs: batch's disparity is the one `stereovision depth`
     writes for it (batch decoded the top 8 bits of each pixel, 0-15 of 0-4095, while depth
     keeps the 16 bits since it reads with io.read_image)."""
@@ -1562,7 +1536,7 @@ def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path, 
         str(tmp_path / "depth"),
     ]
     assert main([*argv, *args]) == 0
-    assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--scheduler", sched,
+    assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--workers", "1",
                  *args]) == 0  # fmt: skip
     want = read_pfm(tmp_path / "depth/disparity.pfm")
     got = read_pfm(tmp_path / "out/a/disparity.pfm")
@@ -1595,7 +1569,7 @@ def _crops(root: Path, data_dir: Path, left: list[str], right: list[str]) -> Non
     ids=["left-right", "L-R", "kitti", "euroc"],
 )  # fmt: skip
 def test_batch_pairs_images_of_the_same_name_in_sibling_camera_folders(
-    data_dir: Path, tmp_path: Path, left: list[str], right: list[str], names: list[str], sched: str
+    data_dir: Path, tmp_path: Path, left: list[str], right: list[str], names: list[str]
 ) -> None:
     """left/0001.png + right/0001.png (L/ R/, KITTI's image_2/ image_3/, EuRoC's cam0/data/
     cam1/data/) are pairs, named by the parent and the path under the camera folder, whose
@@ -1610,7 +1584,7 @@ def test_batch_pairs_images_of_the_same_name_in_sibling_camera_folders(
     by_name = {j.name: j for j in jobs}
     for name, lp, rp in zip(names, left, right, strict=True):
         assert (by_name[name].left, by_name[name].right) == (root / lp, root / rp)
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     s = _summary(out)
     assert sorted(s["pairs"]) == sorted([*names, "ref"])
@@ -1625,7 +1599,7 @@ def test_batch_pairs_images_of_the_same_name_in_sibling_camera_folders(
 
 
 def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """An image in one camera folder without the other is a failed pair saying which file is
     missing; several rigs in one folder keep their left camera's folder in the names; a clash
@@ -1647,7 +1621,7 @@ def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
         *before,
     ]
     assert jobs[4] == PairJob("s/0001~3", root / "s/left/0001.png", root / "s/right/0001.png")
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 1
     said = capsys.readouterr()
     assert said.out.startswith("6 processed, 0 skipped (done before), 2 failed (2 with an image ")
@@ -1684,7 +1658,7 @@ def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
 
 
 def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_listed(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, sched: str
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A pair done with --ground, redone without it by a run stopped before the pair was
     written: the summary still lists the earlier run's outputs (it listed none), so the next
@@ -1693,7 +1667,7 @@ def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_liste
 
     root, out = tmp_path / "in", tmp_path / "out"
     _tiny(root, data_dir, "a/left.png", "a/right.png")
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     # as a run with --ground left it: its ground.json written and recorded
     (out / "a/ground.json").write_text("{}")
@@ -1709,7 +1683,7 @@ def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_liste
     with monkeypatch.context() as m:
         m.setattr(batch, "_run_jobs", stopped)
         with pytest.raises(batch.BatchInterrupted):
-            batch.run_batch(root, out, scheduler=sched, max_disparity=16)
+            batch.run_batch(root, out, workers=1, max_disparity=16)
     pending = _summary(out)["pairs"]["a"]
     assert pending["status"] == "pending"
     assert pending["outputs"] == sorted([*DISPARITY_FILES, "ground.json"])
@@ -1723,7 +1697,6 @@ def test_a_second_batch_into_an_output_folder_in_use_is_refused(
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
-    sched: str,
 ) -> None:
     """A run started while another one writes into the same -o stops before any work, one
     line; each run replaced the whole summary with its own, so the one that finished last
@@ -1742,7 +1715,7 @@ def test_a_second_batch_into_an_output_folder_in_use_is_refused(
         said["err"] = capsys.readouterr().err.splitlines()
 
     monkeypatch.setattr(batch, "_run_jobs", meanwhile)
-    batch.run_batch(one, out, scheduler=sched, max_disparity=16)
+    batch.run_batch(one, out, workers=1, max_disparity=16)
     assert said["rc"] == 2
     assert said["err"] == [
         f"stereovision: error: output folder {out} is in use by another stereovision batch "
@@ -1750,10 +1723,7 @@ def test_a_second_batch_into_an_output_folder_in_use_is_refused(
     ]
     assert set(_summary(out)["pairs"]) == {"a"}
     monkeypatch.undo()  # the folder is free again once the run is over
-    assert (
-        main(["batch", str(two), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"])
-        == 0
-    )
+    assert main(["batch", str(two), "-o", str(out), "--workers", "1", "--max-disparity", "16"]) == 0
     assert set(_summary(out)["pairs"]) == {"a", "b"}
 
 
@@ -1849,7 +1819,7 @@ def test_a_scene_with_only_q_dat_is_batched_with_depth(data_dir: Path, tmp_path:
 
 
 def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A scene's Q.dat is read before its pair is sent (8ab621e): one that is not a Q matrix
     stopped the whole run ('error: .../b/Q.dat: not a rectified Q matrix', exit 2, pair a left
@@ -1857,7 +1827,7 @@ def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
     root, out = tmp_path / "in", tmp_path / "out"
     _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
     (root / "b" / "Q.dat").write_text("0 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 4 0\n")
-    assert main(["batch", str(root), "-o", str(out), "--scheduler", sched]) == 1
+    assert main(["batch", str(root), "-o", str(out), "--workers", "1"]) == 1
     err = capsys.readouterr().err
     q = root / "b" / "Q.dat"
     assert f"failed b: ValueError: {q}: not a rectified Q matrix: Q[0,0] = 0, expected 1" in err
@@ -1867,7 +1837,7 @@ def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
 
 
 def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A version 1 summary's entry without an outputs list takes the standard output names
     in its folder as its own, but no version 1 batch wrote overview.png (4715e5e came after
@@ -1895,7 +1865,7 @@ def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
         "output": str(out.resolve()),
     }
     (out / SUMMARY_NAME).write_text(json.dumps(summary, indent=1))
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(args) == 2
     assert capsys.readouterr().err.splitlines() == [_not_ours(out, "a", "overview.png")]
@@ -1904,7 +1874,7 @@ def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
 
 
 def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A summary.json of a batch before ed0f5f2 (version 1): a pair done, then redone on a
     damaged image, was recorded failed without its outputs list, and a pair whose right image
@@ -1950,7 +1920,7 @@ def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
     _tiny(src, data_dir, "c/left.png", "c/right.png")
     (out / "c").mkdir()
     (out / "c" / "disparity.png").write_text("mine")  # the user's, in a folder no run wrote
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(args) == 2
     assert capsys.readouterr().err.splitlines() == [_not_ours(out, "c", "disparity.png")]
@@ -1968,7 +1938,7 @@ def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
 
 
 def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair removed from the input (or of another input folder run into the same -o) kept
     its record's "this_run": "processed" from the run that did it, so a script reading the
@@ -1976,7 +1946,7 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
     outputs are kept."""
     src, out = tmp_path / "drive", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     shutil.rmtree(src / "b")
     capsys.readouterr()
@@ -2004,13 +1974,13 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
 
 
 def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair recorded as done whose folder the user deleted since: the next run redoes it (it
     is not skipped as done), and its outputs are there again."""
     src, out = tmp_path / "in", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     shutil.rmtree(out / "b")
     capsys.readouterr()
@@ -2022,14 +1992,14 @@ def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
 
 
 def test_retry_failed_redoes_the_pairs_that_failed_on_the_same_images(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair that failed is skipped on unchanged images, and tried again with --retry-failed
     (the done pairs stay skipped)."""
     src, out = tmp_path / "in", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png")
     (src / "b/right.png").write_bytes((src / "a/right.png").read_bytes()[:200])  # truncated
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 1
     capsys.readouterr()
     assert main(args) == 1
@@ -2053,14 +2023,14 @@ def test_retry_failed_redoes_the_pairs_that_failed_on_the_same_images(
 
 
 def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A done pair whose right image goes is a failed pair that keeps its outputs listed: when
     the image comes back the pair is redone over them (not refused as files no run wrote). An
     image rewritten to another size is redone even with its old modification time."""
     src, out = tmp_path / "in", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     right = (src / "b/right.png").read_bytes()
     (src / "b/right.png").unlink()
@@ -2084,14 +2054,14 @@ def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone
 
 
 def test_a_pair_name_taken_by_other_files_of_the_same_input_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The scene folder ``a/`` replaced by ``a_left.png`` + ``a_right.png`` (other images, the
     same pair name) in the same input folder: redone; only another input's pairs are refused
     as 'made from other images'."""
     src, out = tmp_path / "in", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     shutil.rmtree(src / "a")
     _tiny(src, data_dir, "a_left.png", "a_right.png")
@@ -2125,14 +2095,14 @@ def test_a_run_killed_after_one_with_other_outputs_is_resumed_over_both(
 
 
 def test_a_redo_without_calib_removes_the_stale_depth_files_but_not_a_link(
-    data_dir: Path, tmp_path: Path, sched: str
+    data_dir: Path, tmp_path: Path
 ) -> None:
     """A pair done with --calib, redone without it: its depth files (an earlier run's, not
     written now) are removed; one the user replaced with a link is left alone."""
     src, out = tmp_path / "in", tmp_path / "out"
     _tiny(src, data_dir, "seq/0000_left.bmp", "seq/0000_right.bmp")
     Calibration.ideal((96, 64), 60.0, 0.1).save(tmp_path / "rig.yaml")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main([*args, "--calib", str(tmp_path / "rig.yaml")]) == 0
     pair = out / "seq/0000"
     mine = tmp_path / "mine.png"
@@ -2175,7 +2145,7 @@ def test_batch_keeps_dask_logs_off_for_a_restarted_worker_and_restores_the_confi
 
 
 def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair done before whose cloud.ply had gone (deleted, lost in a copy) was skipped as done
     on a rerun (only disparity.pfm was looked for): its cloud was never written again. It is
@@ -2184,7 +2154,7 @@ def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
     _tiny(src, data_dir, "seq/0000_left.png", "seq/0000_right.png")
     _tiny(src, data_dir, "seq/0001_left.png", "seq/0001_right.png")
     Calibration.ideal((96, 64), 60.0, 0.1).save(tmp_path / "rig.yaml")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     args += ["--calib", str(tmp_path / "rig.yaml")]
     assert main(args) == 0
     cloud = out / "seq/0000/cloud.ply"
@@ -2219,7 +2189,7 @@ def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
 
 
 def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A version 1 summary lists no outputs: its entries take the files found in their folders
     as their list, so one whose disparity.pfm had gone listed the others alone, and a done pair
@@ -2228,7 +2198,7 @@ def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again
     looked for."""
     src, out = tmp_path / "in", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "a/right.png")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     pfm = out / "a" / "disparity.pfm"
     disparity = read_pfm(pfm)
@@ -2246,7 +2216,7 @@ def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again
 
 
 def test_a_changed_pair_is_redone_from_another_working_directory(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, sched: str
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The summary recorded a pair's images as given (``drive/a/left.png`` for ``batch drive``),
     and read them against the working directory of the next run: after a run over another
@@ -2255,7 +2225,7 @@ def test_a_changed_pair_is_redone_from_another_working_directory(
     exit 2. The summary records absolute paths now."""
     _tiny(tmp_path, data_dir, "drive/a/left.png", "drive/a/right.png")
     _tiny(tmp_path, data_dir, "other/b/left.png", "other/b/right.png")
-    args = ["-o", "out", "--scheduler", sched, "--max-disparity", "16"]
+    args = ["-o", "out", "--workers", "1", "--max-disparity", "16"]
     monkeypatch.chdir(tmp_path)
     assert main(["batch", "drive", *args]) == 0
     assert _summary(tmp_path / "out")["pairs"]["a"]["left"] == str(tmp_path / "drive/a/left.png")
@@ -2269,7 +2239,7 @@ def test_a_changed_pair_is_redone_from_another_working_directory(
 
 
 def test_the_summary_records_the_files_read_through_a_link_and_dotdot(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``batch home/link/../drive`` with ``link`` a link to ``real/sub``: the OS reads
     ``real/drive``, but the summary recorded ``home/drive`` (os.path.abspath folds '..' as
@@ -2282,7 +2252,7 @@ def test_the_summary_records_the_files_read_through_a_link_and_dotdot(
     (tmp_path / "home").mkdir()
     (tmp_path / "home/link").symlink_to(tmp_path / "real/sub", target_is_directory=True)
     given, out = tmp_path / "home/link/../drive", tmp_path / "out"
-    args = ["-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(given), *args]) == 0
     pair = _summary(out)["pairs"]["a"]
     assert pair["left"] == str(tmp_path / "real/drive/a/left.png")
@@ -2319,7 +2289,7 @@ def test_the_progress_lines_estimate_the_time_left_from_the_pairs_pace(
 
 
 def test_scene_folders_linked_into_the_input_are_batched(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A drive's scenes linked into the input folder (in/b -> /data/b, camera folders too) were
     not entered: their pairs were left out without a word ('1 processed ... 0 failed', exit 0).
@@ -2343,7 +2313,7 @@ def test_scene_folders_linked_into_the_input_are_batched(
     assert [j.name for j in find_pairs(root)] == ["a", "b", "seq/7", "seq2/9"]
     assert find_pairs(root)[1].left == root / "b/left.png"
     out = tmp_path / "out"
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     assert capsys.readouterr().out.startswith("4 processed, 0 skipped (done before), 0 failed")
     assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
@@ -2373,7 +2343,7 @@ def test_a_run_killed_while_writing_a_pair_leaves_no_temporary_folder_for_good(
 
 
 def test_an_image_that_cannot_be_read_fails_its_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A pair's image that is a broken link (a drive not mounted, a sync not finished) stopped
     the whole run before any pair, '[Errno 2] No such file or directory: ...', exit 2. That
@@ -2382,7 +2352,7 @@ def test_an_image_that_cannot_be_read_fails_its_pair_alone(
     src, out = tmp_path / "drive", tmp_path / "out"
     _tiny(src, data_dir, "a/left.png", "b/left.png", "b/right.png")
     (src / "a/right.png").symlink_to(tmp_path / "not-mounted/right.png")
-    args = ["batch", str(src), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(args) == 1
     said = capsys.readouterr()
@@ -2399,7 +2369,7 @@ def test_an_image_that_cannot_be_read_fails_its_pair_alone(
 
 
 def test_an_image_that_cannot_be_read_when_sent_is_tried_again(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, sched: str
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """An image whose size and time could be read but not its bytes (permission denied, an I/O
     error, a network share gone between the check and the read) failed its pair with its
@@ -2420,19 +2390,19 @@ def test_an_image_that_cannot_be_read_when_sent_is_tried_again(
         return real_read(self)
 
     monkeypatch.setattr(Path, "read_bytes", read_bytes)
-    first = batch.run_batch(src, out, scheduler=sched, max_disparity=16, progress=False)
+    first = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
     assert (first.processed, first.failed) == (["b"], ["a"])
     entry = _summary(out)["pairs"]["a"]
     assert entry["error"] == f"PermissionError: [Errno 13] Permission denied: '{denied}'"
     assert "fingerprint" not in entry and "options" not in entry
     monkeypatch.setattr(Path, "read_bytes", real_read)  # readable again, same size and time
-    again = batch.run_batch(src, out, scheduler=sched, max_disparity=16, progress=False)
+    again = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
     assert (again.processed, again.skipped, again.failed_before) == (["a"], ["b"], [])
     assert _summary(out)["pairs"]["a"]["status"] == "done"
 
 
 def test_a_calibration_that_cannot_be_read_for_its_hash_fails_its_pair_alone(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, sched: str
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A pair's calibration file read for its sha256 after its task was made (permission
     denied, an I/O error, a share gone between the two reads) raised out of the run: it
@@ -2456,13 +2426,13 @@ def test_a_calibration_that_cannot_be_read_for_its_hash_fails_its_pair_alone(
         return real_sha256(path)
 
     monkeypatch.setattr(batch, "_sha256", sha256)
-    first = batch.run_batch(src, out, scheduler=sched, max_disparity=16, progress=False)
+    first = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
     assert (first.processed, first.failed) == (["b"], ["a"])
     entry = _summary(out)["pairs"]["a"]
     assert entry["error"] == f"PermissionError: [Errno 13] Permission denied: '{denied}'"
     assert "fingerprint" not in entry and "options" not in entry
     monkeypatch.setattr(batch, "_sha256", real_sha256)
-    again = batch.run_batch(src, out, scheduler=sched, max_disparity=16, progress=False)
+    again = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
     assert (again.processed, again.skipped, again.failed_before) == (["a"], ["b"], [])
 
 
@@ -2499,7 +2469,7 @@ def test_calib_unit_reaches_the_workers(
 
 
 def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no image size: batch refused
     them ("this command cannot read it from its images, so save the rig once in Python ..."),
@@ -2512,7 +2482,7 @@ def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
             cv2.imwrite(str(root / f"{side}9{n}.png"), small)  # another size: pairs 901, 902
     (root / "right902.png").unlink()  # one small pair only
     (root / "left902.png").unlink()
-    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--scheduler", sched]
+    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--workers", "1"]
     args += ["--max-disparity", "16", "--calib-unit", "mm"]
     capsys.readouterr()
     assert main(args) == 1
@@ -2531,7 +2501,7 @@ def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
 
 
 def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A dataset copied without its modification times (cp -r) and run into the same -o was
     refused as 'made from other images' (size + time only), exit 2. The summary records each
@@ -2542,7 +2512,7 @@ def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
 
     src, copy, out = tmp_path / "drive", tmp_path / "copy", tmp_path / "out"
     _tiny(src, data_dir, *(f"seq/{i:04d}_{s}.bmp" for i in range(2) for s in ("left", "right")))
-    args = ["-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(src), *args]) == 0
     entry = _summary(out)["pairs"]["seq/0000"]
     left = src / "seq/0000_left.bmp"
@@ -2597,7 +2567,6 @@ def test_the_check_of_a_copy_without_its_times_shows_its_progress(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
-    sched: str,
 ) -> None:
     """Files copied without their times are read again (their sha256 against the summary's)
     before the pairs' bar starts, which took long on a large dataset with nothing shown. That
@@ -2608,7 +2577,7 @@ def test_the_check_of_a_copy_without_its_times_shows_its_progress(
 
     src, copy, out = tmp_path / "drive", tmp_path / "copy", tmp_path / "out"
     _tiny(src, data_dir, *(f"seq/{i:04d}_{s}.bmp" for i in range(3) for s in ("left", "right")))
-    args = ["-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(src), *args]) == 0
     shutil.copytree(src, copy, copy_function=shutil.copyfile)  # times not kept
     before = _tree(out)
@@ -2640,14 +2609,14 @@ def test_the_check_of_a_copy_without_its_times_shows_its_progress(
 
 
 def test_a_copy_without_its_times_of_a_calibration_is_up_to_date(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The --calib file copied without its time beside the images is checked against its
     recorded sha256 as they are: the same bytes, the pairs are up to date."""
     src, copy, out = tmp_path / "drive", tmp_path / "copy", tmp_path / "out"
     _tiny(src, data_dir, "seq/0000_left.bmp", "seq/0000_right.bmp")
     Calibration.ideal((96, 64), 60.0, 0.1).save(src / "rig.yaml")
-    args = ["-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(src), *args, "--calib", str(src / "rig.yaml")]) == 0
     assert "calib" in _summary(out)["pairs"]["seq/0000"]["hashes"]
     shutil.copytree(src, copy, copy_function=shutil.copyfile)  # times not kept
@@ -2699,7 +2668,7 @@ def test_one_cameras_ros_file_reaches_the_workers_with_its_partner(
 
 
 def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """--calib rig/ (OpenCV stereo_calib's two files): the folder's own size and time were the
     calibration's fingerprint, and a file rewritten in place in it (a baseline of 240 mm for
@@ -2707,7 +2676,7 @@ def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
     files read are fingerprinted; the same bytes with new times (a copy) are still up to date."""
     rig, root, out = _stereo_calib_input(tmp_path, data_dir, ("01",))  # T (-120, 1.5, 0.8) mm
     args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--calib-unit", "mm"]
-    args += ["--scheduler", sched, "--max-disparity", "16"]
+    args += ["--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
     z120 = np.load(out / "01" / "depth.npy")
     extrinsics = rig / "extrinsics.yml"
@@ -2729,7 +2698,7 @@ def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
 
 
 def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """OpenCV stereo_calib output is sized by the first pair by name: a pair of another size
     added later that sorts first (00 before 01) changed calib_size for every pair, so all were
@@ -2737,7 +2706,7 @@ def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
     output folder keeps the size its summary recorded for the same calibration: the new pair
     fails alone, the others are skipped as done."""
     rig, root, out = _stereo_calib_input(tmp_path, data_dir, ("01", "02"))
-    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--scheduler", sched]
+    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--workers", "1"]
     args += ["--max-disparity", "16", "--calib-unit", "mm"]
     assert main(args) == 0
     for side in ("left", "right"):
@@ -2756,7 +2725,7 @@ def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
 
 
 def test_the_image_sizing_a_calibration_is_fingerprinted_as_its_files_are(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """--calib rig/Q.dat is sized by the rig/left.png beside it (a Q matrix holds no image
     size), which was not fingerprinted: another image there (192x128 for 96x64) changed the
@@ -2767,7 +2736,7 @@ def test_the_image_sizing_a_calibration_is_fingerprinted_as_its_files_are(
     shutil.move(root / "rig", rig)
     q = rig / "Q.dat"
     q.write_text("1 0 0 -48\n0 1 0 -32\n0 0 0 100\n0 0 10 0\n")
-    args = ["batch", str(root), "-o", str(out), "--calib", str(q), "--scheduler", sched]
+    args = ["batch", str(root), "-o", str(out), "--calib", str(q), "--workers", "1"]
     args += ["--max-disparity", "16"]
     assert main(args) == 0
     z100 = np.load(out / "a" / "depth.npy")
@@ -2831,7 +2800,6 @@ def test_a_full_output_disk_names_the_pair_and_closes_the_record(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
-    sched: str,
 ) -> None:
     """The output disk full (a robot's SD card) while the third pair was written: the run
     stopped with "stereovision: error: [Errno 28] No space left on device", naming neither the
@@ -2853,7 +2821,7 @@ def test_a_full_output_disk_names_the_pair_and_closes_the_record(
         return commit(out_dir, name, files, *more)
 
     monkeypatch.setattr(batch, "_commit_pair", fill_the_disk)
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1] == (
@@ -2882,7 +2850,6 @@ def test_a_full_output_disk_that_the_summary_cannot_be_written_to_is_said(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
-    sched: str,
 ) -> None:
     """The disk full while the third pair was written, and summary.json (a long run's, written
     every few pairs) not writable either: the summary's own "[Errno 28] No space left on
@@ -2914,7 +2881,7 @@ def test_a_full_output_disk_that_the_summary_cannot_be_written_to_is_said(
     monkeypatch.setattr(batch, "_commit_pair", fill_the_disk)
     monkeypatch.setattr(batch._Summary, "save", save_unless_full)
     monkeypatch.setattr(batch, "SAVE_COST_RATIO", 1e12)  # a long run's: written now and then
-    args = ["batch", str(root), "-o", str(out), "--scheduler", sched, "--max-disparity", "16"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1] == (
@@ -3044,7 +3011,7 @@ def test_a_run_killed_without_calib_does_not_own_the_depth_names(
 
 
 def test_the_summary_of_a_cli_run_says_its_errors_in_the_clis_words(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """`stereovision batch` logged a pair's error in the CLI's words but recorded it in
     summary.json in Python's: "calib.scaled_to((225, 188))" for a resized pair, "give a
@@ -3060,7 +3027,7 @@ def test_the_summary_of_a_cli_run_says_its_errors_in_the_clis_words(
         cv2.imwrite(str(root / "half" / f"{side}.png"), cv2.resize(img, (225, 188)))
     shutil.copy(cones / "calib.txt", root / "half" / "calib.txt")
     _tiny(root, data_dir, "narrow/left.png", "narrow/right.png")  # 96 px wide
-    argv = ["batch", str(root), "-o", str(out), "--max-disparity", "200", "--scheduler", sched]
+    argv = ["batch", str(root), "-o", str(out), "--max-disparity", "200", "--workers", "1"]
     assert main(argv) == 1
     err = capsys.readouterr().err
     resized = (
@@ -3370,7 +3337,7 @@ def test_camera_folders_pair_a_side_of_one_image_at_the_other_sides_number(
     ],
 )
 def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str, says: str, sched: str
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str, says: str
 ) -> None:
     """``--scheduler`` was only read by Dask once a pair was to be done: a rerun with every pair
     done took any value and exited 0. It is refused before any work now, as Dask says it."""
@@ -3378,7 +3345,7 @@ def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
     _noise_pair(tmp_path / "in" / "scene")
     out = tmp_path / "out"
     argv = ["batch", str(tmp_path / "in"), "-o", str(out)]
-    assert main([*argv, "--scheduler", sched]) == 0
+    assert main([*argv, "--workers", "1"]) == 0
     summary = (out / "summary.json").read_bytes()
     capsys.readouterr()
     assert main([*argv, "--scheduler", address]) == 2
@@ -3390,7 +3357,7 @@ def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
 def test_a_fifo_named_as_an_image_fails_its_pair_and_does_not_hang(
-    data_dir: Path, tmp_path: Path, sched: str
+    data_dir: Path, tmp_path: Path
 ) -> None:
     root = tmp_path / "in"
     _crops(root, data_dir, ["left/0002.png"], ["right/0002.png"])
@@ -3405,8 +3372,8 @@ def test_a_fifo_named_as_an_image_fails_its_pair_and_does_not_hang(
             str(root),
             "-o",
             str(tmp_path / "out"),
-            "--scheduler",
-            sched,
+            "--workers",
+            "1",
         ],
         capture_output=True,
         text=True,
@@ -3425,7 +3392,7 @@ def test_a_fifo_named_as_an_image_fails_its_pair_and_does_not_hang(
 
 
 def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
-    data_dir: Path, tmp_path: Path, sched: str
+    data_dir: Path, tmp_path: Path
 ) -> None:
     root = tmp_path / "in"
     _crops(root, data_dir, ["left/0001.png"], ["right/0001.png"])
@@ -3435,7 +3402,7 @@ def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
     lines: list[str] = []
     from stereovision.batch import run_batch
 
-    run_batch(root, tmp_path / "out", scheduler=sched, progress=False, log=lines.append)
+    run_batch(root, tmp_path / "out", workers=1, progress=False, log=lines.append)
     failed = [line for line in lines if line.startswith("failed")]
     assert len(failed) == 1 and "\n" not in failed[0]
     assert failed[0].startswith("failed s\\nx/a: ")
@@ -3443,7 +3410,7 @@ def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
 
 
 def test_a_pair_output_folder_with_a_newline_is_shown_escaped_when_it_fails(
-    data_dir: Path, tmp_path: Path, sched: str
+    data_dir: Path, tmp_path: Path
 ) -> None:
     """The pair's output folder (OUT/<name>/, its name from the images') was not among the
     paths its error line escapes (its images' and calib's alone, whose part is ``a\\nb.png``):
@@ -3456,7 +3423,7 @@ def test_a_pair_output_folder_with_a_newline_is_shown_escaped_when_it_fails(
     lines: list[str] = []
     from stereovision.batch import run_batch
 
-    run_batch(root, out, scheduler=sched, progress=False, log=lines.append)
+    run_batch(root, out, workers=1, progress=False, log=lines.append)
     failed = [line for line in lines if line.startswith("failed")]
     assert len(failed) == 1 and "\n" not in failed[0], failed
     assert failed[0].startswith("failed a\\nb: NotADirectoryError: "), failed[0]
@@ -3497,7 +3464,7 @@ def test_a_scheduler_address_dask_reads_no_port_of_is_left_to_dask(
 
 
 def test_a_jpg_scene_with_a_kitti_calib_without_its_size_is_sized_by_its_left_jpg(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], sched: str
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A scene of left.jpg + right.jpg with a KITTI calib.txt lacking S_rect_02 failed its pair
     with "... pass image_size=(width, height)", Python advice a batch user cannot act on: the
@@ -3512,7 +3479,7 @@ def test_a_jpg_scene_with_a_kitti_calib_without_its_size_is_sized_by_its_left_jp
         "P2: 100 0 24 0 0 100 16 0 0 0 1 0\nP3: 100 0 24 -50 0 100 16 0 0 0 1 0\n"
     )
     out = tmp_path / "out"
-    assert main(["batch", str(tmp_path / "in"), "-o", str(out), "--scheduler", sched]) == 0
+    assert main(["batch", str(tmp_path / "in"), "-o", str(out), "--workers", "1"]) == 0
     assert capsys.readouterr().out.startswith("1 processed, 0 skipped (done before), 0 failed")
     assert _summary(out)["pairs"]["s"]["status"] == "done"
     assert Calibration.from_file(scene / "calib.txt").image_size == (48, 32)
