@@ -1371,6 +1371,18 @@ def _from_zero(
     )
 
 
+def _refuse_range_types(max_disparity: object, min_disparity: object) -> None:
+    """A disparity range that is not one real number (a string, a bool, an array, None for
+    ``min_disparity``; None for ``max_disparity`` is "estimated") refused as a TypeError, in the
+    words :func:`depth_map` and :func:`~stereovision.match` share."""
+    for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        if value is None and name == "max_disparity":
+            continue  # estimated from the images
+        # real_number: a timedelta (an np.integer) passed here, refused later in other words
+        if not real_number(value):
+            raise TypeError(f"{name}: expected a number of pixels, got {_shown(value)}")
+
+
 def depth_map(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
@@ -1549,12 +1561,7 @@ def depth_map(
         raise TypeError(
             f"progress: expected a callable taking a stage name, or None, got {_shown(progress)}"
         )
-    for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        if value is None and name == "max_disparity":
-            continue  # estimated from the images below
-        # real_number: a timedelta (an np.integer) passed here, refused later in other words
-        if not real_number(value):
-            raise TypeError(f"{name}: expected a number of pixels, got {_shown(value)}")
+    _refuse_range_types(max_disparity, min_disparity)
     # NaN, inf or an int beyond 64 bits refused in its own words (finite_number, as below for
     # max_disparity), before the images' work as the refusal after it
     finite_number(min_disparity, "min_disparity")

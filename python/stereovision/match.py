@@ -24,6 +24,7 @@ from stereovision.depth import (
     _from_zero,
     _range_too_wide,
     _rectify_grey,
+    _refuse_range_types,
     _rig_to_warp_by,
     _too_narrow,
     estimate_max_disparity,
@@ -122,12 +123,7 @@ def match(
         raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
     # the range's type first, in depth_map's words: a 0-d array, True or None passed "gabor"'s
     # check (or failed in another class) and was refused by the others as not "non-negative"
-    for name, value in (
-        ("max_disparity", max_disparity),
-        ("min_disparity", params.get("min_disparity", 0)),
-    ):
-        if not (value is None and name == "max_disparity") and not real_number(value):
-            raise TypeError(f"{name}: expected a number of pixels, got {_shown(value)}")
+    _refuse_range_types(max_disparity, params.get("min_disparity", 0))
     gl, gr = check_pair(left, right)
     # a negative min_disparity the method cannot search: said as depth_map says it (the
     # matchers' own words named neither the method nor the one that takes it), before the
