@@ -4,6 +4,7 @@ seeded sensor noise, still, drifting, or with something moving through the view.
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import cv2
@@ -96,6 +97,24 @@ def test_a_negative_int_level_is_not_told_to_be_uint16() -> None:
     )
     with pytest.raises(ValueError, match=r"got 0-300 \(a 16-bit image: pass it as uint16\)$"):
         noise_sigma(np.linspace(0, 300, 16, dtype=np.int32)[None].repeat(4, axis=0))
+
+
+@pytest.mark.parametrize("channels", [0, 3])
+def test_a_float64_level_past_float32s_range_is_clipped_without_a_warning(
+    channels: int,
+) -> None:
+    """A float64 level of 1e40 (past float32's range) in a frame raised NumPy's "overflow
+    encountered in cast" RuntimeWarning from the grey copy; it is a clipped level, measured as
+    inf (and any level over 255) is: left out with its neighbours, without a warning."""
+    img = np.random.default_rng(0).uniform(50, 200, (24, 24))
+    if channels:
+        img = np.repeat(img[..., None], channels, axis=2)
+    huge, inf = img.copy(), img.copy()
+    huge[5, 5], inf[5, 5] = 1e40, np.inf
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sigma = noise_sigma(huge)
+    assert sigma == noise_sigma(inf) > 10  # uniform 50-200: about 35 grey levels
 
 
 def test_a_black_border_is_no_noiseless_image(data_dir: Path) -> None:

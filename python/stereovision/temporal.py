@@ -117,16 +117,20 @@ def _brightness_change(
 
 
 def _grey(img: np.ndarray) -> npt.NDArray[np.float32]:
-    if img.ndim == 3 and img.shape[2] == 1:
-        img = img[..., 0]
-    elif img.ndim == 3:
-        if img.dtype not in (np.uint8, np.uint16, np.float32):
-            # cvtColor takes only these: a float64, float16 or int colour image (a list's
-            # int64) raised OpenCV's own cv2.error
-            img = img.astype(np.float32)
-        code = cv2.COLOR_BGRA2GRAY if img.shape[2] == 4 else cv2.COLOR_BGR2GRAY
-        img = cv2.cvtColor(img, code)
-    return np.asarray(img, dtype=np.float32)
+    # A float64 level past float32's range becomes inf, which reads as clipped (left out) as
+    # any level over 255 does; the cast's overflow RuntimeWarning (1e40 in a frame) said
+    # nothing the result does not.
+    with np.errstate(over="ignore"):
+        if img.ndim == 3 and img.shape[2] == 1:
+            img = img[..., 0]
+        elif img.ndim == 3:
+            if img.dtype not in (np.uint8, np.uint16, np.float32):
+                # cvtColor takes only these: a float64, float16 or int colour image (a list's
+                # int64) raised OpenCV's own cv2.error
+                img = img.astype(np.float32)
+            code = cv2.COLOR_BGRA2GRAY if img.shape[2] == 4 else cv2.COLOR_BGR2GRAY
+            img = cv2.cvtColor(img, code)
+        return np.asarray(img, dtype=np.float32)
 
 
 def noise_sigma(image: npt.ArrayLike) -> float:
