@@ -1478,6 +1478,31 @@ def test_temporal_capture_saves_the_mean_of_still_frames(data_dir: Path, tmp_pat
     assert moving.saved == [] and moving.frames_read == 12 and moving.ended == "end of stream"
 
 
+def test_a_temporal_mean_the_source_ends_is_said_unsaved(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--temporal 3`` over 5 still frames saved the mean of the first 3 and dropped the last
+    2 frames' mean without a word ("1 pair saved (end of stream); 5 pairs read"); a line says
+    it now. 6 frames (two whole means) leave nothing unsaved, and no such line."""
+    from stereovision.cli import main
+
+    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "five_frames", 5)
+    lines: list[str] = []
+    with StereoCamera(lpat, rpat) as cam:
+        result = capture(cam, tmp_path / "five", temporal=3, log=lines.append)
+    assert len(result.saved) == 1 and result.ended == "end of stream", lines
+    assert lines[1:] == [
+        "not saved: the last mean, of 2.0 frames of the 3 asked, was unfinished when the "
+        "source ended"
+    ]
+    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "six_frames", 6)
+    capsys.readouterr()
+    assert main(["capture", "--left", lpat, "--right", rpat, "-o", str(tmp_path / "six"),
+                 "--temporal", "3"]) == 0  # fmt: skip
+    out = capsys.readouterr().out
+    assert out.count("mean of 3.0 frames") == 2 and "not saved" not in out, out
+
+
 def test_temporal_averaging_of_16_bit_frames_is_refused_naming_the_source(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1523,7 +1548,12 @@ def test_temporal_chessboard_capture_waits_for_a_still_board(tmp_path: Path) -> 
     with StereoCamera(*seqs) as cam:
         result = capture(cam, tmp_path / "cb", chessboard="9x6", temporal=2, log=lines.append)
     assert result.frames_read == len(SEQUENCE) and len(result.saved) == 3, lines
-    assert all("mean of 2.0 frames" in ln for ln in lines), lines
+    # the last A, one frame after the board left, is an unfinished mean the end leaves unsaved
+    assert lines[-1] == (
+        "not saved: the last mean, of 1.0 frames of the 2 asked, was unfinished when the "
+        "source ended"
+    )
+    assert all("mean of 2.0 frames" in ln for ln in lines[:-1]), lines
     # Each saved pair is a pose seen by both cameras: the board is found in both images.
     for lp, rp in result.saved:
         assert detect_board_live(cv2.imread(str(lp)), (9, 6)) is not None

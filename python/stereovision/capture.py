@@ -3010,7 +3010,8 @@ def capture(
     ext : str
         Image format of the saved files.
     log : callable, optional
-        Receives one line per saved pair (with coverage in chessboard mode).
+        Receives one line per saved pair (with coverage in chessboard mode) and, with
+        ``temporal``, one for a mean the source's end left unfinished (not saved).
     temporal : int, optional
         Save each pair as the mean of ``temporal`` (2-255) frames of a still view
         (:class:`~stereovision.temporal.TemporalFilter`: a moving rig or board starts the mean
@@ -3100,6 +3101,9 @@ def capture(
     # count and skews are its own
     read_before = getattr(camera, "count", 0)
     skews = SkewStats()
+    # temporal: how many frames the mean being built holds while it is short of a pair's
+    # (None once a pair is taken from it, or without temporal)
+    unfinished: float | None = None
 
     def kept_note() -> str:
         if count is not None:
@@ -3118,6 +3122,12 @@ def capture(
             # "end of stream", exit 0, as a video's end, where stream fails
             if count is None and exc.end and camera.count > 0 and not _device_ended(camera, exc):
                 ended = _end_reason(exc, saved, last_index)
+                if unfinished is not None and log is not None:
+                    # the frames read since the last pair were dropped without a word
+                    log(
+                        f"not saved: the last mean, of {unfinished:.1f} frames of the "
+                        f"{temporal} asked, was unfinished when the source ended"
+                    )
                 break
             raise exc.with_message(f"{exc}; {kept_note()}") from exc
         except ValueError as exc:
@@ -3139,7 +3149,9 @@ def capture(
             # Every pixel's mean full but a few that something crossed (or noise beyond 3
             # sigmas started again).
             if averaged < _TEMPORAL_FULL * tf.max_frames:
+                unfinished = averaged
                 continue
+            unfinished = None
             frame = dataclasses.replace(frame, left=left, right=right)
         if collector is not None:
             decision = collector.consider(frame)
