@@ -1078,32 +1078,80 @@ def test_an_image_the_format_cannot_hold_is_refused_not_saved_as_8_bits(tmp_path
     a 16-bit one as .jpg clipped to white, without a word: refused now, nothing written; a
     format that holds the type keeps it."""
     img = _numbered(1)
-    for bad, ext in (
-        (img.astype(np.float32) / 255, ".png"),
-        (img.astype(np.uint16) * 257, ".jpg"),
-        (img > 100, ".png"),
-    ):
+    for bad, ext, advice in (
+        (img.astype(np.float32) / 255, ".png", "convert it to uint8 first (a float image in "
+         "[0, 1]: times 255)"),
+        (img.astype(np.uint16) * 257, ".jpg", ".png and .tiff hold uint16"),
+        (img > 100, ".png", "convert it to uint8 first (True as 255)"),
+    ):  # fmt: skip
         with pytest.raises(ValueError) as ei:
             save_pair(tmp_path, 1, img, bad, ext=ext)
         assert str(ei.value) == (
             f"cannot save the right image ({bad.dtype}) as {ext} without loss: that format "
-            "would write it as 8 bits; convert it to uint8 first (a float image in [0, 1]: "
-            "times 255)"
+            f"would write it as 8 bits; {advice}"
         )
     # .hdr writes float32 whatever it is given: a 16-bit image was said "written as 8 bits",
     # and uint8 advised, which .hdr writes as float32 too
-    for bad in (img.astype(np.uint16) * 257, img.astype(np.float64) / 255):
+    for bad, holders in (
+        (img.astype(np.uint16) * 257, ".png and .tiff hold"),
+        (img.astype(np.float64) / 255, ".tiff holds"),
+    ):
         with pytest.raises(ValueError) as ei:
             save_pair(tmp_path, 1, img, bad, ext=".hdr")
         assert str(ei.value) == (
             f"cannot save the right image ({bad.dtype}) as .hdr without loss: that format "
-            f"would write it as float32; .tiff holds {bad.dtype}"
+            f"would write it as float32; {holders} {bad.dtype}"
         )
     assert list(tmp_path.iterdir()) == []
     deep = img.astype(np.uint16) * 257
     for kept, ext in ((deep, ".png"), (img.astype(np.float32) / 255, ".tiff"), (img, ".jpg")):
         lp, _ = save_pair(tmp_path, next_pair_index(tmp_path), kept, kept, ext=ext)
         assert cv2.imread(str(lp), cv2.IMREAD_UNCHANGED).dtype == kept.dtype
+
+
+@pytest.mark.parametrize("ext", [".png", ".jpg", ".tiff", ".hdr", ".pfm"])
+def test_save_pairs_advice_names_a_format_that_holds_the_type(tmp_path: Path, ext: str) -> None:
+    """save_pair's advice for each type a format refuses: a float16 or bool image as .hdr was
+    told ".tiff holds float16" (".tiff holds bool"), which .tiff writes as 8 bits; a uint16 one
+    as .jpg, int16 as .png, to convert it to uint8 "(a float image in [0, 1]: times 255)",
+    though .png (.tiff) holds it. Every format it names holds the type, and every conversion
+    it advises saves in the format asked (or the one named)."""
+    img = _numbered(1)[:8, :8]
+    said = {}
+    for dtype in (np.int8, np.uint16, np.int16, np.int32, np.int64, np.float16, np.float32,
+                  np.float64, np.bool_):  # fmt: skip
+        bad = img.astype(dtype)
+        try:
+            lp, _ = save_pair(tmp_path / np.dtype(dtype).name, 0, bad, bad, ext=ext)
+        except ValueError as exc:
+            said[np.dtype(dtype).name] = advice = str(exc).split("; ", 1)[1]
+        else:  # kept (.tiff), or float32 as .hdr / .pfm write every image
+            assert cv2.imread(str(lp), cv2.IMREAD_UNCHANGED).dtype in (dtype, np.float32)
+            continue
+        held = re.fullmatch(r"(\.\w+)(?: and (\.\w+))? holds? (\w+)", advice)
+        if held:
+            for fmt in filter(None, held.groups()[:2]):
+                out = tmp_path / fmt
+                lp, _ = save_pair(out, next_pair_index(out), bad, bad, ext=fmt)
+                assert cv2.imread(str(lp), cv2.IMREAD_UNCHANGED).dtype == dtype, (fmt, dtype)
+            continue
+        to = re.match(r"convert it to (\w+)", advice)
+        assert to, advice
+        fmt = ".tiff" if ".tiff holds" in advice else ext
+        good = bad.astype(to[1])
+        save_pair(tmp_path / "conv", next_pair_index(tmp_path / "conv"), good, good, ext=fmt)
+    if ext in (".hdr", ".pfm"):
+        assert said["float16"] == "convert it to float32 first (no loss)"
+        assert said["bool"] == "convert it to uint8 first (True as 255)"
+    if ext == ".jpg":
+        assert said["uint16"] == ".png and .tiff hold uint16"
+        assert said["int16"] == ".tiff holds int16"
+    if ext == ".tiff":
+        assert said == {
+            "int64": "convert it to int32 or float64 first",
+            "float16": "convert it to float32 first (.tiff holds float32)",
+            "bool": "convert it to uint8 first (True as 255)",
+        }
 
 
 @pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "link"])

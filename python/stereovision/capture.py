@@ -2613,6 +2613,38 @@ def next_pair_index(directory: PathLike) -> int:
     return max(found, default=0) + 1
 
 
+#: The types a lossless format holds (OpenCV's writers: .tiff cut int64 to int32, and wrote
+#: float16 and bool as 8 bits, as .png writes every type but these two).
+_HELD_BY = {
+    ".png": ("uint8", "uint16"),
+    ".tiff": tuple("uint8 int8 uint16 int16 int32 uint32 uint64 float32 float64".split()),
+}
+
+
+def _lossless_advice(dtype: np.dtype, ext: str, writes: str) -> str:
+    """What to do with a ``dtype`` image that ``ext`` would write as ``writes`` (``"8 bits"``,
+    ``"float32"`` or another type's name): :func:`save_pair`'s advice, naming only a format
+    that holds the type. It said ".tiff holds float16" (and bool) of .hdr, though .tiff writes
+    both as 8 bits, and advised uint8 "(a float image in [0, 1]: times 255)" for a 16-bit
+    image .png holds."""
+    ext = ".tiff" if ext.lower() == ".tif" else ext.lower()
+    if dtype.kind == "b":
+        return "convert it to uint8 first (True as 255)"
+    holders = [e for e, held in _HELD_BY.items() if dtype.name in held and e != ext]
+    if dtype.kind == "f":
+        if writes == "float32":  # .hdr, .pfm: float32 as it is
+            return f".tiff holds {dtype}" if holders else "convert it to float32 first (no loss)"
+        if ext == ".tiff":  # float16
+            return "convert it to float32 first (.tiff holds float32)"
+        return "convert it to uint8 first (a float image in [0, 1]: times 255)"
+    if holders:
+        return f"{' and '.join(holders)} hold{'s' if len(holders) == 1 else ''} {dtype}"
+    # int64 (a list's ints): no format here holds it; .tiff cuts it to int32
+    if writes == "float32":
+        return "convert it to uint8 or float32 first"
+    return "convert it to int32 or float64 first" if ext == ".tiff" else "convert it to uint8 first"
+
+
 def save_pair(
     directory: PathLike,
     index: int,
@@ -2680,19 +2712,14 @@ def save_pair(
             # a format without the image's depth is written as 8 bits: a float image in
             # [0, 1] was saved black (0 and 1), a 16-bit one in .jpg white, without a word
             back = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
-            if back is not None and back.dtype == np.float32 and arr.dtype != np.float32:
-                # .hdr writes float32 (RGBE, 1 % steps) whatever it is given: a 16-bit image
-                # was said to be "written as 8 bits", and uint8 advised, which .hdr turns
-                # into float32 too
-                raise ValueError(
-                    f"cannot save the {side} image ({arr.dtype}) as {ext} without loss: that "
-                    f"format would write it as float32; .tiff holds {arr.dtype}"
-                )
+            # .hdr writes float32 (RGBE, 1 % steps) whatever it is given: a 16-bit image
+            # was said to be "written as 8 bits", and uint8 advised, which .hdr turns
+            # into float32 too
+            writes = "8 bits" if back is None or back.dtype == np.uint8 else back.dtype.name
             if back is None or back.dtype != arr.dtype:
                 raise ValueError(
                     f"cannot save the {side} image ({arr.dtype}) as {ext} without loss: that "
-                    "format would write it as 8 bits; convert it to uint8 first (a float image "
-                    "in [0, 1]: times 255)"
+                    f"format would write it as {writes}; {_lossless_advice(arr.dtype, ext, writes)}"
                 )
         data.append(buf.tobytes())
     paths = tuple(d / PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right"))
