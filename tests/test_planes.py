@@ -326,6 +326,32 @@ def test_an_image_the_uint8_cast_would_garble_is_refused(fill: str, image: np.nd
         calls[fill](image)
 
 
+@pytest.mark.parametrize("fill", ["fill_planes", "side_fill", "segments"])
+@pytest.mark.parametrize("holes", [True, False])
+def test_a_bool_image_is_refused_as_the_matchers_refuse_it(fill: str, holes: bool) -> None:
+    """A bool image (a mask passed as the left image) was read as levels 0 and 1, one bin of
+    every step: fill_planes filled every hole from the plane of the whole image without a
+    word (side_fill too), and segments said "expected a real (H, W) or (H, W, C) array, got
+    (8, 8)", its shape; each names the dtype now, as depth_map refuses a bool image, with or
+    without holes in the map."""
+    d = np.ones((8, 8), np.float32)
+    if holes:
+        d[2, 2:5] = np.nan
+    mask = np.zeros((8, 8), bool)
+    mask[:, 4:] = True
+    calls = {
+        "fill_planes": lambda im: fill_planes(d, im),
+        "side_fill": lambda im: side_fill(d, im),
+        "segments": lambda im: segments(im, blur=1.0 if holes else 0.0),
+    }
+    assert np.asarray(calls[fill](mask.astype(np.uint8) * 255)).shape == (8, 8)
+    with pytest.raises(ValueError) as exc:
+        calls[fill](mask)
+    assert str(exc.value) == (
+        "image: expected real 0-255 values, got dtype bool (a mask? pass it as uint8, True as 255)"
+    )
+
+
 def test_fill_planes_names_a_disparity_map_that_is_not_2d() -> None:
     """A 1-D map (and image) reached the binding: "TypeError: dimensionality mismatch"; an
     (H, W, 1) map was reported as an image of the wrong size."""

@@ -103,10 +103,10 @@ def segments(
     Raises
     ------
     ValueError
-        A non-2-D/3-D image or one past the kernels' 32-bit pixel indices (checked on its
-        shape, before the blur), a ``step`` below 1 or not finite, a non-finite ``offset``, a
-        ``blur`` outside [0, 64] px, a ``min_size`` outside 0 to 2**31 - 1, a ``k`` that is no
-        number (or a bool) or a negative ``k``.
+        A non-2-D/3-D image, one not of real numbers (or bool), or one past the kernels' 32-bit
+        pixel indices (checked on its shape, before the blur), a ``step`` below 1 or not finite, a
+        non-finite ``offset``, a ``blur`` outside [0, 64] px, a ``min_size`` outside 0 to 2**31 - 1,
+        a ``k`` that is no number (or a bool) or a negative ``k``.
 
     Warns
     -----
@@ -119,8 +119,9 @@ def segments(
 
     step, offset, blur = _number_of(step), _number_of(offset), _number_of(blur)
     im = np.asarray(image)
-    if im.ndim not in (2, 3) or im.size == 0 or im.dtype.kind not in "iuf":
+    if im.ndim not in (2, 3) or im.size == 0:
         raise ValueError(f"image: expected a real (H, W) or (H, W, C) array, got {im.shape}")
+    _refuse_non_levels(im)  # its shape was said of a bool or complex image ("got (32, 32)")
     check_index_range(im.shape, "image")  # before the blur's copy (OpenCV wrapped a 5e9 row)
     # A NaN step or offset passed this test and made every key NaN: "image: contains NaN".
     if not finite_number(step, "step") >= 1 or finite_number(blur, "blur") < 0:
@@ -205,8 +206,7 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     _check_blur(blur)
     # The cast below turned NaN into 0 and complex values into their real part, with only a
     # NumPy warning: the segments were cut in garbage.
-    if im.dtype.kind not in "biuf":
-        raise ValueError(f"image: expected real 0-255 values, got dtype {im.dtype}")
+    _refuse_non_levels(im)
     if im.dtype.kind == "f" and not np.isfinite(im).all():
         raise ValueError("image: contains NaN or inf")
     if im.dtype != np.uint8:
@@ -215,6 +215,16 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     if blur <= 0:
         return u8
     return np.asarray(cv2.GaussianBlur(u8, (0, 0), float(blur)), np.uint8)
+
+
+def _refuse_non_levels(im: npt.NDArray[Any]) -> None:
+    """A ``ValueError`` naming the dtype unless ``im`` holds real numbers, not booleans: a
+    bool image (a mask) was read as levels 0 and 1, one bin of every step, and fill_planes
+    filled every hole from the plane of the whole image without a word; the matchers refuse
+    it too (stereovision._validate)."""
+    if im.dtype.kind not in "iuf":
+        hint = " (a mask? pass it as uint8, True as 255)" if im.dtype.kind == "b" else ""
+        raise ValueError(f"image: expected real 0-255 values, got dtype {im.dtype}{hint}")
 
 
 def _warn_if_not_0_255(im: npt.NDArray[Any], cast: bool = True) -> None:
@@ -357,9 +367,9 @@ def fill_planes(
     ------
     ValueError
         ``disparity`` not 2-D or not real, an image not 2-D or 3-D, of another size, with more than
-        3 channels, not real or with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count in
-        0 to 2**31 - 1, a ``blur`` outside [0, 64] px or a negative or non-finite ``max_residual``
-        (checked also when ``disparity`` has no hole).
+        3 channels, not real (or bool) or with NaN/inf, ``passes`` not pairs of a step in 1-255 and
+        a count in 0 to 2**31 - 1, a ``blur`` outside [0, 64] px or a negative or non-finite
+        ``max_residual`` (checked also when ``disparity`` has no hole).
 
     Warns
     -----
@@ -396,6 +406,7 @@ def fill_planes(
     residual = float(finite_number(max_residual, "max_residual"))
     if residual < 0:
         raise ValueError(f"max_residual: expected a non-negative number, got {max_residual}")
+    _refuse_non_levels(im)
     if np.isfinite(d).all():
         return d.copy()
     # Blurred once for every pass and binning (uint8: other types clipped to 0-255).
@@ -454,8 +465,8 @@ def side_fill(
     ------
     ValueError
         ``disparity`` not 2-D or not real, an image of another size, with a channel count other than
-        1 or 3, not real or with NaN/inf, a negative or non-finite ``tau`` or a ``blur`` outside
-        [0, 64] px (the parameters checked also when ``disparity`` has no hole).
+        1 or 3, not real (or bool) or with NaN/inf, a negative or non-finite ``tau`` or a ``blur``
+        outside [0, 64] px (the parameters checked also when ``disparity`` has no hole).
 
     Warns
     -----
@@ -484,6 +495,7 @@ def side_fill(
     _check_blur(blur)
     if not finite_number(tau, "tau") >= 0:
         raise ValueError(f"tau: expected a non-negative number, got {tau}")
+    _refuse_non_levels(im)
     if np.isfinite(d).all():
         return d.copy()
     u8 = _blurred(im, blur)
