@@ -1504,6 +1504,29 @@ def _still_noisy_sequence(
     return left, right
 
 
+def test_a_second_capture_on_an_ended_source_is_a_source_error(tmp_path: Path) -> None:
+    """A capture on an image sequence another capture had read to its end read nothing and
+    returned "0 pairs saved (end of stream)" (the CLI's exit 0), where an end before a first
+    pair is a SourceError: the earlier capture's pairs counted as this one's. It says the
+    source ended before this capture read a pair, and to open it again."""
+    frames = [_numbered(i) for i in range(3)]
+    left = _write_sequence(tmp_path / "seq", "left", frames)
+    right = _write_sequence(tmp_path / "seq", "right", frames)
+    with StereoCamera(left, right) as cam:
+        first = capture(cam, tmp_path / "a")
+        assert len(first.saved) == 3 and first.ended == "end of stream"
+        for count, kept in ((None, "0 pairs were"), (2, "0 of 2 pairs were")):
+            with pytest.raises(SourceError) as err:
+                capture(cam, tmp_path / "b", count=count)
+            assert str(err.value) == (
+                "both sources ended after 3 frames, before this capture read a pair (an earlier "
+                f"read of this camera took its frames: open it again); {kept} saved in "
+                f"{tmp_path / 'b'} and are kept"
+            )
+    with StereoCamera(left, right) as cam:  # opened again: its frames again
+        assert len(capture(cam, tmp_path / "c").saved) == 3
+
+
 def test_temporal_capture_saves_the_mean_of_still_frames(data_dir: Path, tmp_path: Path) -> None:
     """``temporal=4``: a pair per 4 frames of a still view, each with less noise than one frame
     (Immerkaer's estimate, which the texture raises too: measured 5.74 -> 3.21-3.27 grey

@@ -3147,7 +3147,9 @@ def capture(
             # partner said "0 pairs saved (end of stream)" and exited 0)
             # a camera device has no end: one that stops delivering (unplugged) was said as
             # "end of stream", exit 0, as a video's end, where stream fails
-            if count is None and exc.end and camera.count > 0 and not _device_ended(camera, exc):
+            # this capture's reads (`read`), not the camera's: a second capture on an ended
+            # file read nothing and said "0 pairs saved (end of stream)", exit 0
+            if count is None and exc.end and read > 0 and not _device_ended(camera, exc):
                 ended = _end_reason(exc, saved, last_index)
                 if unfinished is not None and log is not None:
                     # the frames read since the last pair were dropped without a word
@@ -3156,6 +3158,11 @@ def capture(
                         f"{temporal} asked, was unfinished when the source ended"
                     )
                 break
+            if exc.end and read == 0 and read_before > 0:
+                raise exc.with_message(
+                    f"{exc}, before this capture read a pair (an earlier read of this camera "
+                    f"took its frames: open it again); {kept_note()}"
+                ) from exc
             raise exc.with_message(f"{exc}; {kept_note()}") from exc
         except ValueError as exc:
             # a recording's frame that does not decode (BagCamera names its topic and stamp):
