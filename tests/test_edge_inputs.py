@@ -58,6 +58,37 @@ def test_matches_of_tiny_images_are_none(shape: tuple[int, int], method: str) ->
     assert len(sv.match(left, left, method=method, max_disparity=4)) == 0
 
 
+@pytest.mark.parametrize("matcher", ["gabor", "sgm", "hopfield", "mcgm"])
+def test_the_matchers_search_a_range_past_the_image_to_its_edge(matcher: str) -> None:
+    """What stereovision.matching's docstring says: the functions there search a range past
+    the image to its edge (max_disparity 200 on LEFT, 60 px wide: the result of 60), where
+    match refuses it; a range wholly past the image is refused by both, in the same words."""
+    from stereovision.matching import hopfield, mcgm, sgm
+
+    run = {
+        "gabor": lambda md, lo=0: (
+            gabor.gabor_disparity(LEFT, RIGHT, max_disparity=md, min_disparity=lo).disparity
+        ),
+        "sgm": lambda md, lo=0: sgm.sgm_disparity(LEFT, RIGHT, max_disparity=md, min_disparity=lo),
+        "hopfield": lambda md, lo=0: (
+            hopfield.hopfield_match(LEFT, RIGHT, max_disparity=md, min_disparity=lo).dispx
+        ),
+        "mcgm": lambda md, lo=0: (
+            mcgm.mcgm_match(LEFT, RIGHT, max_disparity=md, min_disparity=lo).dispx
+        ),
+    }[matcher]
+    np.testing.assert_array_equal(run(200), run(60))
+    with pytest.raises(
+        ValueError, match="disparity range 200 is not smaller than the image width 60"
+    ):
+        sv.match(LEFT, RIGHT, method="gabor", max_disparity=200)
+    words = r"^min_disparity \(70\) is not below the image width 60"
+    with pytest.raises(ValueError, match=words):
+        run(200, 70)
+    with pytest.raises(ValueError, match=words):
+        sv.match(LEFT, RIGHT, method="gabor", max_disparity=200, min_disparity=70)
+
+
 @pytest.mark.parametrize(
     ("shape", "max_disparity"),
     [((40, 1), 4), ((1, 1), 4), ((3, 3), 4), ((24, 30), 30), ((24, 30), 40), ((24, 30), 1e300)],

@@ -541,7 +541,9 @@ def fuse_pair(
         Rectified pair, ``(H, W)`` grey float32 in ``[0, 1]`` (or anything
         :func:`stereovision._validate.as_gray_float` takes), same shape.
     max_disparity, min_disparity : float
-        Disparity range every channel searches (px).
+        Disparity range every channel searches (px). A range past the image's width is searched to
+        the image's edge, without the error :func:`stereovision.match` raises (see
+        :mod:`stereovision.matching`).
     channels : tuple of str
         Which channels take part: ``"gabor"`` and at least one of ``"mcgm"``, ``"hopfield"``.
         MCGM runs with :data:`MEMBER_MCGM`.

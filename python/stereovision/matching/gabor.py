@@ -127,7 +127,9 @@ def gabor_disparity(
     left, right : array_like
         Rectified grey images, ``(H, W)`` float32 in ``[0, 1]``, same shape.
     max_disparity : float
-        Largest disparity searched, in pixels (> ``min_disparity``).
+        Largest disparity searched, in pixels (> ``min_disparity``). A range past the image's width
+        is searched to the image's edge, without the error :func:`stereovision.match` raises (see
+        :mod:`stereovision.matching`).
     min_disparity : float, optional
         Smallest disparity searched, in pixels (default 0).
     **params

@@ -260,7 +260,9 @@ def hopfield_match(
         ``[0, 1]``, same shape.
     max_disparity : float
         Largest disparity searched (px). The network searches whole pixels: a fractional value
-        searches up to its ceiling (:func:`stereovision.match` then drops the matches above it).
+        searches up to its ceiling (:func:`stereovision.match` then drops the matches above it). A
+        range past the image's width is searched to the image's edge, without the error
+        :func:`stereovision.match` raises (see :mod:`stereovision.matching`).
     min_disparity : float, optional
         Smallest disparity searched (px, default 0; a fractional value: from its floor).
     **params

@@ -339,7 +339,9 @@ def mcgm_match(
         Rectified pair, ``(H, W)`` grey or ``(H, W, 3)`` BGR, uint8, uint16 or float in
         ``[0, 1]``, same shape.
     max_disparity : float
-        Largest disparity searched (px).
+        Largest disparity searched (px). A range past the image's width is searched to the
+        image's edge, without the error :func:`stereovision.match` raises (see
+        :mod:`stereovision.matching`).
     min_disparity : float, optional
         Smallest disparity searched (px, default 0).
     debug : bool, optional

@@ -148,7 +148,9 @@ def sgm_disparity(
     left, right : array_like
         Rectified pair, ``(H, W)`` grey (or anything :func:`as_gray_float` takes), same shape.
     max_disparity, min_disparity : float
-        Search range (px); rounded outwards to integers.
+        Search range (px); rounded outwards to integers. A range past the image's width is searched
+        to the image's edge, without the error :func:`stereovision.match` raises (see
+        :mod:`stereovision.matching`).
     **params
         :data:`DEFAULTS`' keys.
 
