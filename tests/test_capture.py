@@ -1574,6 +1574,33 @@ def test_a_temporal_mean_the_source_ends_is_said_unsaved(
     assert out.count("mean of 3.0 frames") == 2 and "not saved" not in out, out
 
 
+def test_a_temporal_mean_an_interrupt_cuts_is_said_unsaved(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C while ``temporal=2`` awaits its 4th frame: the pair of frames 1-2 is saved, frame
+    3's unfinished mean was dropped without a word; a line says so before the interrupt goes
+    on (the CLI then says the pairs kept)."""
+    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "still", 5)
+    real = capmod.read_within
+    reads = []
+
+    def interrupted_4th(camera: Any, timeout: Any) -> Any:
+        reads.append(1)
+        if len(reads) == 4:
+            raise KeyboardInterrupt
+        return real(camera, timeout)
+
+    monkeypatch.setattr(capmod, "read_within", interrupted_4th)
+    lines: list[str] = []
+    with StereoCamera(lpat, rpat) as cam, pytest.raises(KeyboardInterrupt):
+        capture(cam, tmp_path / "pairs", temporal=2, log=lines.append)
+    assert len(lines) == 2 and lines[0].startswith("saved left_0001.png"), lines
+    assert lines[1] == (
+        "not saved: the last mean, of 1.0 frames of the 2 asked, was unfinished when the "
+        "capture was interrupted"
+    )
+
+
 def test_temporal_averaging_of_16_bit_frames_is_refused_naming_the_source(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -3038,7 +3038,8 @@ def capture(
         Image format of the saved files.
     log : callable, optional
         Receives one line per saved pair (with coverage in chessboard mode) and, with
-        ``temporal``, one for a mean the source's end left unfinished (not saved).
+        ``temporal``, one for a mean the source's end (or an interrupt) left unfinished (not
+        saved).
     temporal : int, optional
         Save each pair as the mean of ``temporal`` (2-255) frames of a still view
         (:class:`~stereovision.temporal.TemporalFilter`: a moving rig or board starts the mean
@@ -3132,6 +3133,14 @@ def capture(
     # (None once a pair is taken from it, or without temporal)
     unfinished: float | None = None
 
+    def say_unfinished(when: str) -> None:
+        """The frames read since the last pair, dropped without a word before: said."""
+        if unfinished is not None and log is not None:
+            log(
+                f"not saved: the last mean, of {unfinished:.1f} frames of the {temporal} "
+                f"asked, was unfinished when {when}"
+            )
+
     def kept_note() -> str:
         if count is not None:
             return f"{len(saved)} of {count} pairs were saved in {out} and are kept"
@@ -3151,12 +3160,7 @@ def capture(
             # file read nothing and said "0 pairs saved (end of stream)", exit 0
             if count is None and exc.end and read > 0 and not _device_ended(camera, exc):
                 ended = _end_reason(exc, saved, last_index)
-                if unfinished is not None and log is not None:
-                    # the frames read since the last pair were dropped without a word
-                    log(
-                        f"not saved: the last mean, of {unfinished:.1f} frames of the "
-                        f"{temporal} asked, was unfinished when the source ended"
-                    )
+                say_unfinished("the source ended")
                 break
             if exc.end and read == 0 and read_before > 0:
                 raise exc.with_message(
@@ -3164,6 +3168,9 @@ def capture(
                     f"took its frames: open it again); {kept_note()}"
                 ) from exc
             raise exc.with_message(f"{exc}; {kept_note()}") from exc
+        except KeyboardInterrupt:  # Ctrl-C while a frame is awaited (SIGTERM in the CLI)
+            say_unfinished("the capture was interrupted")
+            raise
         except ValueError as exc:
             # a recording's frame that does not decode (BagCamera names its topic and stamp):
             # the pairs saved before it stay, and are said as for a video's failing frame
