@@ -1679,6 +1679,44 @@ def test_a_file_with_a_figure_that_is_no_number_is_named(
     assert math.isnan(back.skew_deg[0]) and back.skew_deg[1] == 0.03
 
 
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("H1", [[1, 0, 0, 0]] * 3, "H1: expected a 3 x 3 matrix [[a, b, c], [d, e, f], [g, h, i]]"),
+        ("H2", "abc", "H2: expected a 3 x 3 matrix [[a, b, c], [d, e, f], [g, h, i]], got 'abc'"),
+        ("F", None, "F: expected a 3 x 3 matrix [[a, b, c], [d, e, f], [g, h, i]], got None"),
+        ("F", [[1, 0, 0], [0, 1, 0], [0, "x", 1]], "F: expected a number, got 'x'"),
+        ("H1", [[True, 0, 0], [0, 1, 0], [0, 0, 1]], "H1: expected a number, got True"),
+        ("H1", [[10**400, 0, 0], [0, 1, 0], [0, 0, 1]], "H1: expected a number, got an integer "
+         "of 401 digits (too large for a float)"),
+        ("median_dy", -(10**400), "median_dy: expected a number, got a negative integer of 401 "
+         "digits (too large for a float)"),
+    ],
+    ids=["3x4", "string", "null", "string-entry", "true-entry", "huge-entry", "huge-figure"],
+)  # fmt: skip
+def test_a_file_with_a_matrix_or_figure_that_is_no_number_is_named(
+    tmp_path: Path, field: str, value: object, words: str
+) -> None:
+    """A hand-edited 3 x 4 H1 said NumPy's "cannot reshape array of size 12 into shape (3,3)",
+    "abc" "could not convert string to float", neither naming the field; true was read as 1.0;
+    and an integer past a float was an OverflowError past load's ValueError (depth
+    --rectification: "internal OverflowError ... (please report this)"). Each is refused
+    naming the field; a null entry is still NaN, refused as damaged."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (640, 360), (600, 400), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
+        48, (0.02, 0.03), (1.001, 0.998),
+    )  # fmt: skip
+    raw = rect.as_dict()
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps({**raw, field: value}))
+    with pytest.raises(ValueError) as err:
+        UncalibratedRectification.load(path)
+    assert str(err.value).startswith(f"{path} is not an uncalibrated rectification: {words}")
+    path.write_text(json.dumps({**raw, "H1": [[None, 0, 0], [0, 1, 0], [0, 0, 1]]}))
+    with pytest.raises(ValueError, match=r"H1 has a NaN or infinite entry$"):
+        UncalibratedRectification.load(path)
+
+
 def test_a_12_bit_pair_in_16_bits_is_rectified_from_its_features(data_dir: Path) -> None:
     """A 12-bit camera's pair in uint16 (0-4095) was cut to 8 bits as 16-bit data: 0-16 grey
     levels, no SIFT feature, and rectify_uncalibrated (stereovision rectify) said "only 0

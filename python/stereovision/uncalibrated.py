@@ -630,7 +630,7 @@ class UncalibratedRectification:
                 "rectification.json that `stereovision rectify` writes)"
             )
         try:
-            mats = {k: np.asarray(d[k], np.float64).reshape(3, 3) for k in ("H1", "H2", "F")}
+            mats = {k: _matrix(d[k], k) for k in ("H1", "H2", "F")}
             out = cls(
                 mats["H1"],
                 mats["H2"],
@@ -693,12 +693,31 @@ def _figure(value: Any, field: str) -> float:
     """A figure of a rectification file: :meth:`UncalibratedRectification.save` writes a NaN
     or infinite one as null (strict JSON), read back as NaN. Anything but a JSON number or
     null is refused naming the field (float() said "could not convert string to float: 'abc'"
-    and read true as 1.0)."""
+    and read true as 1.0), and so is an integer past a float (float()'s OverflowError, which
+    went past :meth:`UncalibratedRectification.load`'s ValueError)."""
     if value is None:
         return math.nan
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{field}: expected a number, got {value!r}")
+    if too_large_for_float(value):
+        raise ValueError(f"{field}: expected a number, got {number_shown(value)}")
     return float(value)
+
+
+def _matrix(value: Any, field: str) -> F64:
+    """A 3 x 3 matrix of a rectification file (``[[a, b, c], [d, e, f], [g, h, i]]``), each
+    entry :func:`_figure` (a null entry NaN, refused by :func:`_damaged`): a 3 x 4 one said
+    NumPy's "cannot reshape array of size 12 into shape (3,3)", "abc" "could not convert
+    string to float", neither naming the field, and true was read as 1.0."""
+    if not (
+        isinstance(value, list)
+        and len(value) == 3
+        and all(isinstance(row, list) and len(row) == 3 for row in value)
+    ):
+        raise ValueError(
+            f"{field}: expected a 3 x 3 matrix [[a, b, c], [d, e, f], [g, h, i]], got {value!r}"
+        )
+    return np.array([[_figure(v, field) for v in row] for row in value], np.float64)
 
 
 def _figures(value: Any, field: str, names: str) -> tuple[float, float]:
