@@ -1717,6 +1717,27 @@ def test_a_file_with_a_matrix_or_figure_that_is_no_number_is_named(
         UncalibratedRectification.load(path)
 
 
+def test_a_file_whose_size_is_past_the_largest_stretch_is_refused(tmp_path: Path) -> None:
+    """rectify_uncalibrated makes no rectified image over MAX_STRETCH times the input's size,
+    but load took any size up to 100000 px: a hand-edited 100000x100000 for a 612x459 pair had
+    OpenCV allocate 30 GB for the warp (depth --rectification: "internal error: ... Failed to
+    allocate 30000000000 bytes", or the machine's memory). A size up to the stretch loads."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (2448, 1836), (612, 459), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
+        48, (0.02, 0.03), (1.001, 0.998),
+    )  # fmt: skip
+    assert UncalibratedRectification.load(rect.save(tmp_path / "r.json")).size == (2448, 1836)
+    for size in ((100_000, 100_000), (2449, 459), (612, 1837)):
+        bad = tmp_path / f"{size[0]}.json"
+        bad.write_text(json.dumps({**rect.as_dict(), "size": list(size)}))
+        with pytest.raises(ValueError) as err:
+            UncalibratedRectification.load(bad)
+        assert str(err.value) == (
+            f"{bad} is not a usable uncalibrated rectification: size {size[0]}x{size[1]} px: "
+            "more than 4 times the input's 612x459 px (rectify_uncalibrated makes none larger)"
+        )
+
+
 def test_a_12_bit_pair_in_16_bits_is_rectified_from_its_features(data_dir: Path) -> None:
     """A 12-bit camera's pair in uint16 (0-4095) was cut to 8 bits as 16-bit data: 0-16 grey
     levels, no SIFT feature, and rectify_uncalibrated (stereovision rectify) said "only 0

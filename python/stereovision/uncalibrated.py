@@ -748,6 +748,15 @@ def _damaged(rect: UncalibratedRectification) -> str | None:
         w, h = getattr(rect, name)
         if not (0 < w <= 100_000 and 0 < h <= 100_000):
             return f"{name} {w}x{h} px: expected positive sizes up to 100000"
+    # rectify_uncalibrated refuses a rectified size past MAX_STRETCH times the input's: a
+    # larger one (hand-edited, 100000x100000 for a 612x459 pair) had OpenCV allocate 30 GB
+    # for the warp ("internal error: ... Failed to allocate 30000000000 bytes")
+    (w, h), (w0, h0) = rect.size, rect.input_size
+    if w > MAX_STRETCH * w0 or h > MAX_STRETCH * h0:
+        return (
+            f"size {w}x{h} px: more than {MAX_STRETCH:g} times the input's {w0}x{h0} px "
+            "(rectify_uncalibrated makes none larger)"
+        )
     if rect.max_disparity < 1:
         return f"max_disparity {rect.max_disparity}: expected at least 1"
     if rect.model not in MODELS[1:]:
