@@ -99,6 +99,29 @@ def test_a_bad_texture_or_camera_is_named(kw: dict, message: str) -> None:
         render_plane(units_per_pixel=0.01, image_size=(20, 12), **args)
 
 
+@pytest.mark.parametrize("model", ["pinhole", "fisheye"])
+@pytest.mark.parametrize(
+    ("k", "said"),
+    [
+        (np.zeros((3, 3)), "fx=0, fy=0"),  # an uncalibrated camera's camera_info K
+        ([[100.0, 0.0, 9.5], [0.0, 0.0, 5.5], [0.0, 0.0, 1.0]], "fx=100, fy=0"),
+        ([[-100.0, 0.0, 9.5], [0.0, 100.0, 5.5], [0.0, 0.0, 1.0]], "fx=-100, fy=100"),
+    ],
+)
+def test_a_camera_matrix_without_positive_focal_lengths_is_named(
+    model: str, k: object, said: str
+) -> None:
+    """K = 0 (or a zero focal length) gave every ray NaN: a picture of the background only,
+    with NumPy's "invalid value encountered" warnings; a negative fx mirrored the picture.
+    Refused in Calibration's words; a positive K renders the plane."""
+    d = np.zeros(4) if model == "fisheye" else None
+    kw = {"image_size": (20, 12), "model": model}
+    with pytest.raises(ValueError, match=rf"^K: focal lengths must be positive, got {said}$"):
+        render_plane(TEX, 0.01, k, d, np.zeros(3), [0, 0, 1.0], **kw)
+    good = np.array([[100.0, 0.0, 9.5], [0.0, 100.0, 5.5], [0.0, 0.0, 1.0]])
+    assert not np.all(render_plane(TEX, 0.01, good, d, np.zeros(3), [0, 0, 1.0], **kw) == 60)
+
+
 def test_no_distortion_coefficients_is_no_distortion() -> None:
     kw = {"image_size": (20, 12)}
     none = render_plane(TEX, 0.01, K, np.zeros(0), np.zeros(3), [0, 0, 1.0], **kw)

@@ -173,8 +173,9 @@ def render_plane(
     ------
     ValueError
         For a bad size, supersampling or model; a texture that is empty or not ``(H, W)`` or
-        ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3, ``D`` of a length the model does
-        not take, ``rvec`` or ``tvec`` not 3 numbers; a camera in the plane (seen edge-on).
+        ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3 or of a focal length that is not
+        positive, ``D`` of a length the model does not take, ``rvec`` or ``tvec`` not 3
+        numbers; a camera in the plane (seen edge-on).
     """
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
@@ -218,6 +219,11 @@ def render_plane(
             )
             got = "None" if name == "D" and D is None else f"shape {arr.shape}"
             raise ValueError(f"{name}: expected {want} (finite), got {got}")
+    # a zero focal length (the K = 0 of an uncalibrated camera's camera_info) gave every ray
+    # NaN and a picture of background only, with NumPy's "invalid value" warnings; a negative
+    # one a mirrored picture. Calibration's words
+    if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
+        raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
     Rb, _ = cv2.Rodrigues(rv.reshape(3, 1))
     plane = np.column_stack([Rb[:, 0], Rb[:, 1], t])
     if abs(np.linalg.det(plane)) <= 1e-12 * max(1.0, float(np.abs(t).max())):
