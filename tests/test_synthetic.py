@@ -122,6 +122,35 @@ def test_a_camera_matrix_without_positive_focal_lengths_is_named(
     assert not np.all(render_plane(TEX, 0.01, good, d, np.zeros(3), [0, 0, 1.0], **kw) == 60)
 
 
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"units_per_pixel": "0.01"}, r"^units_per_pixel: expected a positive finite number"),
+        ({"units_per_pixel": True}, r"^units_per_pixel: expected a positive finite number"),
+        ({"background": "60"}, r"^background: expected a number, got '60'$"),
+        ({"background": True}, r"^background: expected a number, got True$"),
+        (
+            {"background": np.nan},
+            r"^background: expected a value of the uint8 texture \(0 to 255\), got nan$",
+        ),
+        (
+            {"background": 300},
+            r"^background: expected a value of the uint8 texture \(0 to 255\), got 300$",
+        ),
+        ({"background": -1, "texture": np.zeros((4, 4), np.uint16)}, r"uint16 texture \(0 to "),
+    ],
+)
+def test_a_bad_scale_or_background_is_named(kw: dict, message: str) -> None:
+    """units_per_pixel "0.01" or True (1) and background "60" or True were taken as numbers;
+    a NaN background on a uint8 texture was NumPy's "invalid value encountered in cast" and
+    black (0), 300 clipped to 255. Refused naming the argument; a float texture keeps NaN."""
+    args = {"texture": np.full((4, 4), 128, np.uint8), "units_per_pixel": 0.01, **kw}
+    with pytest.raises(ValueError, match=message):
+        render_plane(K=K, D=D, rvec=np.zeros(3), tvec=[0, 0, 1.0], image_size=(20, 12), **args)
+    far = render_plane(TEX, 0.01, K, D, np.zeros(3), [9.0, 9.0, 1.0], background=np.nan)
+    assert np.isnan(far).all()  # off the plane everywhere: NaN, a float texture's value
+
+
 def test_no_distortion_coefficients_is_no_distortion() -> None:
     kw = {"image_size": (20, 12)}
     none = render_plane(TEX, 0.01, K, np.zeros(0), np.zeros(3), [0, 0, 1.0], **kw)

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import int_in_range
+from stereovision._validate import int_in_range, positive_finite, real_number
 
 __all__ = ["render_plane"]
 
@@ -157,7 +157,7 @@ def render_plane(
     supersample : int
         Samples per pixel side (1 to 8).
     background : float
-        Value off the plane.
+        Value off the plane (NaN for a float texture; within an integer texture's range).
     model : str
         ``"pinhole"`` or ``"fisheye"`` (``cv2.fisheye``'s equidistant model).
     origin_px : tuple of float
@@ -172,10 +172,11 @@ def render_plane(
     Raises
     ------
     ValueError
-        For a bad size, supersampling or model; a texture that is empty or not ``(H, W)`` or
-        ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3 or of a focal length that is not
-        positive, ``D`` of a length the model does not take, ``rvec`` or ``tvec`` not 3
-        numbers; a camera in the plane (seen edge-on).
+        For a bad size, supersampling or model; a ``units_per_pixel`` that is not a positive
+        number, a ``background`` that is no number or not a value of an integer texture; a
+        texture that is empty or not ``(H, W)`` or ``(H, W, C)`` with 1 to 4 channels; ``K``
+        not 3 x 3 or of a focal length that is not positive, ``D`` of a length the model does
+        not take, ``rvec`` or ``tvec`` not 3 numbers; a camera in the plane (seen edge-on).
     """
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
@@ -193,9 +194,19 @@ def render_plane(
         raise ValueError(
             f"texture: expected a non-empty (H, W) or (H, W, 1-4) image, got shape {tex.shape}"
         )
-    s = float(units_per_pixel)
-    if not (np.isfinite(s) and s > 0):
-        raise ValueError(f"units_per_pixel: expected a positive number, got {units_per_pixel!r}")
+    # the package's numbers (positive_finite): "0.01" and True (1) were taken as sizes
+    s = positive_finite(units_per_pixel, "units_per_pixel")
+    if not real_number(background):  # "60" was 60, True 1
+        raise ValueError(f"background: expected a number, got {background!r}")
+    if np.issubdtype(tex.dtype, np.integer):
+        # NaN was NumPy's "invalid value encountered in cast" and 0 (a uint8 texture), 300
+        # clipped to 255 (render_charuco's background is refused there too)
+        info = np.iinfo(tex.dtype)
+        if not (info.min <= background <= info.max):
+            raise ValueError(
+                f"background: expected a value of the {tex.dtype} texture ({info.min} to "
+                f"{info.max}), got {background!r}"
+            )
     Kf = np.asarray(K, np.float64)
     # None is no distortion, as the message below and OpenCV's distCoeffs have it: it was
     # asarray's NaN, "... (or none) for model 'pinhole' (finite), got shape (1,)"
