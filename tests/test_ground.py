@@ -830,6 +830,29 @@ def test_scan_bad_input() -> None:
     assert len(empty.ranges) == 230 and np.isnan(empty.ranges).all()
 
 
+@pytest.mark.parametrize(
+    ("angles", "said"),
+    [
+        ((-1.0, 1.0, 5e-324), "4.94066e-324 rad beams over 2 rad are inf beams"),
+        ((-1e308, 1e308, None), "0.00436332 rad beams over inf rad are inf beams"),
+        ((-1.0, 1.0, 1e-300), "1e-300 rad beams over 2 rad are 2e+300 beams"),
+    ],
+)
+def test_a_scan_of_beams_past_a_float_is_refused_by_name(
+    angles: tuple[float, float, float | None], said: str
+) -> None:
+    """Beams of 5e-324 rad, or angles from -1e308 to 1e308, made the beam count a float's
+    infinity: OverflowError 'cannot convert float infinity to integer', naming nothing; 1e-300
+    rad said its count in 300 digits. Refused as the scan over 100000 beams it is."""
+    from stereovision.ground import laser_scan
+
+    plane, _ = _level_floor()
+    a0, a1, inc = angles
+    with pytest.raises(ValueError) as err:
+        laser_scan(np.zeros((3, 3)), plane, angle_min=a0, angle_max=a1, angle_increment=inc)
+    assert str(err.value) == f"angle_increment: {said}; at most 100000"
+
+
 def test_reprs_are_summaries_not_arrays() -> None:
     from stereovision.ground import GroundPlane, LaserScan, OccupancyGrid
 

@@ -1330,7 +1330,16 @@ def laser_scan(
     inc = positive_finite(inc, "angle_increment")
     if not (math.isfinite(a0) and math.isfinite(a1) and a1 > a0):
         raise ValueError(f"angle_min, angle_max: expected angle_max > angle_min, got {a0}, {a1}")
-    n = math.floor((a1 - a0) / inc + 1e-9) + 1
+    # a quotient past a float (5e-324 rad beams, or angles of -1e308 to 1e308) was
+    # OverflowError "cannot convert float infinity to integer", and one short of it (1e-300
+    # rad) said its count in 300 digits
+    beams = (a1 - a0) / inc
+    if not beams < 1e15:
+        raise ValueError(
+            f"angle_increment: {inc:g} rad beams over {a1 - a0:g} rad are {beams:.3g} beams; "
+            "at most 100000"
+        )
+    n = math.floor(beams + 1e-9) + 1
     if n > 100_000:
         raise ValueError(f"angle_increment: {n} beams; at most 100000")
     flat = pts.reshape(-1, 3)
