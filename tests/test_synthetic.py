@@ -138,12 +138,16 @@ def test_a_camera_matrix_without_positive_focal_lengths_is_named(
             r"^background: expected a value of the uint8 texture \(0 to 255\), got 300$",
         ),
         ({"background": -1, "texture": np.zeros((4, 4), np.uint16)}, r"uint16 texture \(0 to "),
+        ({"origin_px": "ab"}, r"^origin_px: expected two finite numbers \(x, y\), got 'ab'$"),
+        ({"origin_px": (np.nan, 0.0)}, r"^origin_px: expected two finite numbers"),
+        ({"origin_px": (1.0,)}, r"^origin_px: expected two finite numbers \(x, y\), got \(1.0,\)$"),
     ],
 )
 def test_a_bad_scale_or_background_is_named(kw: dict, message: str) -> None:
     """units_per_pixel "0.01" or True (1) and background "60" or True were taken as numbers;
     a NaN background on a uint8 texture was NumPy's "invalid value encountered in cast" and
-    black (0), 300 clipped to 255. Refused naming the argument; a float texture keeps NaN."""
+    black (0), 300 clipped to 255; origin_px "ab" was NumPy's UFuncTypeError, a NaN one drew
+    the background alone. Refused naming the argument; a float texture keeps NaN."""
     args = {"texture": np.full((4, 4), 128, np.uint8), "units_per_pixel": 0.01, **kw}
     with pytest.raises(ValueError, match=message):
         render_plane(K=K, D=D, rvec=np.zeros(3), tvec=[0, 0, 1.0], image_size=(20, 12), **args)

@@ -9,6 +9,7 @@ rig are rendered this way, so that a test knows the exact geometry behind every 
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import cv2
@@ -173,10 +174,11 @@ def render_plane(
     ------
     ValueError
         For a bad size, supersampling or model; a ``units_per_pixel`` that is not a positive
-        number, a ``background`` that is no number or not a value of an integer texture; a
-        texture that is empty or not ``(H, W)`` or ``(H, W, C)`` with 1 to 4 channels; ``K``
-        not 3 x 3 or of a focal length that is not positive, ``D`` of a length the model does
-        not take, ``rvec`` or ``tvec`` not 3 numbers; a camera in the plane (seen edge-on).
+        number, a ``background`` that is no number or not a value of an integer texture, an
+        ``origin_px`` that is not two finite numbers; a texture that is empty or not ``(H, W)``
+        or ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3 or of a focal length that is not
+        positive, ``D`` of a length the model does not take, ``rvec`` or ``tvec`` not 3
+        numbers; a camera in the plane (seen edge-on).
     """
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
@@ -207,6 +209,14 @@ def render_plane(
                 f"background: expected a value of the {tex.dtype} texture ({info.min} to "
                 f"{info.max}), got {background!r}"
             )
+    # a string was NumPy's UFuncTypeError "ufunc 'add' did not contain a loop", naming no
+    # argument, and a NaN drew the background alone (every texture coordinate NaN)
+    try:
+        ox, oy = (float(v) if real_number(v) else math.nan for v in origin_px)
+    except (TypeError, ValueError, OverflowError):  # no pair; an int past a float
+        ox = oy = math.nan
+    if not (math.isfinite(ox) and math.isfinite(oy)):
+        raise ValueError(f"origin_px: expected two finite numbers (x, y), got {origin_px!r}")
     Kf = np.asarray(K, np.float64)
     # None is no distortion, as the message below and OpenCV's distCoeffs have it: it was
     # asarray's NaN, "... (or none) for model 'pinhole' (finite), got shape (1,)"
@@ -248,8 +258,8 @@ def render_plane(
     # Rays that meet the plane behind the camera (q <= 0 for a plane in front) see background.
     front = np.isfinite(q) & (q > 1e-12)
     qs = np.where(front, q, 1.0)
-    mx = np.where(front, u / qs / s + origin_px[0], -1e6).astype(np.float32)
-    my = np.where(front, v / qs / s + origin_px[1], -1e6).astype(np.float32)
+    mx = np.where(front, u / qs / s + ox, -1e6).astype(np.float32)
+    my = np.where(front, v / qs / s + oy, -1e6).astype(np.float32)
     work = tex.astype(np.float32)
     fill = (float(background),) * (tex.shape[2] if tex.ndim == 3 else 1)  # grey in every channel
     canvas = cv2.remap(
