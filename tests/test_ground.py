@@ -1025,6 +1025,41 @@ def _level_floor() -> tuple[GroundPlane, np.ndarray]:
     return plane, pts
 
 
+def test_a_plane_rebuilt_from_ground_json_works_as_the_fitted_one() -> None:
+    """ground.json (as_dict) holds the normal as a list: a GroundPlane rebuilt from it described
+    itself and marked obstacles, but camera_in_floor, ros2_static_transform, as_dict,
+    occupancy_grid and laser_scan failed in floor_frame with Python's "can't multiply
+    sequence by non-int of type 'float'". The normal is an array now; a fitted plane's is
+    kept as it is (the same object)."""
+    from stereovision.ground import laser_scan, occupancy_grid
+
+    plane, pts = _level_floor()
+    d = json.loads(json.dumps(plane.as_dict()))
+    back = GroundPlane(
+        normal=d["normal"], height=d["height_m"], disparity_plane=tuple(d["disparity_plane"]),
+        inliers=plane.inliers, inlier_share=d["inlier_share"], rms_px=d["rms_px"],
+    )  # fmt: skip
+    assert isinstance(back.normal, np.ndarray) and back.normal.dtype == np.float64
+    np.testing.assert_array_equal(back.camera_in_floor(), plane.camera_in_floor())
+    assert back.ros2_static_transform() == plane.ros2_static_transform()
+    assert back.as_dict() == d
+    grid, want = (
+        occupancy_grid(pts, back, resolution=0.5),
+        occupancy_grid(pts, plane, resolution=0.5),
+    )
+    np.testing.assert_array_equal(grid.data, want.data)
+    assert (grid.data == 100).any()
+    kw = {"angle_min": -0.5, "angle_max": 0.5, "angle_increment": 0.1, "min_points": 1}
+    scan = laser_scan(pts, back, **kw)
+    np.testing.assert_array_equal(scan.ranges, laser_scan(pts, plane, **kw).ranges)
+    assert np.isfinite(scan.ranges).any()
+    assert GroundPlane(plane.normal, 1.0, (0.0, 0.0, 0.0), plane.inliers, 1.0, 0.0).normal is (
+        plane.normal
+    )
+    with pytest.raises(ValueError, match=r"^normal: expected 3 numbers, got shape \(2,\)$"):
+        GroundPlane([0.0, -1.0], 1.0, (0.0, 0.0, 0.0), plane.inliers, 1.0, 0.0)
+
+
 @pytest.mark.parametrize("value", ["1", True, None, [1.0]])
 @pytest.mark.parametrize("key", ["min_height", "max_height", "max_range"])
 def test_obstacle_mask_limits_must_be_numbers(key: str, value: object) -> None:

@@ -169,6 +169,15 @@ class GroundPlane:
     rms_px: float
     below_share: float = 0.0
 
+    def __post_init__(self) -> None:
+        # a plane rebuilt from ground.json (as_dict: the normal a list) described itself and
+        # marked obstacles, then failed in floor_frame with Python's "can't multiply sequence
+        # by non-int of type 'float'" (camera_in_floor, occupancy_grid, laser_scan, as_dict)
+        normal = np.asarray(self.normal, np.float64)  # a fitted plane's: the same array
+        if normal.shape != (3,):
+            raise ValueError(f"normal: expected 3 numbers, got shape {normal.shape}")
+        object.__setattr__(self, "normal", normal)
+
     @property
     def pitch_deg(self) -> float:
         """Optical axis below the horizon (degrees; positive: looking down at the floor)."""
