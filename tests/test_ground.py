@@ -2044,6 +2044,31 @@ def test_occupancy_grid_save_into_a_file_says_it_is_no_folder(tmp_path: Path) ->
     assert (tmp_path / "maps").read_bytes() == b"x"
 
 
+def test_occupancy_grid_save_through_a_link_to_nothing_or_under_a_file_says_so(
+    tmp_path: Path,
+) -> None:
+    """A maps/ link to a folder that is not there (an unmounted drive) was mkdir's bare
+    "[Errno 17] File exists: '.../maps'", as if the map were there, and a folder under a file
+    "[Errno 20] Not a directory"; both now name what stands in the way (make_folder's words),
+    nothing written. A link to a folder is written through."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    (tmp_path / "maps").symlink_to(tmp_path / "drive" / "maps")
+    (tmp_path / "notes").write_bytes(b"x")
+    for folder, says in (
+        ("maps", f"maps is a link to {tmp_path / 'drive' / 'maps'}, which does not exist"),
+        ("notes/maps", "notes is a file, not a folder"),
+    ):
+        with pytest.raises(NotADirectoryError) as exc:
+            grid.save(tmp_path / folder)
+        assert str(exc.value) == (f"cannot make the folder {tmp_path / folder}: {tmp_path / says}")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["maps", "notes"]
+    (tmp_path / "drive" / "maps").mkdir(parents=True)
+    png, _ = grid.save(tmp_path / "maps")
+    assert (tmp_path / "drive" / "maps" / "map.png").is_file() and png.parent.is_symlink()
+
+
 @pytest.mark.parametrize("name", ["run #3", "lab: 2", "*x", "[a]", 'say "hi"', "é\tb", "map"])
 def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: str) -> None:
     """map.yaml's 'image: run #3.png' read as 'run' (YAML took the rest for a comment), and

@@ -967,9 +967,10 @@ class OccupancyGrid:
         RuntimeError
             If the grid could not be encoded as PNG.
         OSError
-            If ``directory`` is a file (FileExistsError), or a file could not be written; the
-            previous pair is then intact (should putting a previous file back fail too, its
-            copy is kept and named in the exception's notes).
+            If ``directory`` is a file (FileExistsError), a link to nothing or under a file
+            (NotADirectoryError), or a file could not be written; the previous pair is then
+            intact (should putting a previous file back fail too, its copy is kept and named in
+            the exception's notes).
         """
         import json
         import re
@@ -985,7 +986,11 @@ class OccupancyGrid:
         d = as_path(directory, "directory")
         if d.exists() and not d.is_dir():  # mkdir's "[Errno 17] File exists: 'maps'"
             raise FileExistsError(f"cannot write the map into {d}: it is a file, not a folder")
-        d.mkdir(parents=True, exist_ok=True)
+        from stereovision.io import make_folder
+
+        # mkdir's words named no cause: "[Errno 17] File exists" of a link to nothing (a
+        # maps/ link to an unmounted drive), "[Errno 20] Not a directory" under a file
+        make_folder(d)
         png, yml = d / f"{name}.png", d / f"{name}.yaml"
         ok, buf = cv2.imencode(".png", self.image())
         if not ok:
