@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ipaddress
 import json
+import math
 import os
 import re
 import shutil
@@ -1864,6 +1865,29 @@ def test_run_stream_refuses_no_disparity_range_and_a_bool_check_every() -> None:
         with pytest.raises(ValueError, match=said):
             run_stream(rig, **kw)  # type: ignore[arg-type]
         assert rig.count == 0
+
+
+def test_run_stream_refuses_a_disparity_range_that_is_no_number_before_any_grab() -> None:
+    """A range that is no positive number is refused before any grab, in depth_map's words:
+    "64" raised "'<=' not supported between instances of 'str' and 'int'", and NaN, inf, True
+    and a timedelta were refused by depth_map after a pair was taken off the camera; 0 with
+    homographies silently searched their range."""
+    for md, err, said in (
+        ("64", TypeError, "max_disparity: expected a number of pixels, got '64'"),
+        (True, TypeError, "max_disparity: expected a number of pixels, got True"),
+        (np.timedelta64(16), TypeError, "max_disparity: expected a number of pixels, got"),
+        (math.nan, ValueError, "max_disparity: expected a positive number, got nan"),
+        (math.inf, ValueError, "max_disparity: expected a positive number, got inf"),
+        (10**400, ValueError, "max_disparity: expected a finite number, got an integer of 401"),
+    ):
+        rig = _FakeRig([_frame(0)])
+        with pytest.raises(err, match=re.escape(said)):
+            run_stream(rig, max_disparity=md, pipelined=False)  # type: ignore[arg-type]
+        assert rig.count == 0, md
+    rig = _FakeRig([_frame(0)])
+    with pytest.raises(ValueError, match="max_disparity: expected a positive number, got 0"):
+        run_stream(rig, max_disparity=0, homographies=_Homographies())  # type: ignore[arg-type]
+    assert rig.count == 0
 
 
 def test_a_window_reports_its_own_pairs_per_second() -> None:

@@ -42,7 +42,9 @@ from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
 from stereovision._validate import (
     HELD_WARNINGS,
+    finite_number,
     first_line,
+    number_shown,
     positive_whole,
     real_number,
     too_large_for_float,
@@ -947,10 +949,17 @@ def run_stream(
         ``error``; an OSError of ``on_result`` or ``on_stamped_result`` (an output that cannot
         be written) ends it likewise, ``ended`` ``"output failed"``.
     ValueError
-        If ``frames`` is not positive, ``method`` is unknown (before any grab), or the
-        calibration does not fit the frames.
+        If ``frames`` or ``max_disparity`` is not positive, ``method`` is unknown (before any
+        grab), or the calibration does not fit the frames.
+    TypeError
+        If ``max_disparity`` is not a number (``"64"``, True; before any grab).
     """
-    from stereovision.depth import METHODS, depth_map, estimate_max_disparity
+    from stereovision.depth import (
+        METHODS,
+        _refuse_range_types,
+        depth_map,
+        estimate_max_disparity,
+    )
 
     # NaN matched no pair ("end of stream"), 2.5 three and True one
     if frames is not None:
@@ -962,12 +971,21 @@ def run_stream(
         # -10**5000 by its size: it has no repr (Python's 4300-digit limit, naming nothing)
         shown = too_large_for_float(report_period, why=False) or repr(report_period)
         raise ValueError(f"report_period: expected a number of seconds >= 0, got {shown}")
+    if max_disparity is not None:
+        # refused before any grab, as batch refuses it: "64" failed in the comparison below
+        # ("'<=' not supported between instances of 'str' and 'int"), and NaN, inf, True or a
+        # timedelta passed it, refused by depth_map once a pair was taken off the camera
+        _refuse_range_types(max_disparity, 0)
+        if too_large_for_float(max_disparity):  # 10**400: said by its size, not its digits
+            finite_number(max_disparity, "max_disparity")
+        if not (math.isfinite(max_disparity) and max_disparity > 0):
+            given = number_shown(max_disparity)
+            raise ValueError(f"max_disparity: expected a positive number, got {given}")
     if homographies is not None:
         if calib is not None:
             raise ValueError("homographies and calib: give one way to rectify the pairs")
-        max_disparity = max_disparity or homographies.max_disparity
-    if max_disparity is not None and max_disparity <= 0:
-        raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+        if max_disparity is None:  # 0 passed as "none given", where it is refused without them
+            max_disparity = homographies.max_disparity
     # usage errors before the first grab (the read ahead below takes a pair off the camera)
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
