@@ -3328,3 +3328,27 @@ def test_a_scoped_ipv6_hosts_url_escapes_its_zone() -> None:
     assert url_for("fe80::1%eth0", 8080) == "http://[fe80::1%25eth0]:8080/"
     assert _host_port("::1", 8765) == "[::1]:8765"  # unscoped: unchanged
     assert _host_port("127.0.0.1", 8765) == "127.0.0.1:8765"
+
+
+def test_check_every_with_no_check_is_refused_before_any_open(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``stream --no-check --check-every 1`` (run_stream's check=False, check_every=1) checked
+    no pair at all, the summary's checks [] and nothing said; refused now before any grab (the
+    CLI's cameras do not exist: before any open), in one line, exit 2."""
+    rig = _FakeRig([_frame(0)])
+    with pytest.raises(ValueError) as err:
+        run_stream(rig, max_disparity=8, check=False, check_every=1)  # type: ignore[arg-type]
+    assert str(err.value) == (
+        "check_every: it checks the rows of pairs, which check=False turns off; give one or the "
+        "other"
+    )
+    assert rig.count == 0
+    argv = ["stream", "--left", str(tmp_path / "l.avi"), "--right", str(tmp_path / "r.avi")]
+    assert main([*argv, "--no-display", "--no-check", "--check-every", "1"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        "stereovision: error: --check-every: it checks the rows of pairs, which --no-check turns "
+        "off; give one or the other\n"
+    )

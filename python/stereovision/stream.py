@@ -907,6 +907,7 @@ def run_stream(
     check_every : int, optional
         Also check every ``check_every``-th pair (in the grab thread when pipelined), and warn
         when the rows stop agreeing: a rig bumped while running. None: the first pair only.
+        Not with ``check=False``.
     ground_every : int, optional
         Fit the floor (:func:`~stereovision.ground.fit_ground_plane`, 30-150 ms) on pair 0 and
         every ``ground_every``-th pair, and warn once when the camera's height moves by more
@@ -991,6 +992,11 @@ def run_stream(
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     if check_every is not None:  # 2.5 checked pairs 0, 5, 10
         check_every = positive_whole(check_every, "check_every", "a positive number of pairs")
+        if not check:  # it checked no pair at all, without a word
+            raise ValueError(
+                "check_every: it checks the rows of pairs, which check=False turns off; give "
+                "one or the other"
+            )
     if ground_every is not None:
         ground_every = positive_whole(ground_every, "ground_every", "a positive number of pairs")
         if calib is None:
@@ -1419,6 +1425,12 @@ def cmd_stream(args: argparse.Namespace) -> int:
         raise ValueError(
             f"{' and '.join(given)}: {'they place' if len(given) > 1 else 'it places'} the live "
             "view, which --no-display turns off; give one or the other"
+        )
+    if args.no_check and args.check_every is not None:
+        # refused before any open, not ignored: no pair was checked, the summary's checks []
+        raise ValueError(
+            "--check-every: it checks the rows of pairs, which --no-check turns off; give one "
+            "or the other"
         )
     if args.no_tf and not args.bag:  # refused before any open, not ignored
         raise ValueError("--no-tf leaves /tf out of a --bag: give --bag DIR")
