@@ -1890,6 +1890,45 @@ def test_run_stream_refuses_a_disparity_range_that_is_no_number_before_any_grab(
     assert rig.count == 0
 
 
+def test_run_stream_refuses_the_wrong_objects_by_name_before_any_grab() -> None:
+    """A calib.txt's path failed with "'str' object has no attribute 'rectified'" once a pair
+    was taken off the camera, temporal=8 (capture's temporal is a count) with "'int' object has
+    no attribute 'frames'", a callback that is none with "'int' object is not callable" after
+    the first pair was matched, fill="no" after a grab. Each is a TypeError naming it now,
+    before any grab."""
+    for kw, said in (
+        (
+            {"calib": "calib.txt"},
+            "calib: got the path 'calib.txt', not a calibration: read it first "
+            "(stereovision.Calibration.from_file(path))",
+        ),
+        (
+            {"homographies": Path("h.json")},
+            "homographies: got the path 'h.json', not the homographies: read them first "
+            "(stereovision.uncalibrated.UncalibratedRectification.load(path))",
+        ),
+        (
+            {"homographies": 3},
+            "homographies: expected a stereovision.uncalibrated.UncalibratedRectification, got int",
+        ),
+        (
+            {"temporal": 8},
+            "temporal: expected a stereovision.TemporalFilter, got int (a filter averaging up "
+            "to 8 frames: TemporalFilter(max_frames=8))",
+        ),
+        ({"temporal": True}, "temporal: expected a stereovision.TemporalFilter, got bool"),
+        ({"fill": "no"}, "fill: expected True, False or None, got 'no'"),
+        ({"refine": 1}, "refine: expected True, False or None, got 1"),
+        ({"on_result": 5}, "on_result: expected a callable, or None, got 5"),
+        ({"on_report": "print"}, "on_report: expected a callable, or None, got 'print'"),
+    ):
+        for pipelined in (False, True):
+            rig = _FakeRig([_frame(0)])
+            with pytest.raises(TypeError) as err:
+                run_stream(rig, max_disparity=8, pipelined=pipelined, **kw)  # type: ignore[arg-type]
+            assert (str(err.value), rig.count) == (said, 0)
+
+
 def test_a_window_reports_its_own_pairs_per_second() -> None:
     """A per-second report's fps is its window's pairs over its length, not the run's total."""
     from stereovision.stream import _Done, _window_report

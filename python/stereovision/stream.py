@@ -42,11 +42,14 @@ from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
 from stereovision._validate import (
     HELD_WARNINGS,
+    _shown,
     finite_number,
     first_line,
     number_shown,
+    path_given,
     positive_whole,
     real_number,
+    require,
     too_large_for_float,
     user_stacklevel,
     whole_value,
@@ -953,7 +956,9 @@ def run_stream(
         If ``frames`` or ``max_disparity`` is not positive, ``method`` is unknown (before any
         grab), or the calibration does not fit the frames.
     TypeError
-        If ``max_disparity`` is not a number (``"64"``, True; before any grab).
+        Before any grab: if ``max_disparity`` is not a number (``"64"``, True), ``fill`` or
+        ``refine`` not a bool, a callback not callable, or ``calib``, ``homographies`` or
+        ``temporal`` not what they name (a calibration file's path, ``temporal=8``).
     """
     from stereovision.depth import (
         METHODS,
@@ -973,7 +978,7 @@ def run_stream(
         shown = too_large_for_float(report_period, why=False) or repr(report_period)
         raise ValueError(f"report_period: expected a number of seconds >= 0, got {shown}")
     if max_disparity is not None:
-        # refused before any grab, as batch refuses it: "64" failed in the comparison below
+        # refused before any grab, as batch refuses it: "64" failed in its comparison with 0
         # ("'<=' not supported between instances of 'str' and 'int"), and NaN, inf, True or a
         # timedelta passed it, refused by depth_map once a pair was taken off the camera
         _refuse_range_types(max_disparity, 0)
@@ -982,11 +987,8 @@ def run_stream(
         if not (math.isfinite(max_disparity) and max_disparity > 0):
             given = number_shown(max_disparity)
             raise ValueError(f"max_disparity: expected a positive number, got {given}")
-    if homographies is not None:
-        if calib is not None:
-            raise ValueError("homographies and calib: give one way to rectify the pairs")
-        if max_disparity is None:  # 0 passed as "none given", where it is refused without them
-            max_disparity = homographies.max_disparity
+    if homographies is not None and calib is not None:
+        raise ValueError("homographies and calib: give one way to rectify the pairs")
     # usage errors before the first grab (the read ahead below takes a pair off the camera)
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
@@ -1001,6 +1003,21 @@ def run_stream(
         ground_every = positive_whole(ground_every, "ground_every", "a positive number of pairs")
         if calib is None:
             raise ValueError("ground_every: the floor is found in metres; give a calibration")
+    _refuse_wrong_objects(
+        calib,
+        homographies,
+        temporal,
+        {"fill": fill, "refine": refine},
+        {
+            "on_report": on_report,
+            "on_result": on_result,
+            "on_stamped_result": on_stamped_result,
+            "on_ground": on_ground,
+        },
+    )
+    if homographies is not None and max_disparity is None:
+        # 0 was taken as "none given", where it is refused without them
+        max_disparity = homographies.max_disparity
     stopped: str | None = None  # Ctrl-C or SIGTERM while the first pair was read ahead
     if calib is not None and getattr(camera, "count", None) == 0:
         # fitted to the first pair delivered, not to the mode the driver reports (a driver
@@ -1212,6 +1229,50 @@ def run_stream(
             "noise_sigma": round(filtered[2], 3) if filtered[0] else math.nan,
         },
     )
+
+
+def _refuse_wrong_objects(
+    calib: Any,
+    homographies: Any,
+    temporal: Any,
+    flags: dict[str, Any],
+    callbacks: dict[str, Any],
+) -> None:
+    """A TypeError naming the argument of :func:`run_stream` given the wrong object, before any
+    grab: a calib.txt's path failed with "'str' object has no attribute 'rectified'" once a
+    pair was taken off the camera, ``temporal=8`` (capture's ``temporal`` is a count of frames)
+    with "'int' object has no attribute 'frames'", ``on_result=print_it()`` with "'NoneType'
+    object is not callable" after the first pair was matched."""
+    from stereovision.temporal import TemporalFilter
+
+    if calib is not None:
+        require(calib, "Calibration", "calib")
+    if homographies is not None and not callable(getattr(homographies, "rectify", None)):
+        path = path_given(homographies)
+        raise TypeError(
+            f"homographies: got the path {path!r}, not the homographies: read them first "
+            "(stereovision.uncalibrated.UncalibratedRectification.load(path))"
+            if path is not None
+            else "homographies: expected a stereovision.uncalibrated.UncalibratedRectification,"
+            f" got {type(homographies).__name__}"
+        )
+    if temporal is not None and not isinstance(temporal, TemporalFilter):
+        count = whole_value(temporal)
+        hint = (
+            f" (a filter averaging up to {count} frames: TemporalFilter(max_frames={count}))"
+            if count is not None
+            else ""
+        )
+        raise TypeError(
+            f"temporal: expected a stereovision.TemporalFilter, got {type(temporal).__name__}"
+            + hint
+        )
+    for name, flag in flags.items():  # "no" was true (depth_map refused it after a grab)
+        if flag is not None and not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"{name}: expected True, False or None, got {_shown(flag)}")
+    for name, fn in callbacks.items():
+        if fn is not None and not callable(fn):
+            raise TypeError(f"{name}: expected a callable, or None, got {_shown(fn)}")
 
 
 def _note_noise(left: np.ndarray, averaging: bool) -> float:
