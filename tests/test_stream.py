@@ -3391,3 +3391,20 @@ def test_check_every_with_no_check_is_refused_before_any_open(
         "stereovision: error: --check-every: it checks the rows of pairs, which --no-check turns "
         "off; give one or the other\n"
     )
+
+
+@pytest.mark.parametrize("pipelined", [False, True])
+def test_a_reused_temporal_filter_reports_the_restarts_of_its_own_run(pipelined: bool) -> None:
+    """A TemporalFilter reused from a stream before (reset()'s note allows it): the summary's
+    restarts were the filter's over both runs (a still view that restarted once, on its first
+    pair against the run before's mean, said 4, the first run's 3 with it). They are the run's."""
+    from stereovision.temporal import TemporalFilter
+
+    tf = TemporalFilter(max_frames=4)
+    kw: dict[str, Any] = {"max_disparity": 8, "check": False, "temporal": tf}
+    moving = run_stream(_FakeRig([_frame(i) for i in range(4)]), pipelined=False, **kw)  # type: ignore[arg-type]
+    assert moving.temporal is not None and moving.temporal["restarts"] == 3 == tf.restarts
+    still = run_stream(_FakeRig([_frame(9)] * 4), pipelined=pipelined, **kw)  # type: ignore[arg-type]
+    assert still.temporal is not None
+    assert (still.temporal["restarts"], tf.restarts) == (1, 4)
+    assert still.temporal["frames_averaged"] == 2.5

@@ -212,11 +212,12 @@ class StreamReport:
         (:func:`~stereovision.temporal.noise_sigma`; NaN when no pair came).
     temporal : dict or None
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
-        the pairs of the frames in a pixel's mean), ``restarts`` (pairs on which the rig or
-        scene moved) and ``noise_sigma`` (its last noise estimate, grey levels; NaN when it
-        saw no frame), as of the last pair counted in :attr:`frames`. The filter itself also
-        took the pairs that were not: the one whose output failed, and those grabbed ahead
-        when pipelined (its own ``frames`` and ``restarts`` can be higher).
+        the pairs of the frames in a pixel's mean), ``restarts`` (pairs of this run on which
+        the rig or scene moved, not those of an earlier run of the same filter) and
+        ``noise_sigma`` (its last noise estimate, grey levels; NaN when it saw no frame), as
+        of the last pair counted in :attr:`frames`. The filter itself also took the pairs that
+        were not: the one whose output failed, and those grabbed ahead when pipelined (its own
+        ``frames`` and ``restarts`` can be higher).
     error : str or None
         With ``ended`` ``"source failed"`` or ``"output failed"``: the error (None otherwise).
     density : float
@@ -1042,6 +1043,11 @@ def run_stream(
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
     kw: dict[str, Any] = {"refine": refine, "method": method, "fill": fill}
+    # the temporal filter as it came, before the grab thread can take a pair: a filter reused
+    # from a stream before (as reset()'s note allows) said that stream's restarts as this one's
+    # (4 restarts on a still view that restarted once, 3 of them the run before)
+    filtered = None if temporal is None else (temporal.frames, temporal.restarts, temporal.sigma)
+    restarts_before = 0 if filtered is None else filtered[1]
     stop = threading.Event()  # the end of the stream, for a grab thread left behind
     source: Iterator[_Pair | _Note] = (
         iter(())
@@ -1084,8 +1090,7 @@ def run_stream(
 
     tally = _Tally()
     noise = math.nan  # the first left frame's noise
-    # the temporal filter as of the last pair counted (before the first: as it came)
-    filtered = None if temporal is None else (temporal.frames, temporal.restarts, temporal.sigma)
+    # the temporal filter as of the last pair counted (before the first: as it came, above)
     checks: list[dict[str, Any]] = []
     grounds: list[dict[str, Any]] = []
     first_plane: list[Any] = []  # the first floor found, for the mount check
@@ -1224,7 +1229,7 @@ def run_stream(
         if filtered is None
         else {
             "frames_averaged": round(tally.mean("averaged"), 3),
-            "restarts": filtered[1],
+            "restarts": filtered[1] - restarts_before,
             # its starting 0.0 before any frame: a noise never measured (NaN, JSON null)
             "noise_sigma": round(filtered[2], 3) if filtered[0] else math.nan,
         },
