@@ -3408,3 +3408,32 @@ def test_a_reused_temporal_filter_reports_the_restarts_of_its_own_run(pipelined:
     assert still.temporal is not None
     assert (still.temporal["restarts"], tf.restarts) == (1, 4)
     assert still.temporal["frames_averaged"] == 2.5
+
+
+def test_the_view_refuses_a_disparity_of_another_size_than_its_left_image(
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """FrameServer.update(left, disparity) with a disparity of another size (matched at half
+    size) was taken, then every request failed in the server's thread: no answer, NumPy's
+    hstack traceback on stderr. It is refused in the caller's thread now, the view kept."""
+    left = np.zeros((40, 60, 3), np.uint8)
+    server = FrameServer("127.0.0.1", 0)
+    try:
+        server.update(left, np.zeros((40, 60), np.float32), 16)
+        for disparity, shape in (
+            (np.zeros((20, 30), np.float32), "(20, 30)"),
+            (np.zeros((40, 60, 1), np.float32), "(40, 60, 1)"),
+        ):
+            with pytest.raises(ValueError) as err:
+                server.update(left, disparity, 16)
+            assert str(err.value) == (
+                f"disparity: expected a map of the left image's 60x40 px, got shape {shape}"
+            )
+        with pytest.raises(ValueError, match=re.escape("left: expected an (H, W) or (H, W, C)")):
+            server.update(np.zeros(5, np.uint8), np.zeros((40, 60), np.float32), 16)
+        status, ctype, body = _get(server.url + "frame.jpg")
+        assert (status, ctype) == (200, "image/jpeg")
+        assert cv2.imdecode(np.frombuffer(body, np.uint8), cv2.IMREAD_COLOR).shape == (40, 120, 3)
+    finally:
+        server.close()
+    assert "Traceback" not in capfd.readouterr().err

@@ -475,7 +475,23 @@ class FrameServer:
         return self._closed
 
     def update(self, left: np.ndarray, disparity: np.ndarray, max_disparity: float) -> None:
-        """Publish a result (kept by reference: encoded only when a client asks)."""
+        """Publish a result (kept by reference: encoded only when a client asks).
+
+        Raises
+        ------
+        ValueError
+            If ``left`` is no image, or ``disparity`` not a 2-D map of its size: the frame is
+            composed side by side in the server's thread, where every request then failed (no
+            answer, a traceback on stderr).
+        """
+        if np.ndim(left) not in (2, 3):
+            raise ValueError(f"left: expected an (H, W) or (H, W, C) image, got {np.shape(left)}")
+        lh, lw = np.shape(left)[:2]
+        if np.ndim(disparity) != 2 or np.shape(disparity) != (lh, lw):
+            raise ValueError(
+                f"disparity: expected a map of the left image's {lw}x{lh} px, got shape "
+                f"{np.shape(disparity)}"
+            )
         with self._cond:
             self._latest = (left, disparity, float(max_disparity))
             self._seq += 1
