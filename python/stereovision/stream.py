@@ -6,9 +6,10 @@ queue while the main thread computes the depth of the current one. The Rust kern
 GIL, so the producer's decoding and remapping overlap the matching instead of adding to it.
 
 Every second a report is emitted: frames per second over that second, the mean time of each stage
-(``grab``, ``rectify``, ``prepare``, ``match``, ``fill``, ``triangulate``), the mean latency from
-the start of a pair's grab to its depth, the time the matcher waited for the producer, and the
-left/right grab skew. ``--json`` prints each report as one JSON object on stdout, then a final
+(``grab``, ``rectify``, ``temporal``, ``prepare``, ``match``, ``fill``, ``triangulate``), the
+mean latency from the start of a pair's grab to its depth, the time the matcher waited for the
+producer, the left/right grab skew, the share of pixels with a disparity and the frames averaged
+per pixel. ``--json`` prints each report as one JSON object on stdout, then a final
 summary object (``"summary": true``).
 
 The result is shown by serving it over HTTP (OpenCV's own windows are not part of the headless
