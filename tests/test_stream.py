@@ -3437,3 +3437,31 @@ def test_the_view_refuses_a_disparity_of_another_size_than_its_left_image(
     finally:
         server.close()
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_the_view_refuses_a_colour_scale_that_is_no_positive_number(
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """FrameServer.update(..., max_disparity=nan) (np.nanmax of a map without a value) was
+    taken: every frame's colours were the cast of NaN, with NumPy's "invalid value encountered
+    in cast" from the server's thread; -5 or "16" passed too. Refused in the caller's thread."""
+    left = np.zeros((8, 8, 3), np.uint8)
+    disparity = np.full((8, 8), 4.0, np.float32)
+    server = FrameServer("127.0.0.1", 0)
+    try:
+        for top, said in (
+            (math.nan, "max_disparity: expected a finite number, got nan"),
+            (None, "max_disparity: expected a finite number, got None"),
+            ("16", "max_disparity: expected a finite number, got '16'"),
+            (-5.0, "max_disparity: expected a positive number, got -5.0"),
+            (0, "max_disparity: expected a positive number, got 0"),
+        ):
+            with pytest.raises(ValueError) as err:
+                server.update(left, disparity, top)  # type: ignore[arg-type]
+            assert str(err.value) == said
+        assert _get(server.url + "frame.jpg")[0] == 503  # nothing was published
+        server.update(left, disparity, np.float32(8))
+        assert _get(server.url + "frame.jpg")[:2] == (200, "image/jpeg")
+    finally:
+        server.close()
+    assert "RuntimeWarning" not in capfd.readouterr().err

@@ -483,8 +483,14 @@ class FrameServer:
         ValueError
             If ``left`` is no image, or ``disparity`` not a 2-D map of its size: the frame is
             composed side by side in the server's thread, where every request then failed (no
-            answer, a traceback on stderr).
+            answer, a traceback on stderr). If ``max_disparity``, the top of the colour scale, is
+            not a positive number.
         """
+        # NaN (np.nanmax of a map without a value) coloured every pixel of every frame as the
+        # cast of NaN, with NumPy's RuntimeWarning from the server's thread
+        top = finite_number(max_disparity, "max_disparity")
+        if not top > 0:
+            raise ValueError(f"max_disparity: expected a positive number, got {max_disparity!r}")
         if np.ndim(left) not in (2, 3):
             raise ValueError(f"left: expected an (H, W) or (H, W, C) image, got {np.shape(left)}")
         lh, lw = np.shape(left)[:2]
@@ -494,7 +500,7 @@ class FrameServer:
                 f"{np.shape(disparity)}"
             )
         with self._cond:
-            self._latest = (left, disparity, float(max_disparity))
+            self._latest = (left, disparity, top)
             self._seq += 1
             self._cond.notify_all()
 
