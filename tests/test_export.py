@@ -1694,3 +1694,34 @@ def test_mesh_ply_refuses_what_is_not_a_mesh(tmp_path):
     ):
         export.write_mesh_ply(tmp_path / "m.ply", np.zeros((3, 3)))
     assert not (tmp_path / "m.ply").exists()
+
+
+def test_png_writers_name_swapped_arguments_and_a_file_name_for_the_map(result, tmp_path):
+    """``write_depth_png(res, "d.png")`` (the arguments swapped) took the file name for the map:
+    "could not convert string to float: 'd.png'", naming neither; the path is checked first, as
+    the other writers do, and a file name given for the map is named. Nothing is written."""
+    import warnings
+
+    for writer in (export.write_depth_png, export.write_disparity_png):
+        with pytest.raises(
+            TypeError, match=r"^path: expected a str or os.PathLike file name, got DepthResult$"
+        ):
+            writer(result, str(tmp_path / "d.png"))
+    for writer, name in (
+        (export.write_depth_png, "depth"),
+        (export.write_disparity_png, "disparity"),
+    ):
+        with pytest.raises(
+            TypeError,
+            match=rf"^{name}: expected an \(H, W\) array, got the file name 'm\.npy': read the "
+            "map first$",
+        ):
+            writer(tmp_path / "d.png", "m.npy")
+    with pytest.raises(TypeError, match=r"^depth: expected an \(H, W\) array, got the file name"):
+        export.encode_depth_png(tmp_path / "m.npy")
+    # the suffix is refused before the map is looked at: no all-0 warning first
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"a 16-bit depth image is written as \.png"):
+            export.write_depth_png(tmp_path / "d.jpg", np.full((2, 2), 1500.0))
+    assert list(tmp_path.iterdir()) == []

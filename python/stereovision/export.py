@@ -844,10 +844,17 @@ def _png16_bytes(values: npt.NDArray[np.float64], what: str) -> bytes:
     return bytes(buf.tobytes())
 
 
-def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
+def _png16_dest(path: PathLike, what: str) -> Path:
+    """The file a 16-bit PNG writer writes, checked before its map is: with the arguments
+    swapped (``write_depth_png(res, "d.png")``) the file name was taken for the map, "could
+    not convert string to float: 'd.png'", naming neither."""
     dest = as_path(path, file=True)
     if dest.suffix.lower() != ".png":
         raise ValueError(f"{path}: a 16-bit {what} image is written as .png (lossless)")
+    return dest
+
+
+def _png16(dest: Path, values: npt.NDArray[np.float64], what: str) -> Path:
     data = _png16_bytes(values, what)
     with atomic_write(dest) as fh:
         fh.write(data)
@@ -873,7 +880,7 @@ def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> by
     ------
     TypeError
         If ``scale`` is not a real number (a string, a bool), or ``depth`` is a whole
-        :class:`~stereovision.DepthResult` (its ``depth`` is meant).
+        :class:`~stereovision.DepthResult` (its ``depth`` is meant) or a file name.
     ValueError
         If ``scale`` is not positive and finite, or ``depth`` is not a non-empty 2-D map.
     """
@@ -903,6 +910,12 @@ def _check_scale(scale: float) -> float:
 
 def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
     scale = _check_scale(scale)
+    if isinstance(arr, (str, bytes, os.PathLike)):
+        # a file name for the map: NumPy's "could not convert string to float: 'depth.npy'"
+        shown = str(os.fsdecode(arr))
+        raise TypeError(
+            f"{name}: expected an (H, W) array, got the file name {shown!r}: read the map first"
+        )
     if isinstance(arr, np.ndarray) and arr.ndim == 2:  # before the float64 copy
         check_index_range(arr.shape, name, "map")
     a = np.asarray(arr, dtype=np.float64)
@@ -967,15 +980,17 @@ def write_depth_png(
         A result without calibration (no depth), a map that is not 2-D, or a ``scale`` that is
         not positive and finite.
     TypeError
-        A ``scale`` that is not a real number (a string, a bool).
+        A ``scale`` that is not a real number (a string, a bool), a ``path`` that is no file
+        name (a DepthResult: the arguments swapped), or a file name for ``depth``.
     """
     from stereovision.depth import DepthResult
 
+    dest = _png16_dest(path, "depth")
     if isinstance(depth, DepthResult):
         if depth.depth is None:
             raise ValueError(NO_DEPTH.format(what="depth"))
-        return _png16(path, _scaled_u16(depth.depth, scale, "depth"), "depth")
-    return _png16(path, _scaled_u16(depth, scale, "depth"), "depth")
+        return _png16(dest, _scaled_u16(depth.depth, scale, "depth"), "depth")
+    return _png16(dest, _scaled_u16(depth, scale, "depth"), "depth")
 
 
 def write_disparity_png(path: PathLike, disparity: DepthResult | npt.ArrayLike) -> Path:
@@ -1000,11 +1015,15 @@ def write_disparity_png(path: PathLike, disparity: DepthResult | npt.ArrayLike) 
     ------
     ValueError
         A map that is not 2-D.
+    TypeError
+        A ``path`` that is no file name (a DepthResult: the arguments swapped), or a file name
+        for ``disparity``.
     """
     from stereovision.depth import DepthResult
 
+    dest = _png16_dest(path, "disparity")
     d = disparity.disparity if isinstance(disparity, DepthResult) else disparity
-    return _png16(path, _scaled_u16(d, DISPARITY_PNG_SCALE, "disparity"), "disparity")
+    return _png16(dest, _scaled_u16(d, DISPARITY_PNG_SCALE, "disparity"), "disparity")
 
 
 def _read_png16(path: PathLike, scale: float, what: str) -> npt.NDArray[np.float32]:
