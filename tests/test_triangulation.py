@@ -471,6 +471,11 @@ def test_undistortion_limits_are_checked(key: str, value: object, says: str) -> 
     assert triangulate(xl, xr, c).valid.all()
     with pytest.raises(ValueError, match=re.escape(says)):
         triangulate(xl, xr, c, **{key: value})
+    # undistort_normalized, public too, took them unchecked: the same NaN for every point (or
+    # UFuncTypeError, "'float' object cannot be interpreted as an integer" for 2.5)
+    assert undistort_normalized(xl, c.K1, c.D1)[1].all()
+    with pytest.raises(ValueError, match=re.escape(says)):
+        undistort_normalized(xl, c.K1, c.D1, **{key: value})
 
 
 # ------------------------------------------------------------------ mutation audit (value tests)

@@ -131,9 +131,14 @@ def undistort_normalized(
     ------
     ValueError
         On a bad shape, a ``K`` that is no 3 x 3 camera matrix (non-finite, or a focal length
-        not positive), non-finite or non-zero tilt coefficients.
+        not positive), non-finite or non-zero tilt coefficients, a ``max_iter`` that is not an
+        integer >= 1 or a ``tol`` that is not a positive finite number.
     """
     p = _points(pts, "pts")
+    # as triangulate checks them: 0 or -5 iterations, a tol of 0, -1 or NaN made every point NaN
+    # without a word (never converged), tol "1" was NumPy's UFuncTypeError from the comparison
+    max_iter = int_in_range(max_iter, "max_iter", 1, 2**31 - 1)
+    tol = positive_finite(tol, "tol")
     Km = np.asarray(K, dtype=np.float64)
     # a (2, 2) K was NumPy's IndexError, a zero focal length a RuntimeWarning and every point
     # inf, a NaN coefficient every point NaN: each without naming what was wrong
