@@ -9,10 +9,10 @@ Conventions shared with pyvista, Open3D, MeshLab and PCL:
   g << 8 | b``: opaque, as ``pcl::PointXYZRGB`` writes it); the cloud keeps the image layout
   (``WIDTH`` = image width, ``HEIGHT`` = image height, row-major), pixels without depth are NaN
   points (``is_dense`` false).
-- NPZ: ``depth``, ``confidence``, ``disparity`` (H, W float32, NaN = none), ``K`` (3x3),
-  ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``
-  (int64; float64 for a fractional range), ``min_disparity`` (float64), ``depth_sigma`` (H, W
-  float32, metres).
+- NPZ: ``depth``, ``disparity`` (H, W float32, NaN = none), ``confidence`` (H, W float32,
+  0-1, 0 = none), ``K`` (3x3), ``baseline`` (metres), ``doffs`` (pixels), ``image_size``
+  (W, H), ``method``, ``max_disparity`` (int64; float64 for a fractional range),
+  ``min_disparity`` (float64), ``depth_sigma`` (H, W float32, metres, NaN = none).
 - 16-bit PNG: depth in millimetres (ROS ``16UC1``, TUM RGB-D, Open3D), disparity times 256
   (KITTI); 0 = none.
 
