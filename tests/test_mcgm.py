@@ -729,6 +729,18 @@ def test_matches_are_no_array_for_numpy() -> None:
     np.testing.assert_array_equal(np.asarray(m.to_array())[:, 0], [10, 20, 30])
 
 
+def test_matches_without_a_trace_or_stats() -> None:
+    """energy_trace=None was a trace of one NaN energy, stats=None an AttributeError at the
+    first selection ('NoneType' object has no attribute 'items'); both are none now, and stats
+    that are no dict are named."""
+    a = [1.0, 2.0]
+    m = sv.Matches(a, a, a, a, a, (4, 4), energy_trace=None, stats=None)
+    assert m.energy_trace.shape == (0,) and m.stats == {}
+    assert m[:1].stats == {} and len(m[:1]) == 1
+    with pytest.raises(TypeError, match=r"^stats: expected a dict of the run's counters, got list"):
+        sv.Matches(a, a, a, a, a, (4, 4), stats=[("n", 2)])
+
+
 def test_matches_rasters_are_left_minus_right_at_the_rounded_left_pixel() -> None:
     m = _three()
     assert (m.dispx[5, 10], m.dispx[6, 20], m.dispx[7, 30]) == (2.5, 2.0, 0.0)

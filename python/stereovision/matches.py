@@ -112,9 +112,16 @@ class Matches:
             raise ValueError(f"image_shape must be positive (H, W) integers, got {shape!r}")
         h, w = int(dims[0]), int(dims[1])
         object.__setattr__(self, "image_shape", (h, w))
-        object.__setattr__(
-            self, "energy_trace", np.asarray(self.energy_trace, dtype=np.float64).reshape(-1)
-        )
+        # None is no trace and no stats: np.asarray(None, float) made a trace of one NaN
+        # energy, and None as the stats an AttributeError at the first selection (m[:5])
+        trace = np.zeros(0) if self.energy_trace is None else self.energy_trace
+        object.__setattr__(self, "energy_trace", np.asarray(trace, dtype=np.float64).reshape(-1))
+        if self.stats is None:
+            object.__setattr__(self, "stats", {})
+        elif not isinstance(self.stats, dict):
+            raise TypeError(
+                f"stats: expected a dict of the run's counters, got {type(self.stats).__name__}"
+            )
 
     def __len__(self) -> int:
         return int(self.xl.shape[0])
