@@ -109,6 +109,12 @@ def test_undistort_skew() -> None:
     got, ok = undistort_normalized(px, K, np.zeros(5))
     assert ok.all()
     np.testing.assert_allclose(got, xy, atol=1e-14)
+    # None is no distortion, as OpenCV takes it: it was "D: expected 4, 5, 8, 12 or 14
+    # coefficients, got 1" (np.asarray(None) is one NaN)
+    for none in (None, []):
+        again, ok = undistort_normalized(px, K, none)
+        assert ok.all()
+        np.testing.assert_array_equal(again, got)
 
 
 def test_undistort_flags_non_convergence() -> None:

@@ -94,7 +94,7 @@ def _points(x: npt.ArrayLike, name: str) -> F64:
 def undistort_normalized(
     pts: npt.ArrayLike,
     K: npt.ArrayLike,
-    D: npt.ArrayLike,
+    D: npt.ArrayLike | None,
     max_iter: int = UNDISTORT_MAX_ITER,
     tol: float = UNDISTORT_TOL,
 ) -> tuple[F64, npt.NDArray[np.bool_]]:
@@ -111,9 +111,9 @@ def undistort_normalized(
         ``(N, 2)`` pixel coordinates ``(x, y)``.
     K : array_like
         ``(3, 3)`` camera matrix.
-    D : array_like
+    D : array_like or None
         ``(n,)`` OpenCV distortion coefficients (``n`` in 4, 5, 8, 12, 14; the tilt terms of
-        the 14-coefficient model must be zero).
+        the 14-coefficient model must be zero); None or empty: no distortion.
     max_iter : int
         Iteration cap.
     tol : float
@@ -148,7 +148,8 @@ def undistort_normalized(
             f"got shape {Km.shape}" + (f": {Km.tolist()}" if Km.size <= 9 else "")
         )
     d = np.zeros(14)
-    dist = np.asarray(D, dtype=np.float64).ravel()
+    # None is no distortion, as OpenCV takes it (np.asarray(None) is one NaN: "got 1")
+    dist = np.zeros(0) if D is None else np.asarray(D, dtype=np.float64).ravel()
     if dist.size not in (0, 4, 5, 8, 12, 14):
         raise ValueError(f"D: expected 4, 5, 8, 12 or 14 coefficients, got {dist.size}")
     if not np.isfinite(dist).all():
