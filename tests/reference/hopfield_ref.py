@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 BORDER = 3
 SIM_RADIUS = 3
@@ -142,13 +143,16 @@ def zncc_curve(
     out = np.zeros(d_hi + 1)
     if tn < min_n2:
         return out
-    for d in range(d_hi + 1):
-        xr = x - d
-        r = right[yr + y0 : yr + y1 + 1, xr + x0 : xr + x1 + 1].astype(np.float64)
-        r = r - r.mean()
-        rn = float((r * r).sum())
-        if rn >= min_n2:
-            out[d] = float((t * r).sum()) / np.sqrt(tn * rn)
+    # Row d: the right window at x - d, flattened (one contiguous row each, so every row sums
+    # in the same order as one window's ``.sum()``: the values of a loop over d, bit for bit).
+    band = right[yr + y0 : yr + y1 + 1, x - d_hi + x0 : x + x1 + 1]
+    wins = sliding_window_view(band, (y1 - y0 + 1, x1 - x0 + 1))[0, ::-1]
+    r = np.ascontiguousarray(wins, dtype=np.float64).reshape(d_hi + 1, n)
+    r = r - r.mean(axis=1, keepdims=True)
+    rn = (r * r).sum(axis=1)
+    num = (t.reshape(1, n) * r).sum(axis=1)
+    ok = rn >= min_n2
+    out[ok] = num[ok] / np.sqrt(tn * rn[ok])
     return out
 
 
@@ -188,9 +192,10 @@ def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: d
             c = full[d]
             ok_lo = d == d_min or c >= full[d - 1]
             ok_hi = d == d_hi or c > full[d + 1]
-            # an undefined ZNCC (a textureless window) reads 0 but is no candidate at any s_min
-            defined = _textured(left, x, y) and _textured(right, x - d, y)
-            if c >= p["s_min"] and ok_lo and ok_hi and defined:
+            # an undefined ZNCC (a textureless window) reads 0 but is no candidate at any s_min;
+            # the window tests come last, as they cost the most
+            peak = c >= p["s_min"] and ok_lo and ok_hi
+            if peak and _textured(left, x, y) and _textured(right, x - d, y):
                 lo, hi = max(d - p["edge_tol"], d_min), min(d + p["edge_tol"], d_hi)
                 halves_fail = sum(
                     (0 if b is not None and c[lo : hi + 1].max() >= c[b] - p["edge_margin"] else 1)
