@@ -241,9 +241,11 @@ def build_weights(neurons: list[dict], p: dict) -> list[list[tuple[int, float]]]
     points = sorted({n["point"] for n in neurons})
     pxy = {}
     members: dict[int, list[int]] = {}
+    same_right: dict[tuple[int, int], list[int]] = {}  # neurons by right pixel, in order
     for a, n in enumerate(neurons):
         pxy[n["point"]] = (n["xl"], n["yl"])
         members.setdefault(n["point"], []).append(a)
+        same_right.setdefault((n["xr"], n["yr"]), []).append(a)
     nbrs = {
         q: [
             r
@@ -258,8 +260,8 @@ def build_weights(neurons: list[dict], p: dict) -> list[list[tuple[int, float]]]
         for b in members[na["point"]]:
             if b != a:
                 row.append((b, -p["B"]))
-        for b, nb in enumerate(neurons):
-            if nb["point"] != na["point"] and (nb["xr"], nb["yr"]) == (na["xr"], na["yr"]):
+        for b in same_right[(na["xr"], na["yr"])]:
+            if neurons[b]["point"] != na["point"]:
                 row.append((b, -p["B"]))
         q = na["point"]
         for r in nbrs[q]:
