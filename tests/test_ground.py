@@ -2012,6 +2012,31 @@ def test_a_scan_from_0_to_2_pi_sees_the_right_side() -> None:
     assert np.count_nonzero(np.isfinite(full.ranges)) == 2
 
 
+def test_a_full_turn_scan_fills_its_last_beam_as_its_first() -> None:
+    """A scan from -pi to pi (both ends: 361 beams of 1 degree) has its last beam where its
+    first looks, but every point behind went to beam 0 and the last beam was NaN; it now holds
+    the same range. Beams past a full turn (-3.2 to 3.2 rad), whose last ones were NaN
+    whatever stood there, are refused."""
+    from stereovision.ground import laser_scan
+
+    plane, _ = _level_floor()
+    behind = [(r * math.cos(a), r * math.sin(a), 0.5) for a in (3.14, -3.14) for r in (2, 3)]
+    pts = _camera_points(behind)
+    inc = math.radians(1)
+    scan = laser_scan(
+        pts, plane, angle_min=-math.pi, angle_max=math.pi, angle_increment=inc, min_points=2
+    )
+    assert len(scan.ranges) == 361
+    assert scan.ranges[0] == pytest.approx(2.0) and scan.ranges[360] == pytest.approx(2.0)
+    assert np.count_nonzero(np.isfinite(scan.ranges)) == 2
+    with pytest.raises(
+        ValueError,
+        match=r"^angle_min, angle_max: beams from -3\.2 to 3\.18791 rad cover more than a full "
+        r"turn \(2 pi rad\)$",
+    ):
+        laser_scan(pts, plane, angle_min=-3.2, angle_max=3.2, angle_increment=inc)
+
+
 @pytest.mark.parametrize(
     ("directory", "says"),
     [

@@ -1294,9 +1294,9 @@ def laser_scan(
     ------
     ValueError
         For points not real or not of shape ``(..., 3)``, no angles (no ``calib`` and no
-        ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or
-        over 100000 beams, a bad height band or range (``range_max`` infinite too), or
-        ``min_points < 1``.
+        ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, beams over more than a full
+        turn, a non-positive increment or over 100000 beams, a bad height band or range
+        (``range_max`` infinite too), or ``min_points < 1``.
     TypeError
         If ``plane`` is not a :class:`GroundPlane`, or ``calib`` is given and is not a
         :class:`~stereovision.Calibration` (a path: read it with ``Calibration.from_file``).
@@ -1356,6 +1356,13 @@ def laser_scan(
     n = math.floor(beams + 1e-9) + 1
     if n > 100_000:
         raise ValueError(f"angle_increment: {n} beams; at most 100000")
+    if (n - 1) * inc > 2 * math.pi * (1 + 1e-9):
+        # the beams past a turn repeat directions the earlier ones hold: each point went to
+        # one of them only, and the later ones were NaN whatever stood there
+        raise ValueError(
+            f"angle_min, angle_max: beams from {a0:g} to {a0 + (n - 1) * inc:g} rad cover "
+            "more than a full turn (2 pi rad)"
+        )
     flat = pts.reshape(-1, 3)
     flat = flat[np.all(np.isfinite(flat), axis=1)]
     xyz = flat @ axes.T
@@ -1367,6 +1374,14 @@ def laser_scan(
     rel = np.arctan2(xyz[:, 1], xyz[:, 0]) - a0
     rel -= 2 * np.pi * np.floor((rel + inc / 2) / (2 * np.pi))
     beam = np.floor(rel / inc + 0.5).astype(np.int64)
+    # a scan of a full turn with both ends (-pi to pi, ROS's 361 beams of 1 degree): its last
+    # beam looks where its first does, but the turn above put every point there in beam 0
+    # and the last beam was NaN; a point is in each beam of its direction
+    again = np.floor((rel + 2 * np.pi) / inc + 0.5).astype(np.int64)
+    twice = (again < n) & (again != beam)
+    if twice.any():
+        beam = np.r_[beam, again[twice]]
+        dist, h = np.r_[dist, dist[twice]], np.r_[h, h[twice]]
     keep = (beam >= 0) & (beam < n) & (dist >= r0) & (dist <= r1)
     ranges = np.full(n, np.nan, np.float32)
     floor = keep & (np.abs(h) <= lo)
