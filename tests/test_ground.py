@@ -1060,6 +1060,29 @@ def test_a_plane_rebuilt_from_ground_json_works_as_the_fitted_one() -> None:
         GroundPlane([0.0, -1.0], 1.0, (0.0, 0.0, 0.0), plane.inliers, 1.0, 0.0)
 
 
+@pytest.mark.parametrize(
+    ("inliers", "says"),
+    [
+        (None, "None"),
+        (np.zeros((4, 4), np.uint8), "uint8 of shape (4, 4)"),
+        (np.zeros(4, bool), "bool of shape (4,)"),
+    ],
+)
+def test_a_plane_without_a_mask_is_refused_on_construction(inliers: object, says: str) -> None:
+    """inliers=None (a plane rebuilt from ground.json, which holds no mask) built, then repr
+    and support raised AttributeError "'NoneType' object has no attribute 'shape'"; a 0/1 mask
+    was the GUI's fancy index. They are refused when the plane is made."""
+    plane, _ = _level_floor()
+    with pytest.raises(ValueError) as exc:
+        GroundPlane(plane.normal, 1.0, (0.0, 0.0, 0.0), inliers, 1.0, 0.0)  # type: ignore[arg-type]
+    assert str(exc.value) == (
+        f"inliers: expected an (H, W) bool mask (all False if none), got {says}"
+    )
+    assert GroundPlane(plane.normal, 1.0, (0.0, 0.0, 0.0), plane.inliers, 1.0, 0.0).inliers is (
+        plane.inliers
+    )
+
+
 @pytest.mark.parametrize("value", ["1", True, None, [1.0]])
 @pytest.mark.parametrize("key", ["min_height", "max_height", "max_range"])
 def test_obstacle_mask_limits_must_be_numbers(key: str, value: object) -> None:

@@ -147,7 +147,8 @@ class GroundPlane:
     disparity_plane : tuple of float
         ``(a, b, c)`` with the floor's disparity ``d = a u + b v + c`` (pixels).
     inliers : numpy.ndarray
-        ``(H, W)`` bool: pixels whose disparity lies on the plane.
+        ``(H, W)`` bool: pixels whose disparity lies on the plane (a plane rebuilt from
+        :meth:`as_dict`'s figures needs one of its images' size: all False will do).
     inlier_share : float
         Share of the pixels with a disparity that lie on the plane.
     rms_px : float
@@ -177,6 +178,15 @@ class GroundPlane:
         if normal.shape != (3,):
             raise ValueError(f"normal: expected 3 numbers, got shape {normal.shape}")
         object.__setattr__(self, "normal", normal)
+        # None (no mask at hand: a plane rebuilt from ground.json) built, then repr and support
+        # were AttributeError "'NoneType' object has no attribute 'shape'"
+        mask = np.asarray(self.inliers)  # a fitted plane's: the same array
+        if mask.ndim != 2 or mask.dtype != np.bool_:
+            got = repr(self.inliers) if mask.ndim == 0 else f"{mask.dtype} of shape {mask.shape}"
+            raise ValueError(
+                f"inliers: expected an (H, W) bool mask (all False if none), got {got}"
+            )
+        object.__setattr__(self, "inliers", mask)
 
     @property
     def pitch_deg(self) -> float:
