@@ -1083,6 +1083,26 @@ def test_a_plane_without_a_mask_is_refused_on_construction(inliers: object, says
     )
 
 
+def test_the_static_transform_command_quotes_its_frames_and_refuses_no_frame() -> None:
+    """'base link' went into the command unquoted, two arguments to the shell ('base', 'link');
+    None was a frame named "None" and '' took --child-frame-id for the parent frame."""
+    import shlex
+
+    plane, _ = _level_floor()
+    args = shlex.split(plane.ros2_static_transform("base link", "cam;x"))
+    assert args[-4:] == ["--frame-id", "base link", "--child-frame-id", "cam;x"]
+    assert plane.ros2_static_transform().endswith(
+        "--frame-id base_footprint --child-frame-id stereo_left_optical"
+    )
+    for parent in ("", None, "/base"):
+        with pytest.raises(ValueError) as exc:
+            plane.ros2_static_transform(parent)  # type: ignore[arg-type]
+        assert str(exc.value) == (
+            "parent: expected a tf frame name (not empty, no leading '/', which tf2 refuses), "
+            f"got {parent!r}"
+        )
+
+
 @pytest.mark.parametrize("value", ["1", True, None, [1.0]])
 @pytest.mark.parametrize("key", ["min_height", "max_height", "max_range"])
 def test_obstacle_mask_limits_must_be_numbers(key: str, value: object) -> None:

@@ -314,14 +314,27 @@ class GroundPlane:
         Returns
         -------
         str
-            The command, one line.
+            The command, one line (a frame name the shell would split or read is quoted).
+
+        Raises
+        ------
+        ValueError
+            If ``parent`` or ``child`` is no tf frame name (not a string, empty, or with a
+            leading ``/``), as :class:`~stereovision.rosbag.BagWriter` refuses them.
         """
+        import shlex
+
+        from stereovision.rosbag import _frame_name
+
+        # 'base link' went out unquoted, which the shell split into two arguments; None was
+        # a frame named "None", '' took the next option for the frame
+        parent, child = _frame_name(parent, "parent"), _frame_name(child, "child")
         rot = floor_frame(self)  # floor <- camera: its columns are the camera's axes
         x, y, z, w = _quaternion(rot)
         return (
             "ros2 run tf2_ros static_transform_publisher --x 0 --y 0 "
             f"--z {self.height:.4f} --qx {x:.6f} --qy {y:.6f} --qz {z:.6f} --qw {w:.6f} "
-            f"--frame-id {parent} --child-frame-id {child}"
+            f"--frame-id {shlex.quote(parent)} --child-frame-id {shlex.quote(child)}"
         )
 
     def as_dict(self) -> dict[str, Any]:
