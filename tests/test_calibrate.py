@@ -285,6 +285,25 @@ def test_saved_calibration_loads_back_identical(
     fs.release()
 
 
+def test_report_write_through_a_link_to_nothing_or_under_a_file_says_so(
+    chessboard: tuple[Calibration, CalibrationReport], tmp_path: Path
+) -> None:
+    """A report/ link to a folder that is not there (an unmounted drive) was mkdir's bare
+    "[Errno 17] File exists", as if the folder were there, and a folder under a file
+    "[Errno 20] Not a directory"; both name what stands in the way (io.make_folder)."""
+    _, rep = chessboard
+    (tmp_path / "report").symlink_to(tmp_path / "drive" / "report")
+    (tmp_path / "notes").write_bytes(b"x")
+    for folder, says in (
+        ("report", f"report is a link to {tmp_path / 'drive' / 'report'}, which does not exist"),
+        ("notes/report", "notes is a file, not a folder"),
+    ):
+        with pytest.raises(NotADirectoryError) as exc:
+            rep.write(tmp_path / folder)
+        assert str(exc.value) == f"cannot make the folder {tmp_path / folder}: {tmp_path / says}"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes", "report"]
+
+
 def test_report_files(chessboard: tuple[Calibration, CalibrationReport], tmp_path: Path) -> None:
     _, rep = chessboard
     paths = rep.write(tmp_path / "report")

@@ -3531,6 +3531,29 @@ def test_live_board_corners_start_at_the_top_left_whichever_way_the_board_turns(
         assert c is not None and c[0].sum() < c[-1].sum()
 
 
+def test_save_pair_through_a_link_to_nothing_or_under_a_file_says_so(tmp_path: Path) -> None:
+    """A pairs/ link to a folder that is not there (an unmounted drive) was mkdir's bare
+    "[Errno 17] File exists", as if the folder were there, and a folder under a file
+    "[Errno 20] Not a directory"; both name what stands in the way (io.make_folder)."""
+    img = np.zeros((4, 6), np.uint8)
+    (tmp_path / "pairs").symlink_to(tmp_path / "drive" / "pairs")
+    (tmp_path / "notes").write_bytes(b"x")
+    for folder, says in (
+        ("pairs", f"pairs is a link to {tmp_path / 'drive' / 'pairs'}, which does not exist"),
+        ("notes/pairs", "notes is a file, not a folder"),
+    ):
+        with pytest.raises(NotADirectoryError) as exc:
+            save_pair(tmp_path / folder, 0, img, img)
+        assert str(exc.value) == f"cannot make the folder {tmp_path / folder}: {tmp_path / says}"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes", "pairs"]
+    with pytest.raises(FileExistsError) as fe:  # capture() stops on it: not a number taken
+        save_pair(tmp_path / "notes", 0, img, img)
+    assert (
+        str(fe.value)
+        == f"cannot write the pair into {tmp_path / 'notes'}: it is a file, not a folder"
+    )
+
+
 def test_save_pair_refuses_a_negative_or_fractional_index(tmp_path: Path) -> None:
     """save_pair(-1) wrote left_-001.png, a name no pair numbering reads (next_pair_index
     skipped it); 1.0 failed on the format code. Both are refused naming the index, before any

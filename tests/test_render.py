@@ -1761,6 +1761,23 @@ def test_write_render_and_render_outputs_refuse_a_bytes_folder_naming_it(result,
     assert not out.exists()
 
 
+def test_write_render_through_a_link_to_nothing_or_under_a_file_says_so(tmp_path):
+    """A render/ link to a folder that is not there (an unmounted drive) was mkdir's bare
+    "[Errno 17] File exists", as if the folder were there, and a folder under a file
+    "[Errno 20] Not a directory"; both name what stands in the way (io.make_folder)."""
+    img = np.zeros((4, 6, 3), np.uint8)
+    (tmp_path / "out").symlink_to(tmp_path / "drive" / "out")
+    (tmp_path / "notes").write_bytes(b"x")
+    for folder, says in (
+        ("out", f"out is a link to {tmp_path / 'drive' / 'out'}, which does not exist"),
+        ("notes/out", "notes is a file, not a folder"),
+    ):
+        with pytest.raises(NotADirectoryError) as exc:
+            render.write_render(img, tmp_path / folder)
+        assert str(exc.value) == f"cannot make the folder {tmp_path / folder}: {tmp_path / says}"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes", "out"]
+
+
 def test_write_render_creates_nested_folders(tmp_path):
     img = np.zeros((4, 6, 3), np.uint8)
     img[..., 2] = 200  # blue in RGB

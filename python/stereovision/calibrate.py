@@ -801,11 +801,17 @@ class CalibrationReport:
         -------
         dict of str to pathlib.Path
             ``{"html": ..., "yaml": ..., "json": ...}``.
-        """
-        from stereovision.io import atomic_write
 
-        d = as_path(directory, "directory")  # as save
-        d.mkdir(parents=True, exist_ok=True)
+        Raises
+        ------
+        NotADirectoryError
+            If ``directory`` or a folder above it is a file or a link to nothing.
+        """
+        from stereovision.io import atomic_write, make_folder
+
+        # as save; mkdir's bare "[Errno 17] File exists" of a link to nothing, or "[Errno 20]
+        # Not a directory" under a file, named no cause
+        d = make_folder(as_path(directory, "directory"))
         page = _render_html(self)
         paths = {"html": d / "report.html", "yaml": d / "report.yaml", "json": d / "report.json"}
         self.save(paths["yaml"])

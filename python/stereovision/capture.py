@@ -72,7 +72,7 @@ from stereovision.calibrate import (
     parse_pattern,
 )
 from stereovision.charuco import CharucoBoard
-from stereovision.io import _opencv_quiet, check_output_folder
+from stereovision.io import _opencv_quiet, check_output_folder, make_folder
 
 __all__ = [
     "MIN_POSE_DISTANCE",
@@ -2689,7 +2689,10 @@ def save_pair(
         image cannot be encoded in that format, or not without loss (a float image in
         ``.png``: it would be written as 8 bits).
     FileExistsError
-        If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind).
+        If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind), or
+        ``directory`` is a file.
+    NotADirectoryError
+        If ``directory`` is a link to nothing, or a folder above it a file.
     OSError
         If writing fails (no partial file, and no half pair, is left behind).
     """
@@ -2698,7 +2701,11 @@ def save_pair(
         raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
     _check_ext(ext)
     d = as_path(directory, "directory")
-    d.mkdir(parents=True, exist_ok=True)
+    if d.exists() and not d.is_dir():  # FileExistsError, as mkdir's: capture stops on it
+        raise FileExistsError(f"cannot write the pair into {d}: it is a file, not a folder")
+    # mkdir's bare "[Errno 17] File exists" of a link to nothing (an unmounted drive), or
+    # "[Errno 20] Not a directory" under a file, named no cause
+    make_folder(d)
     data = []
     for side, img in (("left", left), ("right", right)):
         try:

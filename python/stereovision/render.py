@@ -1398,13 +1398,15 @@ def write_render(image: npt.NDArray[np.uint8], out_dir: str | os.PathLike[str]) 
     ValueError
         ``image`` is None, not ``(H, W, 3)`` uint8, empty, or past the kernels' 32-bit pixel
         indices (checked from its shape, before the BGR copy).
+    NotADirectoryError
+        ``out_dir`` or a folder above it is a file or a link to nothing.
     OSError
         The image could not be encoded or written.
     """
     import cv2
 
     from stereovision._validate import check_index_range
-    from stereovision.io import atomic_write
+    from stereovision.io import atomic_write, make_folder
 
     # unchecked, a grey image came out mirrored (its columns reversed as if channels), RGBA as
     # ABGR, uint16 or float as a 16-bit or clipped PNG, and a broadcast 70000 x 70000 render
@@ -1422,8 +1424,9 @@ def write_render(image: npt.NDArray[np.uint8], out_dir: str | os.PathLike[str]) 
     ok, buf = cv2.imencode(".png", np.ascontiguousarray(img[..., ::-1]))
     if not ok:
         raise OSError("could not encode render.png")
-    out = as_path(out_dir, "out_dir")  # bytes: pathlib's TypeError named no argument
-    out.mkdir(parents=True, exist_ok=True)
+    # bytes: pathlib's TypeError named no argument; mkdir's bare "[Errno 17] File exists" of a
+    # link to nothing, or "[Errno 20] Not a directory" under a file, named no cause
+    out = make_folder(as_path(out_dir, "out_dir"))
     path = out / "render.png"
     with atomic_write(path) as fh:
         fh.write(buf.tobytes())
