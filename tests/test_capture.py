@@ -1574,6 +1574,23 @@ def test_a_temporal_mean_the_source_ends_is_said_unsaved(
     assert out.count("mean of 3.0 frames") == 2 and "not saved" not in out, out
 
 
+def test_a_temporal_mean_the_source_ends_before_the_count_is_said_unsaved(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """``temporal=3, count=4`` over 5 still frames: the end is an error ("1 of 4 pairs were
+    saved"), and the last 2 frames' mean was dropped without the line the end without a count
+    says (fc77903); it is said before the error."""
+    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "five_frames", 5)
+    lines: list[str] = []
+    with StereoCamera(lpat, rpat) as cam, pytest.raises(SourceError, match="1 of 4 pairs"):
+        capture(cam, tmp_path / "five", temporal=3, count=4, log=lines.append)
+    assert len(lines) == 2 and lines[0].startswith("saved left_0001.png"), lines
+    assert lines[1] == (
+        "not saved: the last mean, of 2.0 frames of the 3 asked, was unfinished when the "
+        "source ended"
+    )
+
+
 def test_a_temporal_mean_an_interrupt_cuts_is_said_unsaved(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -3169,6 +3169,9 @@ def capture(
                 ended = _end_reason(exc, saved, last_index)
                 say_unfinished("the source ended")
                 break
+            # with count too (the end is then an error), or a source's failure: the mean was
+            # dropped without a word ("1 of 4 pairs were saved" of 5 frames at temporal=3)
+            say_unfinished("the source ended" if exc.end else "the source failed")
             if exc.end and read == 0 and read_before > 0:
                 raise exc.with_message(
                     f"{exc}, before this capture read a pair (an earlier read of this camera "
@@ -3181,6 +3184,7 @@ def capture(
         except ValueError as exc:
             # a recording's frame that does not decode (BagCamera names its topic and stamp):
             # the pairs saved before it stay, and are said as for a video's failing frame
+            say_unfinished("a frame could not be read")
             if not saved:
                 raise
             raise ValueError(f"{exc}; {kept_note()}") from exc
