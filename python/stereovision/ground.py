@@ -20,6 +20,7 @@ counter-clockwise as seen from behind).
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -1174,7 +1175,8 @@ class LaserScan:
     range_min, range_max : float
         Metres.
     ranges : numpy.ndarray
-        ``(n,)`` float32 metres.
+        ``(n,)`` float32 metres (given as :meth:`as_dict`'s list, ``null`` and ``"inf"`` /
+        ``"-inf"`` included, it is read back as such an array).
     """
 
     angle_min: float
@@ -1183,6 +1185,29 @@ class LaserScan:
     range_min: float
     range_max: float
     ranges: npt.NDArray[np.float32]
+
+    def __post_init__(self) -> None:
+        # a scan rebuilt from scan.json (as_dict: the ranges a list, NaN as null and +-inf as
+        # "inf" / "-inf") failed in repr and endpoints with NumPy's "ufunc 'isfinite' not
+        # supported for the input types", and as_dict with float()'s "not 'NoneType'"
+        r = self.ranges
+        if isinstance(r, np.ndarray) and r.dtype == np.float32 and r.ndim == 1:
+            return  # laser_scan's: the same array
+        if isinstance(r, (list, tuple)):
+            special = {"inf": math.inf, "-inf": -math.inf}
+            r = [
+                math.nan if v is None else special.get(v, v) if isinstance(v, str) else v for v in r
+            ]
+        try:  # True was a range of 1 m
+            ranges = np.asarray(None if any(isinstance(v, NOT_NUMBERS) for v in r) else r)
+        except (TypeError, ValueError):  # ragged; no sequence
+            ranges = np.asarray(None)
+        if ranges.ndim != 1 or ranges.dtype.kind not in "iuf":  # not bools, strings, complex
+            raise ValueError(
+                "ranges: expected (n,) metres (numbers, null for NaN, 'inf' / '-inf' as "
+                f"as_dict writes them), got {reprlib.repr(self.ranges)}"
+            )
+        object.__setattr__(self, "ranges", ranges.astype(np.float32))
 
     def __repr__(self) -> str:
         # A summary, not the (n,) ranges the dataclass repr printed.
