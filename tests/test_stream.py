@@ -1417,6 +1417,48 @@ def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
 
 
 @PIPELINED
+def test_a_closed_stdout_still_says_what_the_bag_holds(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`stream --json --bag DIR | head -n1`: the reader went away after the first report, and
+    the next report's BrokenPipeError went past the summary (exit 141) without the line saying
+    what the bag holds, on stderr that is still open. It stops as before (141), with that line."""
+    import io
+
+    import stereovision.rosbag as rosbag
+    import stereovision.stream as stream
+
+    class _Bag:
+        def __init__(self, path: Any, **kw: Any) -> None:
+            self.path, self.messages, self.frames = Path(path), 0, 0
+
+        def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:
+            self.messages += 7
+            self.frames += 1
+
+        def close(self) -> None:
+            pass
+
+    class _HeadOne(io.StringIO):  # a pipe whose reader (head -n1) left after the first line
+        def write(self, text: str) -> int:
+            if "\n" in self.getvalue():
+                raise BrokenPipeError(32, "Broken pipe")
+            return super().write(text)
+
+    run = stream.run_stream
+    monkeypatch.setattr(rosbag, "BagWriter", _Bag)
+    # a report for every pair: the second pair's is the write that fails
+    monkeypatch.setattr(stream, "run_stream", lambda *a, **kw: run(*a, **kw, report_period=0))
+    monkeypatch.setattr("sys.stdout", _HeadOne())
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"]), "--json"]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--max-disparity", "16"]
+    assert main([*argv, "--frames", "4", "--bag", "b"]) == 141
+    assert capsys.readouterr().err.splitlines() == [
+        "ROS 2 bag written to b (2 of the 2 pairs processed, 14 messages)"
+    ]
+
+
+@PIPELINED
 def test_the_text_summary_of_no_pair_says_so_not_nan(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

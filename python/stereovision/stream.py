@@ -1587,6 +1587,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
     bag = None
     report: StreamReport | None = None  # None after the try: an error or interrupt is raised
     close_error: str | None = None  # the bag could not be finished (a full disk)
+    piped = False  # stdout's reader went away
     try:
         if args.bag and calib is None and not stopped:
             raise ValueError("--bag: a bag holds depth; give --calib")
@@ -1655,6 +1656,11 @@ def cmd_stream(args: argparse.Namespace) -> int:
             temporal=temporal,
             read_timeout=read_timeout,
         )
+    except BrokenPipeError:
+        # the reader of the reports went away (`stream --json --bag DIR | head -n1`): the stream
+        # stops, as Unix tools do (the CLI's 141), but what the bag holds is still said below
+        piped = True
+        raise
     finally:
         try:
             cam.close()
@@ -1678,6 +1684,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
                     import shutil
 
                     shutil.rmtree(bag.path, ignore_errors=True)
+                if piped:  # (on stderr: stdout is gone) each pair processed went into the bag
+                    print(_bag_line(bag, bag.frames), file=log)
     if close_error is not None and report.error is None:
         # said in the summary as an output that failed while streaming is; a stream that ended
         # by itself ended with its output failing, an interrupted one keeps its end (and 130)
