@@ -2498,6 +2498,35 @@ def test_a_temporal_stream_averages_up_to_255_pairs(
         ]
 
 
+@PIPELINED
+def test_a_temporal_stream_of_black_frames_measured_no_noise(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--temporal on frames all black (a capped lens, a dark room): the filter has no noise
+    estimate (no pixel neither black nor white), and the summary said "noise 0.0 grey levels"
+    (JSON 0.0), a noise it never measured. It says none was measured now (JSON null)."""
+    import stereovision.stream as stream
+    from stereovision.capture import StereoFrame
+
+    class _Rig(_FakeRig):
+        def close(self) -> None:
+            pass
+
+    black = np.zeros((48, 64, 3), np.uint8)
+    pairs = [StereoFrame(black, black.copy(), 0.0, 0.0, i) for i in range(2)]
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check"]
+    argv += ["--max-disparity", "8", "--temporal", "3"]
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: _Rig(list(pairs)))
+    assert main(argv) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        "temporal: 1.5 frames averaged per pixel on average, 0 restarts (the rig or the view "
+        "moved), no noise measured (frames all black or white)"
+    )
+    assert main([*argv, "--json"]) == 0
+    temporal = _json_lines(capsys.readouterr().out)[-1]["temporal"]
+    assert temporal == {"frames_averaged": 1.5, "restarts": 0, "noise_sigma": None}
+
+
 def test_run_stream_refuses_a_bool_ground_every_and_two_ways_to_rectify() -> None:
     """``ground_every=True`` or 0, ``ground_every`` without a calibration (a floor in metres)
     and homographies with a calibration are usage errors, said as such before any grab."""

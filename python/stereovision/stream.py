@@ -215,7 +215,8 @@ class StreamReport:
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
         the pairs of the frames in a pixel's mean), ``restarts`` (pairs of this run on which
         the rig or scene moved, not those of an earlier run of the same filter) and
-        ``noise_sigma`` (its last noise estimate, grey levels; NaN when it saw no frame), as
+        ``noise_sigma`` (its last noise estimate, grey levels; NaN when it saw no frame, or
+        none it could measure: all black or white), as
         of the last pair counted in :attr:`frames`. The filter itself also took the pairs that
         were not: the one whose output failed, and those grabbed ahead when pipelined (its own
         ``frames`` and ``restarts`` can be higher).
@@ -658,7 +659,7 @@ def _pairs(
                 note = resampled_for_temporal_note(camera, fr)
             left, right = temporal_average(temporal, fr)
             averaged = temporal.mean_frames()
-            filtered = (temporal.frames, temporal.restarts, float(temporal.sigma))
+            filtered = (temporal.frames, temporal.restarts, _filter_noise(temporal))
         t2 = time.perf_counter()
         if calib is not None and not calib.rectified:
             left, right = calib.rectify(left, right)
@@ -1069,7 +1070,9 @@ def run_stream(
     # the temporal filter as it came, before the grab thread can take a pair: a filter reused
     # from a stream before (as reset()'s note allows) said that stream's restarts as this one's
     # (4 restarts on a still view that restarted once, 3 of them the run before)
-    filtered = None if temporal is None else (temporal.frames, temporal.restarts, temporal.sigma)
+    filtered = (
+        None if temporal is None else (temporal.frames, temporal.restarts, _filter_noise(temporal))
+    )
     restarts_before = 0 if filtered is None else filtered[1]
     stop = threading.Event()  # the end of the stream, for a grab thread left behind
     source: Iterator[_Pair | _Note] = (
@@ -1257,6 +1260,13 @@ def run_stream(
             "noise_sigma": round(filtered[2], 3) if filtered[0] else math.nan,
         },
     )
+
+
+def _filter_noise(temporal: Any) -> float:
+    """The temporal filter's noise estimate (grey levels), NaN while it has none: its ``sigma``
+    is 0 until a frame with a pixel neither black nor white, which all-black frames (a capped
+    lens, a dark room) never give, and the summary said "noise 0.0 grey levels"."""
+    return float(temporal.sigma) if temporal._sigmas else math.nan
 
 
 def _refuse_wrong_objects(
@@ -1728,10 +1738,14 @@ def cmd_stream(args: argparse.Namespace) -> int:
             print(f"temporal: no pair filtered, {report.temporal['restarts']} restarts", file=out)
         elif report.temporal is not None:
             tp = report.temporal
+            noise = (
+                "no noise measured (frames all black or white)"
+                if math.isnan(tp["noise_sigma"])
+                else f"noise {tp['noise_sigma']:.1f} grey levels"
+            )
             print(
                 f"temporal: {tp['frames_averaged']:.1f} frames averaged per pixel on average,"
-                f" {tp['restarts']} restarts (the rig or the view moved), noise"
-                f" {tp['noise_sigma']:.1f} grey levels",
+                f" {tp['restarts']} restarts (the rig or the view moved), {noise}",
                 file=out,
             )
         found = [g for g in report.grounds if g["found"]]
