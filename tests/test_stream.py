@@ -3536,3 +3536,31 @@ def test_the_view_refuses_a_colour_scale_that_is_no_positive_number(
     finally:
         server.close()
     assert "RuntimeWarning" not in capfd.readouterr().err
+
+
+def test_the_view_refuses_a_left_it_cannot_show(capfd: pytest.CaptureFixture[str]) -> None:
+    """FrameServer.update took a left of 2 channels, an empty one and a nested list (its shape
+    alone was checked), and every request then failed in the server's thread (NumPy's hstack,
+    OpenCV's JPEG encoder, "'list' object has no attribute 'dtype'"): no answer, a traceback on
+    stderr. They are refused in the caller's thread, the view kept; a list is shown as its
+    array."""
+    disparity = np.zeros((40, 60), np.float32)
+    server = FrameServer("127.0.0.1", 0)
+    try:
+        server.update(np.zeros((40, 60, 3), np.uint8), disparity, 16)
+        for left, said in (
+            (np.zeros((40, 60, 2), np.uint8), "left: expected 1, 3 or 4 channels, got 2"),
+            (np.zeros((0, 0), np.uint8), "left: expected an (H, W) or (H, W, C) image, got (0, 0)"),
+        ):
+            with pytest.raises(ValueError) as err:
+                server.update(left, np.zeros(left.shape[:2], np.float32), 16)
+            assert str(err.value) == said
+        # a float image's [0, 1], as run_stream's frames of floats are shown
+        server.update(np.full((40, 60), 200 / 255).tolist(), disparity, 16)  # type: ignore[arg-type]
+        status, ctype, body = _get(server.url + "frame.jpg")
+        assert (status, ctype) == (200, "image/jpeg")
+        view = cv2.imdecode(np.frombuffer(body, np.uint8), cv2.IMREAD_GRAYSCALE)
+        assert view.shape == (40, 120) and abs(int(view[20, 30]) - 200) <= 2
+    finally:
+        server.close()
+    assert "Traceback" not in capfd.readouterr().err

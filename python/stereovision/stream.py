@@ -492,9 +492,15 @@ class FrameServer:
         top = finite_number(max_disparity, "max_disparity")
         if not top > 0:
             raise ValueError(f"max_disparity: expected a positive number, got {max_disparity!r}")
-        if np.ndim(left) not in (2, 3):
-            raise ValueError(f"left: expected an (H, W) or (H, W, C) image, got {np.shape(left)}")
-        lh, lw = np.shape(left)[:2]
+        # an array, kept by reference: a nested list failed in the server's thread as the map
+        # of another size did ("'list' object has no attribute 'dtype'"), as did 2 channels (the
+        # hstack) and an empty image (OpenCV's JPEG encoder)
+        left = np.asarray(left)
+        if left.ndim not in (2, 3) or left.size == 0:
+            raise ValueError(f"left: expected an (H, W) or (H, W, C) image, got {left.shape}")
+        if left.ndim == 3 and left.shape[2] == 2:  # (more: the first 3 shown, as BGRA's)
+            raise ValueError(f"left: expected 1, 3 or 4 channels, got {left.shape[2]}")
+        lh, lw = left.shape[:2]
         if np.ndim(disparity) != 2 or np.shape(disparity) != (lh, lw):
             raise ValueError(
                 f"disparity: expected a map of the left image's {lw}x{lh} px, got shape "
