@@ -1971,6 +1971,25 @@ def test_run_stream_refuses_the_wrong_objects_by_name_before_any_grab() -> None:
             assert (str(err.value), rig.count) == (said, 0)
 
 
+def test_run_stream_refuses_a_check_or_pipelined_that_is_no_bool_before_any_grab() -> None:
+    """check="no" (a config file's text) was true: the first pair was checked, and with
+    check_every every n-th too; pipelined="no" ran pipelined, its summary saying
+    "pipelined": "no". Each is a TypeError naming it now, before any grab, as fill's is."""
+    for kw, said in (
+        ({"check": "no"}, "check: expected True or False, got 'no'"),
+        ({"check": "no", "check_every": 2}, "check: expected True or False, got 'no'"),
+        ({"check": None}, "check: expected True or False, got None"),
+        ({"pipelined": "no"}, "pipelined: expected True or False, got 'no'"),
+    ):
+        rig = _FakeRig([_frame(0)])
+        with pytest.raises(TypeError) as err:
+            run_stream(rig, max_disparity=8, **kw)  # type: ignore[arg-type]
+        assert (str(err.value), rig.count) == (said, 0)
+    rep = run_stream(_FakeRig([_frame(0)]), max_disparity=8, pipelined=np.False_, check=np.True_)
+    assert (rep.pipelined, len(rep.checks)) == (False, 1)
+    assert json.loads(json.dumps(rep.as_dict()))["pipelined"] is False
+
+
 def test_a_window_reports_its_own_pairs_per_second() -> None:
     """A per-second report's fps is its window's pairs over its length, not the run's total."""
     from stereovision.stream import _Done, _window_report

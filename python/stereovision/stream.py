@@ -987,9 +987,10 @@ def run_stream(
         If ``frames`` or ``max_disparity`` is not positive, ``method`` is unknown (before any
         grab), or the calibration does not fit the frames.
     TypeError
-        Before any grab: if ``max_disparity`` is not a number (``"64"``, True), ``fill`` or
-        ``refine`` not a bool, a callback not callable, or ``calib``, ``homographies`` or
-        ``temporal`` not what they name (a calibration file's path, ``temporal=8``).
+        Before any grab: if ``max_disparity`` is not a number (``"64"``, True), ``fill``,
+        ``refine``, ``check`` or ``pipelined`` not a bool, a callback not callable, or
+        ``calib``, ``homographies`` or ``temporal`` not what they name (a calibration file's
+        path, ``temporal=8``).
     """
     from stereovision.depth import (
         METHODS,
@@ -1023,6 +1024,12 @@ def run_stream(
     # usage errors before the first grab (the read ahead below takes a pair off the camera)
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    for name, flag in (("check", check), ("pipelined", pipelined)):
+        # "no" (a config file's text) was true: the pairs checked, or a pipelined run whose
+        # summary said "pipelined": "no"
+        if not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"{name}: expected True or False, got {_shown(flag)}")
+    check, pipelined = bool(check), bool(pipelined)
     if check_every is not None:  # 2.5 checked pairs 0, 5, 10
         check_every = positive_whole(check_every, "check_every", "a positive number of pairs")
         if not check:  # it checked no pair at all, without a word
