@@ -1990,6 +1990,17 @@ def test_run_stream_refuses_a_check_or_pipelined_that_is_no_bool_before_any_grab
     assert json.loads(json.dumps(rep.as_dict()))["pipelined"] is False
 
 
+def test_the_summary_says_a_fractional_range_as_searched() -> None:
+    """run_stream(max_disparity=8.5), a range it accepts, searched 8.5 px and the per-second
+    reports said 8.5, but the summary int()'s 8 (0.5: 0, a range it refuses). It says the range
+    searched now, an int when whole as before."""
+    for md, said in ((8.5, 8.5), (0.5, 0.5), (np.float64(8.0), 8), (np.int64(8), 8)):
+        rep = run_stream(_FakeRig([_frame(0)]), max_disparity=md, pipelined=False, check=False)
+        assert [r["max_disparity"] for r in rep.reports] == [md]
+        assert (rep.max_disparity, type(rep.max_disparity)) == (said, type(said))
+        assert json.loads(json.dumps(rep.as_dict()))["max_disparity"] == said
+
+
 def test_a_window_reports_its_own_pairs_per_second() -> None:
     """A per-second report's fps is its window's pairs over its length, not the run's total."""
     from stereovision.stream import _Done, _window_report

@@ -182,8 +182,8 @@ class StreamReport:
         Median time the matcher waited for the next pair (0 when the producer keeps up).
     skew_ms : dict of str to float
         ``mean`` and ``max`` left/right grab skew.
-    max_disparity : int
-        Disparity range searched.
+    max_disparity : int or float
+        Disparity range searched (a float when fractional; 0 when no pair came to estimate it).
     pipelined : bool
         Whether grab/rectify ran in the producer thread.
     ended : str
@@ -236,7 +236,7 @@ class StreamReport:
     latency_ms: float
     wait_ms: float
     skew_ms: dict[str, float]
-    max_disparity: int
+    max_disparity: float
     pipelined: bool
     ended: str
     density: float = math.nan
@@ -1253,7 +1253,9 @@ def run_stream(
         latency_ms=1e3 * tally.median("latency_s") if n else math.nan,
         wait_ms=1e3 * tally.median("wait_s") if n else math.nan,
         skew_ms={"mean": tally.mean("skew_ms"), "max": tally.skew_max},
-        max_disparity=int(md or 0),
+        # as searched: int() said a range of 8.5 px as 8, and 0.5 (accepted) as 0, where the
+        # per-second reports gave 8.5 (an int when whole, as batch's summary says it)
+        max_disparity=0 if not md else int(md) if float(md).is_integer() else float(md),
         pipelined=pipelined,
         ended=ended,
         density=tally.mean("density"),
