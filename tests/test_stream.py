@@ -2557,6 +2557,24 @@ def test_a_temporal_stream_of_black_frames_measured_no_noise(
     assert temporal == {"frames_averaged": 1.5, "restarts": 0, "noise_sigma": None}
 
 
+def test_the_noise_of_a_black_first_frame_is_not_measured() -> None:
+    """A first frame all black (a capped lens, a dark room) has no pixel to measure the noise
+    on: the summary's noise_sigma said 0.0 (noise_sigma's 0 for such an image), a noise never
+    measured; it is NaN (JSON null) now, as with no pair. noise_sigma itself still says 0."""
+    from stereovision._jsonout import json_line
+    from stereovision.capture import StereoFrame
+    from stereovision.temporal import noise_sigma
+
+    black = np.zeros((48, 64, 3), np.uint8)
+    rig = _FakeRig([StereoFrame(black, black.copy(), 0.0, 0.0, 0)])
+    rep = run_stream(rig, max_disparity=8, pipelined=False, check=False)
+    assert rep.frames == 1 and math.isnan(rep.noise_sigma)
+    assert json.loads(json_line(rep.as_dict()))["noise_sigma"] is None
+    assert noise_sigma(black) == 0.0
+    rep = run_stream(_FakeRig([_frame(0)]), max_disparity=8, pipelined=False, check=False)
+    assert rep.noise_sigma == noise_sigma(_frame(0).left)
+
+
 def test_run_stream_refuses_a_bool_ground_every_and_two_ways_to_rectify() -> None:
     """``ground_every=True`` or 0, ``ground_every`` without a calibration (a floor in metres)
     and homographies with a calibration are usage errors, said as such before any grab."""

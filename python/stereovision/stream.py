@@ -210,7 +210,8 @@ class StreamReport:
         in :meth:`as_dict`.
     noise_sigma : float
         Noise of the first left frame as grabbed (before rectification), in grey levels
-        (:func:`~stereovision.temporal.noise_sigma`; NaN when no pair came).
+        (:func:`~stereovision.temporal.noise_sigma`; NaN when no pair came, or the frame is all
+        black or white: nothing to measure).
     temporal : dict or None
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
         the pairs of the frames in a pixel's mean), ``restarts`` (pairs of this run on which
@@ -1329,10 +1330,12 @@ def _refuse_wrong_objects(
 
 
 def _note_noise(left: np.ndarray, averaging: bool) -> float:
-    """The first left frame's noise; a warning suggesting ``--temporal`` when it is high."""
-    from stereovision.temporal import noise_sigma
+    """The first left frame's noise (NaN for a frame all black or white, which noise_sigma
+    calls 0); a warning suggesting ``--temporal`` when it is high."""
+    from stereovision.temporal import _measured_noise
 
-    sigma = noise_sigma(left)
+    measured = _measured_noise(left)
+    sigma = math.nan if measured is None else measured
     if sigma > NOISY_SIGMA and not averaging:
         warnings.warn(
             f"the cameras are noisy ({sigma:.1f} grey levels on the first frame; low light?): "

@@ -162,6 +162,13 @@ def noise_sigma(image: npt.ArrayLike) -> float:
         3 x 3, is not of numbers (bool, complex), or is of integers other than uint16 outside
         0-255 (an int image's levels in 0-255 read as its uint8 image).
     """
+    estimate = _measured_noise(image)
+    return 0.0 if estimate is None else estimate
+
+
+def _measured_noise(image: npt.ArrayLike) -> float | None:
+    """:func:`noise_sigma`, None where it has no pixel to measure (all black or white) rather
+    than its 0: the stream's summary said such a frame's noise was 0.0."""
     img = np.asarray(image)
     if img.ndim not in (2, 3) or img.shape[0] < 3 or img.shape[1] < 3:
         raise ValueError(
@@ -192,8 +199,7 @@ def noise_sigma(image: npt.ArrayLike) -> float:
                 f"image: {img.dtype} grey levels must lie in 0-255, got {lo}-{hi} ({why})"
             )
         img = img.astype(np.uint8)
-    estimate = _noise_estimate(img)
-    return 0.0 if estimate is None else estimate
+    return _noise_estimate(img)
 
 
 def _noise_estimate(img: np.ndarray) -> float | None:
