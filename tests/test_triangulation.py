@@ -818,3 +818,28 @@ def test_undistortion_names_a_camera_that_is_none(K: np.ndarray, D: object, says
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=re.escape(says)):
             undistort_normalized([[300.0, 200.0]], K, D)
+
+
+def test_undistortion_names_a_camera_that_is_no_numbers() -> None:
+    """A K or D of text, a ragged list or complex numbers was NumPy's words naming neither
+    ("could not convert string to float: 'abc'", "setting an array element with a sequence"),
+    and a complex D lost its imaginary part with a ComplexWarning alone. Each is refused naming
+    it; an object array of numbers (a pandas column) is still read."""
+    K = np.diag([600.0, 600.0, 1.0])
+    says = "K: expected a 3 x 3 camera matrix of finite numbers with positive focal lengths, got"
+    for bad_K in ("abc", [[600, 0, 0], [0, 600], [0, 0, 1]], K + 0j):
+        with pytest.raises(ValueError, match="^" + re.escape(says)):
+            undistort_normalized([[300.0, 200.0]], bad_K, None)
+    for bad_D, shown in (("abc", "'abc'"), ([[0, 0], [0, 0, 0]], "[[0, 0], [0, 0, 0]]")):
+        with pytest.raises(ValueError) as err:
+            undistort_normalized([[300.0, 200.0]], K, bad_D)
+        assert str(err.value) == f"D: expected finite coefficients, got {shown}"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the ComplexWarning: no silent cast
+        with pytest.raises(ValueError, match=r"^D: expected finite coefficients, got array"):
+            undistort_normalized([[300.0, 200.0]], K, np.zeros(5) + 1e-3j)
+    D = np.array([0.1, -0.05, 0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(
+        undistort_normalized([[300.0, 200.0]], K.astype(object), D.astype(object))[0],
+        undistort_normalized([[300.0, 200.0]], K, D)[0],
+    )

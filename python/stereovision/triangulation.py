@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import int_in_range, known_unit, positive_finite
+from stereovision._validate import _real_array, _shown, int_in_range, known_unit, positive_finite
 from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
@@ -91,6 +91,20 @@ def _points(x: npt.ArrayLike, name: str) -> F64:
     return a.astype(np.float64)
 
 
+def _reals(x: object, name: str, expected: str) -> F64:
+    """``x`` as float64, refused naming ``name`` unless of real numbers: text was NumPy's
+    "could not convert string to float: 'abc'", a ragged list "setting an array element with
+    a sequence", neither naming K or D, and a complex one lost its imaginary part (a
+    ComplexWarning alone)."""
+    try:
+        raw = _real_array(x)  # (an object array of numbers too)
+    except ValueError:  # ragged
+        raw = None
+    if raw is None:
+        raise ValueError(f"{name}: expected {expected}, got {_shown(x)}")
+    return raw.astype(np.float64)
+
+
 def undistort_normalized(
     pts: npt.ArrayLike,
     K: npt.ArrayLike,
@@ -139,7 +153,7 @@ def undistort_normalized(
     # without a word (never converged), tol "1" was NumPy's UFuncTypeError from the comparison
     max_iter = int_in_range(max_iter, "max_iter", 1, 2**31 - 1)
     tol = positive_finite(tol, "tol")
-    Km = np.asarray(K, dtype=np.float64)
+    Km = _reals(K, "K", "a 3 x 3 camera matrix of finite numbers with positive focal lengths")
     # a (2, 2) K was NumPy's IndexError, a zero focal length a RuntimeWarning and every point
     # inf, a NaN coefficient every point NaN: each without naming what was wrong
     if Km.shape != (3, 3) or not np.isfinite(Km).all() or not (Km[0, 0] > 0 and Km[1, 1] > 0):
@@ -149,7 +163,7 @@ def undistort_normalized(
         )
     d = np.zeros(14)
     # None is no distortion, as OpenCV takes it (np.asarray(None) is one NaN: "got 1")
-    dist = np.zeros(0) if D is None else np.asarray(D, dtype=np.float64).ravel()
+    dist = np.zeros(0) if D is None else _reals(D, "D", "finite coefficients").ravel()
     if dist.size not in (0, 4, 5, 8, 12, 14):
         raise ValueError(f"D: expected 4, 5, 8, 12 or 14 coefficients, got {dist.size}")
     if not np.isfinite(dist).all():
