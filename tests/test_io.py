@@ -2609,6 +2609,30 @@ def test_keep_previous_takes_a_legal_name_whose_suffix_is_long(tmp_path: Path) -
     assert second is not None and second.name == "x." + "b" * 242 + ".previous.2"
 
 
+@pytest.mark.parametrize("mode", ["a", "ab", "x", "xb", "r+", "rb", None])
+def test_atomic_write_refuses_a_mode_that_keeps_the_old_contents(
+    tmp_path: Path, mode: str | None
+) -> None:
+    """atomic_write(p, "a") replaced a log with the body's lines alone, its old lines lost,
+    and "x" replaced the existing file it is there to keep, without a word: only a mode that
+    writes a whole new file is taken now, the file left as it was."""
+    dest = tmp_path / "log.txt"
+    dest.write_bytes(b"line1\n")
+    with pytest.raises(
+        ValueError,
+        match=r"^mode: expected 'wb' or 'w' \(atomic_write replaces the whole file\), got "
+        + re.escape(repr(mode))
+        + "$",
+    ):
+        with atomic_write(dest, mode) as fh:  # type: ignore[arg-type]
+            fh.write(b"line2\n")
+    assert dest.read_bytes() == b"line1\n" and os.listdir(tmp_path) == ["log.txt"]
+    for ok in ("w", "wt", "wb", "w+b"):
+        with atomic_write(dest, ok) as fh:
+            fh.write("new" if "b" not in ok else b"new")
+        assert dest.read_bytes() == b"new"
+
+
 def test_atomic_write_refuses_a_name_ending_in_a_slash(tmp_path: Path) -> None:
     """'new/' (no such folder) was written as a file named 'new': Path() drops the slash,
     where open('new/', 'w') refuses it. It is refused now, nothing made."""

@@ -646,7 +646,8 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         Destination file. Its directory must exist. A link is written through: its target
         is replaced (created when missing) and the link kept, as ``open(path, "w")`` does.
     mode : str
-        ``"wb"`` (default) or ``"w"`` (text, UTF-8).
+        ``"wb"`` (default) or ``"w"`` (text, UTF-8): the file is replaced whole, so a mode
+        that keeps or reads its contents (``"a"``, ``"x"``, ``"r+"``) is refused.
 
     Yields
     ------
@@ -656,6 +657,8 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
 
     Raises
     ------
+    ValueError
+        If ``mode`` is not a writing mode (``"w"``, ``"wb"``, ``"wt"``, ``"+"`` allowed).
     FileNotFoundError
         If the destination directory does not exist.
     IsADirectoryError, NotADirectoryError
@@ -667,6 +670,12 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         or put in place (a full disk, a rename refused): the message names ``path``, and the
         temporary file is removed.
     """
+    if not isinstance(mode, str) or "w" not in mode or set(mode) - set("wbt+"):
+        # the temporary file replaces the whole file: "a" left the body's lines alone (a log's
+        # old lines lost), "x" replaced the existing file it is there to keep, without a word
+        raise ValueError(
+            f"mode: expected 'wb' or 'w' (atomic_write replaces the whole file), got {mode!r}"
+        )
     given = as_path(path, file=True)
     text = os.fspath(path)
     if text.endswith(("/", os.sep)) and not given.is_dir():
