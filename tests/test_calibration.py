@@ -364,6 +364,36 @@ def test_from_middlebury_terrace(data_dir: Path) -> None:
     assert v["ndisp"] == 713.0 and v["baseline"] == 59.9432
 
 
+def test_middlebury_matrices_in_matlab_syntax_with_commas_or_a_last_semicolon(
+    tmp_path: Path,
+) -> None:
+    """calib.txt's matrices are MATLAB's syntax: "[f, 0, cx; 0, f, cy; 0, 0, 1]" and a last
+    row ended by ';' were refused with NumPy's "setting an array element with a sequence ...
+    inhomogeneous shape"; they are read, and a matrix of other rows says what it holds."""
+    rest = "doffs=0\nbaseline=59.5\nwidth=64\nheight=48\n"
+    k = np.array([[542.019, 0, 31.5], [0, 542.019, 23.5], [0, 0, 1]])
+    for cam in (
+        "[542.019, 0, 31.5; 0, 542.019, 23.5; 0, 0, 1]",
+        "[542.019 0 31.5; 0 542.019 23.5; 0 0 1;]",
+    ):
+        (tmp_path / "calib.txt").write_text(f"cam0={cam}\ncam1={cam}\n{rest}")
+        c = Calibration.from_middlebury(tmp_path / "calib.txt")
+        assert np.array_equal(c.K1, k) and np.array_equal(c.K2, k)
+    # a decimal comma (542,019) is no separator: its row has 5 numbers, not a misread matrix
+    for cam, rows in (
+        ("[542,019 0 31,5; 0 542,019 23,5; 0 0 1]", "5, 5, 3"),
+        ("[1 0 0; 0 1 0]", "3, 3"),
+        ("[1 0 0 0 1 0 0 0 1]", "9"),
+    ):
+        (tmp_path / "calib.txt").write_text(f"cam0={cam}\n")
+        with pytest.raises(
+            ValueError,
+            match=r"calib\.txt:1: cannot parse cam0=.* \(expected 3 rows of 3 numbers, "
+            rf"\[f 0 cx; 0 f cy; 0 0 1\], got rows of {rows} numbers\)$",
+        ):
+            parse_middlebury_calib(tmp_path / "calib.txt")
+
+
 def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
     # Middlebury 2014 style: different principal points, doffs = cx1 - cx0
     (tmp_path / "calib.txt").write_text(

@@ -1626,7 +1626,9 @@ def test_scene_range_ignores_infinite_gt_and_calib_ndisp_inf_names_the_file(
     calib.write_text(calib.read_text().replace("ndisp=inf", "ndisp=20"))
     assert load_scene(d).max_disparity == 32  # no GT: the calibration's ndisp, rounded up
     calib.write_text(calib.read_text().replace("0 0 1]\ncam1", "0 0 1; 1 2 3]\ncam1"))
-    with pytest.raises(ValueError, match=r"calib\.txt:1: cannot parse cam0=.*\(shape \(4, 3\)\)"):
+    with pytest.raises(
+        ValueError, match=r"calib\.txt:1: cannot parse cam0=.*, got rows of 3, 3, 3, 3 numbers\)$"
+    ):
         load_scene(d)
 
 

@@ -2472,7 +2472,8 @@ _MB_LINE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(.*?)\s*$")
 def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     """Parse a Middlebury ``calib.txt`` into a dict.
 
-    ``cam0``/``cam1`` (``[f 0 cx; 0 f cy; 0 0 1]``) become ``(3, 3)`` float64 arrays; every
+    ``cam0``/``cam1`` (``[f 0 cx; 0 f cy; 0 0 1]``, MATLAB's syntax: commas may part the
+    numbers, a ``;`` may end the last row) become ``(3, 3)`` float64 arrays; every
     other ``key=number`` line (``doffs``, ``baseline``, ``width``, ``height``, ``ndisp``,
     ``vmin``, ...) a float.
 
@@ -2518,11 +2519,20 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
         first[key] = n
         try:
             if val.startswith("["):
-                rows = [r.split() for r in val.strip("[]").split(";")]
-                mat = np.array(rows, dtype=np.float64)
-                if mat.shape != (3, 3):
-                    raise ValueError(f"shape {mat.shape}")
-                out[key] = mat
+                # the format is MATLAB's matrix syntax, which also parts numbers by commas and
+                # may end the last row with ';' ([f, 0, cx; 0, f, cy; 0, 0, 1;]): both were
+                # NumPy's "setting an array element with a sequence ... inhomogeneous shape"
+                rows = [re.split(r"[\s,]+", r.strip()) for r in val.strip("[]").split(";")]
+                rows = [[x for x in r if x] for r in rows]
+                if len(rows) > 1 and not rows[-1]:
+                    rows.pop()
+                if len(rows) != 3 or any(len(r) != 3 for r in rows):
+                    raise ValueError(
+                        "expected 3 rows of 3 numbers, [f 0 cx; 0 f cy; 0 0 1], got rows of "
+                        + ", ".join(str(len(r)) for r in rows)
+                        + " numbers"
+                    )
+                out[key] = np.array(rows, dtype=np.float64)
             else:
                 out[key] = float(val)
         except ValueError as exc:
