@@ -1113,6 +1113,20 @@ def test_scan_scenes_names_half_scenes_and_skips_hidden_folders(tmp_path: Path) 
     assert scan_scenes(tmp_path / "e/.git") == ([tmp_path / "e/.git/x"], [])
 
 
+def test_scan_scenes_says_a_left_png_that_is_a_folder_is_one(tmp_path: Path) -> None:
+    """A left.png that is a folder beside a right.png was 'has right.png but no left.png'
+    (eval's and bench's line), where a right.png folder is said to be one."""
+    from stereovision.io import _no_scene_under
+
+    (tmp_path / "s" / "left.png").mkdir(parents=True)
+    (tmp_path / "s" / "right.png").write_bytes(b"")
+    why = "has right.png but left.png is a folder (a scene folder holds both)"
+    assert scan_scenes(tmp_path) == ([], [(tmp_path / "s", why)])
+    given = str(tmp_path / "s")
+    half = scan_scenes(given)[1]
+    assert _no_scene_under(tmp_path / "s", given, half) == f"{given}: {why}"
+
+
 def test_scan_scenes_finds_a_scene_linked_by_a_hidden_and_a_visible_name(tmp_path: Path) -> None:
     """434f57a's skip of hidden folders dropped a scene linked as ``.cache`` and as ``s``: the
     walk took the hidden link (first in name order) as the folder's one entry, so the visible

@@ -2120,7 +2120,10 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
             found.append(Path(folder))
         elif has_left or has_right:
             why = (
-                "has right.png but no left.png"
+                # a left.png that is a folder was "no left.png", as the right one was before
+                "has right.png but left.png is a folder"
+                if has_right and os.path.isdir(os.path.join(folder, "left.png"))
+                else "has right.png but no left.png"
                 if has_right
                 else "has left.png but right.png is a folder"
                 if os.path.isdir(right)
