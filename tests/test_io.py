@@ -2464,6 +2464,23 @@ def test_an_empty_file_name_is_refused_not_taken_for_the_current_folder(
     assert not list(tmp_path.iterdir())  # nothing written
 
 
+def test_read_ply_ascii_blank_lines_are_skipped_without_numpy_s_warning(tmp_path: Path) -> None:
+    """A blank line in an ASCII PLY's body was skipped (the cloud right), but NumPy's
+    loadtxt warned 'Input line 1 contained no data and will not be counted towards
+    `max_rows=2` ...' in four lines, shown before the CLI's output."""
+    import warnings
+
+    header = (
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n"
+    )
+    (tmp_path / "c.ply").write_text(header + "\n1 2 3\n\n4 5 6\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        points, colours = read_ply(tmp_path / "c.ply")
+    assert points.tolist() == [[1, 2, 3], [4, 5, 6]] and colours is None
+
+
 def test_read_ply_ascii_damaged_count_or_out_of_type_value_is_said(tmp_path: Path) -> None:
     """An ASCII PLY whose vertex count is damaged (99999999999 of one row) was a MemoryError of
     terabytes (the table and records allocated for the count), not "truncated"; a uchar colour

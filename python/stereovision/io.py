@@ -1727,13 +1727,18 @@ def _ascii_table(
     if not body.strip():
         return np.zeros((0, columns))
     try:
-        return np.loadtxt(
-            _io.BytesIO(body),
-            dtype=np.float64,
-            ndmin=2,
-            max_rows=rows,
-            usecols=range(columns) if first else None,
-        )
+        with warnings.catch_warnings():
+            # a blank line in the body (an exporter's, a hand edit's) is skipped, as it was,
+            # but NumPy said so in a 4-line UserWarning about its max_rows since NumPy 1.23,
+            # printed before the CLI's own output
+            warnings.filterwarnings("ignore", "Input line", UserWarning)
+            return np.loadtxt(
+                _io.BytesIO(body),
+                dtype=np.float64,
+                ndmin=2,
+                max_rows=rows,
+                usecols=range(columns) if first else None,
+            )
     except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
         raise ValueError(f"damaged {kind} file {path}: {str(exc).splitlines()[0]}") from None
 
