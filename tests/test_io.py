@@ -2464,6 +2464,21 @@ def test_an_empty_file_name_is_refused_not_taken_for_the_current_folder(
     assert not list(tmp_path.iterdir())  # nothing written
 
 
+@pytest.mark.parametrize("flag", [0, 1, cv2.IMREAD_GRAYSCALE, "no", None])
+def test_imread_gray_is_true_or_false_not_cv2_s_flags(tmp_path: Path, flag: object) -> None:
+    """imread(p, 0), as cv2.imread(p, 0) (IMREAD_GRAYSCALE) is written, returned the colour
+    image, and imread(p, 1) or gray="no" the grey one, without a word."""
+    path = tmp_path / "a.png"
+    assert cv2.imwrite(str(path), np.zeros((2, 3, 3), np.uint8))
+    with pytest.raises(
+        TypeError,
+        match=rf"^gray: expected True or False, got {re.escape(repr(flag))} \(not "
+        r"cv2\.imread's flags: gray=True for a grey image\)$",
+    ):
+        imread(path, flag)  # type: ignore[arg-type]
+    assert imread(path, np.bool_(True)).shape == (2, 3) and imread(path, False).shape == (2, 3, 3)
+
+
 def test_read_ply_ascii_blank_lines_are_skipped_without_numpy_s_warning(tmp_path: Path) -> None:
     """A blank line in an ASCII PLY's body was skipped (the cloud right), but NumPy's
     loadtxt warned 'Input line 1 contained no data and will not be counted towards

@@ -1190,7 +1190,8 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
         Image file (any format OpenCV decodes: PNG, JPEG, ...).
     gray : bool
         Return a grey ``(H, W)`` image instead of BGR ``(H, W, 3)``, converted with
-        ``cv2.cvtColor(COLOR_BGR2GRAY)`` (BT.601 luma).
+        ``cv2.cvtColor(COLOR_BGR2GRAY)`` (BT.601 luma). True or False, not ``cv2.imread``'s
+        flags.
 
     Returns
     -------
@@ -1203,7 +1204,16 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
         If ``path`` does not exist.
     ValueError
         If the file cannot be decoded as an image.
+    TypeError
+        If ``gray`` is not True or False.
     """
+    if not isinstance(gray, (bool, np.bool_)):
+        # imread(p, 0) as cv2.imread(p, 0) (IMREAD_GRAYSCALE) gave the colour image, and 1
+        # (IMREAD_COLOR) or "no" the grey one, each without a word
+        raise TypeError(
+            f"gray: expected True or False, got {gray!r} (not cv2.imread's flags: "
+            "gray=True for a grey image)"
+        )
     p = _existing_file(path, "image file")
     # imdecode from bytes: works for non-ASCII paths, and fails loudly instead of returning None.
     data = np.fromfile(p, dtype=np.uint8)
