@@ -927,6 +927,11 @@ fn half_better(
     // order); the scan stops at the first lane that fits better.
     if bound.shared_weight {
         bound.lane_sums(&mut scratch.rows, nk.div_ceil(8) * 8, mean_free);
+        // Usually no lane is open at all: then no block is, and the answer is `false`
+        // without the block scan.
+        if !bound.any_open(&scratch.rows.lane_acc[..nk], k_hi, open_below) {
+            return false;
+        }
     }
     for j0 in (0..nk).step_by(8) {
         let lanes = (nk - j0).min(8);
@@ -1187,6 +1192,33 @@ impl SidesBound {
                 *a += (lt - t - wt * q).abs() + (lb - b - wb * q).abs();
             }
         }
+    }
+
+    /// Whether [`Self::lane_bits`] would set a bit for some lane of `acc` (lanes `0..nk`) that
+    /// is more than 1 px from the match (`k = k_hi - j` outside `-1..=1`). One test on the
+    /// smallest sum: `/ n` (n > 0) is monotone, so `acc[t] / n < open_below` holds for some
+    /// lane iff it holds for their minimum (a NaN sum, never open, is skipped by the `<`).
+    #[inline(always)]
+    fn any_open(&self, acc: &[f32], k_hi: i32, open_below: f32) -> bool {
+        let nk = acc.len() as i64;
+        let near = |k: i64| (i64::from(k_hi) - k).clamp(0, nk) as usize;
+        // Eight running minima (`v < low ? v : low`, a vector min), then theirs.
+        let mut low = [f32::INFINITY; 8];
+        for part in [&acc[..near(1)], &acc[near(-2)..]] {
+            let mut blocks = part.chunks_exact(8);
+            for b in &mut blocks {
+                for (l, &v) in low.iter_mut().zip(b) {
+                    *l = if v < *l { v } else { *l };
+                }
+            }
+            for (l, &v) in low.iter_mut().zip(blocks.remainder()) {
+                *l = if v < *l { v } else { *l };
+            }
+        }
+        let low = low
+            .iter()
+            .fold(f32::INFINITY, |m, &v| if v < m { v } else { m });
+        low / self.n < open_below
     }
 
     /// Bit `t` set when `acc[t] / n` is below `open_below`.

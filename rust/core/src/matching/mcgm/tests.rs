@@ -648,6 +648,55 @@ fn both_sides_bound_never_rules_out_the_best_other_disparity() {
 }
 
 #[test]
+fn both_sides_any_open_equals_the_block_scan_of_open_lanes() {
+    // half_better's early `false` (no lane open) against the rule its block scan applies: some
+    // lane j in 0..nk with `k = k_hi - j` outside -1..=1 and `acc[j] / n < open_below`. Every
+    // lane count up to 3 blocks, the near lanes at either end, inside and outside the range;
+    // thresholds one ulp above and at a lane's quotient; NaN and infinite sums.
+    let mut rng = crate::matching::hopfield::network::SplitMix64::new(17);
+    let mut unit = || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    let (mut opened, mut closed) = (0, 0);
+    for n in [1.0f32, 28.0, 3.0] {
+        let bound = SidesBound {
+            nc: 1,
+            cols: [(0, 0.0, 0.0, 0.0); MAX_SIDES_WIDTH],
+            ltot: 0.0,
+            rows: (1.0, 0.0),
+            n,
+            shared_weight: true,
+        };
+        for nk in 1..=24usize {
+            let acc: Vec<f32> = (0..nk)
+                .map(|_| match (unit() * 10.0) as u32 {
+                    0 => f32::NAN,
+                    1 => f32::INFINITY,
+                    _ => unit() * 50.0,
+                })
+                .collect();
+            for k_hi in -3..=nk as i32 + 3 {
+                for j in 0..nk {
+                    for below in [(acc[j] / n).next_up(), acc[j] / n, f32::NAN] {
+                        let want = (0..nk)
+                            .any(|t| !(-1..=1).contains(&(k_hi - t as i32)) && acc[t] / n < below);
+                        let got = bound.any_open(&acc, k_hi, below);
+                        assert_eq!(got, want, "n {n} nk {nk} k_hi {k_hi} j {j} {below}");
+                        if got {
+                            opened += 1;
+                        } else {
+                            closed += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        opened > 1000 && closed > 1000,
+        "{opened} open, {closed} closed"
+    );
+}
+
+#[test]
 fn knn_graph_equals_the_brute_force_neighbours() {
     // Random centroids, some repeated and some on a lattice (exact distance ties), several
     // densities and radii: the ring search gives the brute-force k nearest within r_max
