@@ -394,6 +394,21 @@ def test_middlebury_matrices_in_matlab_syntax_with_commas_or_a_last_semicolon(
             parse_middlebury_calib(tmp_path / "calib.txt")
 
 
+def test_middlebury_matrix_ended_as_a_matlab_statement(tmp_path: Path) -> None:
+    """cam0=[...]; (a MATLAB statement's ';' after the ']') was "could not convert string to
+    float: '1]'"; it is read as the matrix, and a row short of numbers still refused."""
+    k = np.array([[542.019, 0, 31.5], [0, 542.019, 23.5], [0, 0, 1]])
+    (tmp_path / "calib.txt").write_text(
+        "cam0=[542.019 0 31.5; 0 542.019 23.5; 0 0 1];\ncam1 = [542.019, 0, 31.5; 0, 542.019, "
+        "23.5; 0, 0, 1;] ;\nbaseline=59.5\n"
+    )
+    out = parse_middlebury_calib(tmp_path / "calib.txt")
+    assert np.array_equal(out["cam0"], k) and np.array_equal(out["cam1"], k)
+    (tmp_path / "calib.txt").write_text("cam0=[1 0 0; 0 1 0; 0 0];\n")
+    with pytest.raises(ValueError, match=r"got rows of 3, 3, 2 numbers\)$"):
+        parse_middlebury_calib(tmp_path / "calib.txt")
+
+
 def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
     # Middlebury 2014 style: different principal points, doffs = cx1 - cx0
     (tmp_path / "calib.txt").write_text(

@@ -2473,7 +2473,7 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     """Parse a Middlebury ``calib.txt`` into a dict.
 
     ``cam0``/``cam1`` (``[f 0 cx; 0 f cy; 0 0 1]``, MATLAB's syntax: commas may part the
-    numbers, a ``;`` may end the last row) become ``(3, 3)`` float64 arrays; every
+    numbers, a ``;`` may end the last row or the line) become ``(3, 3)`` float64 arrays; every
     other ``key=number`` line (``doffs``, ``baseline``, ``width``, ``height``, ``ndisp``,
     ``vmin``, ...) a float.
 
@@ -2522,7 +2522,10 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
                 # the format is MATLAB's matrix syntax, which also parts numbers by commas and
                 # may end the last row with ';' ([f, 0, cx; 0, f, cy; 0, 0, 1;]): both were
                 # NumPy's "setting an array element with a sequence ... inhomogeneous shape"
-                rows = [re.split(r"[\s,]+", r.strip()) for r in val.strip("[]").split(";")]
+                # a MATLAB statement's ';' after the ']' (cam0=[...];) was "could not convert
+                # string to float: '1]'"
+                body = re.sub(r"\]\s*;$", "]", val)
+                rows = [re.split(r"[\s,]+", r.strip()) for r in body.strip("[]").split(";")]
                 rows = [[x for x in r if x] for r in rows]
                 if len(rows) > 1 and not rows[-1]:
                     rows.pop()
