@@ -3612,3 +3612,26 @@ def test_the_view_refuses_a_left_it_cannot_show(capfd: pytest.CaptureFixture[str
     finally:
         server.close()
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_the_view_refuses_a_left_of_no_image_dtype(capfd: pytest.CaptureFixture[str]) -> None:
+    """FrameServer.update took a left of any dtype: a list of grey levels (int64) was shown
+    white (as floats past 1), strings failed in the server's thread (NumPy's UFuncTypeError).
+    They are refused as the package's images are; a big-endian uint16 is shown as its values."""
+    disparity = np.zeros((40, 60), np.float32)
+    server = FrameServer("127.0.0.1", 0)
+    try:
+        for left, said in (
+            ([[100] * 60] * 40, "unsupported dtype int64"),
+            (np.zeros((40, 60), bool), "unsupported dtype bool"),
+            (np.full((40, 60), "a"), "expected a numeric image array"),
+        ):
+            with pytest.raises(ValueError, match=rf"^left: {said}"):
+                server.update(left, disparity, 16)  # type: ignore[arg-type]
+        server.update(np.full((40, 60), 200 * 257, ">u2"), disparity, 16)
+        status, _, body = _get(server.url + "frame.jpg")
+        view = cv2.imdecode(np.frombuffer(body, np.uint8), cv2.IMREAD_GRAYSCALE)
+        assert status == 200 and abs(int(view[20, 30]) - 200) <= 2
+    finally:
+        server.close()
+    assert "Traceback" not in capfd.readouterr().err

@@ -44,6 +44,7 @@ from stereovision._jsonout import json_line
 from stereovision._validate import (
     HELD_WARNINGS,
     _shown,
+    as_image_array,
     finite_number,
     first_line,
     number_shown,
@@ -483,10 +484,10 @@ class FrameServer:
         Raises
         ------
         ValueError
-            If ``left`` is no image, or ``disparity`` not a 2-D map of its size: the frame is
-            composed side by side in the server's thread, where every request then failed (no
-            answer, a traceback on stderr). If ``max_disparity``, the top of the colour scale, is
-            not a positive number.
+            If ``left`` is no image (uint8, uint16 or float), or ``disparity`` not a 2-D map of
+            its size: the frame is composed side by side in the server's thread, where every
+            request then failed (no answer, a traceback on stderr). If ``max_disparity``, the
+            top of the colour scale, is not a positive number.
         """
         # NaN (np.nanmax of a map without a value) coloured every pixel of every frame as the
         # cast of NaN, with NumPy's RuntimeWarning from the server's thread
@@ -501,6 +502,9 @@ class FrameServer:
             raise ValueError(f"left: expected an (H, W) or (H, W, C) image, got {left.shape}")
         if left.ndim == 3 and left.shape[2] == 2:  # (more: the first 3 shown, as BGRA's)
             raise ValueError(f"left: expected 1, 3 or 4 channels, got {left.shape[2]}")
+        # the package's image dtypes: int64 (a list of grey levels) was shown white as floats
+        # past 1, strings failed in the server's thread; a big-endian uint16 in native order
+        left = as_image_array(left, "left")
         lh, lw = left.shape[:2]
         if np.ndim(disparity) != 2 or np.shape(disparity) != (lh, lw):
             raise ValueError(
