@@ -2107,6 +2107,25 @@ def test_a_full_turn_scan_fills_its_last_beam_as_its_first() -> None:
         laser_scan(pts, plane, angle_min=-3.2, angle_max=3.2, angle_increment=inc)
 
 
+def test_a_full_turn_scan_of_a_lidar_s_float32_angles_is_a_full_turn() -> None:
+    """A sensor_msgs/LaserScan's angles are float32: -pi and pi as float32 lie 2.4e-7 rad
+    more than a turn apart, and with the increment of 360 beams (their span / 360) the full
+    turn above was refused as 'beams from -3.14159 to 3.14159 rad cover more than a full
+    turn'; it is the full turn of 361 beams, its last beam as its first."""
+    from stereovision.ground import laser_scan
+
+    plane, _ = _level_floor()
+    behind = [(r * math.cos(a), r * math.sin(a), 0.5) for a in (3.14, -3.14) for r in (2, 3)]
+    pts = _camera_points(behind)
+    a0, a1 = float(np.float32(-math.pi)), float(np.float32(math.pi))
+    scan = laser_scan(
+        pts, plane, angle_min=a0, angle_max=a1, angle_increment=(a1 - a0) / 360, min_points=2
+    )
+    assert len(scan.ranges) == 361
+    assert scan.ranges[0] == pytest.approx(2.0) and scan.ranges[360] == pytest.approx(2.0)
+    assert np.count_nonzero(np.isfinite(scan.ranges)) == 2
+
+
 @pytest.mark.parametrize(
     ("directory", "says"),
     [

@@ -1404,9 +1404,10 @@ def laser_scan(
     n = math.floor(beams + 1e-9) + 1
     if n > 100_000:
         raise ValueError(f"angle_increment: {n} beams; at most 100000")
-    if (n - 1) * inc > 2 * math.pi * (1 + 1e-9):
+    if (n - 1) * inc > 2 * math.pi + 1e-6:
         # the beams past a turn repeat directions the earlier ones hold: each point went to
-        # one of them only, and the later ones were NaN whatever stood there
+        # one of them only, and the later ones were NaN whatever stood there. (1e-6 rad: a
+        # lidar's float32 -pi and pi, 2.4e-7 rad more than a turn apart, are a full turn)
         raise ValueError(
             f"angle_min, angle_max: beams from {a0:g} to {a0 + (n - 1) * inc:g} rad cover "
             "more than a full turn (2 pi rad)"
