@@ -1647,6 +1647,15 @@ def test_a_file_with_a_count_that_is_no_whole_number_is_named(
     assert type(back.size[0]) is int and type(back.max_disparity) is int
 
 
+def _hand_made_rectification() -> dict[str, object]:
+    """``as_dict()`` of a hand-made rectification: the file the hand-edit tests change."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (640, 360), (600, 400), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
+        48, (0.02, 0.03), (1.001, 0.998),
+    )  # fmt: skip
+    return rect.as_dict()
+
+
 @pytest.mark.parametrize(
     ("field", "value", "words"),
     [
@@ -1664,11 +1673,7 @@ def test_a_file_with_a_figure_that_is_no_number_is_named(
     """A hand-edited "skew_deg": null said "'NoneType' object is not subscriptable", a
     one-entry aspect "list index out of range", "abc" float()'s words, none naming the field,
     and true was read as 1.0. Each is refused naming the field; a null figure is still NaN."""
-    rect = UncalibratedRectification(
-        np.eye(3), np.eye(3), (640, 360), (600, 400), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
-        48, (0.02, 0.03), (1.001, 0.998),
-    )  # fmt: skip
-    raw = rect.as_dict()
+    raw = _hand_made_rectification()
     path = tmp_path / "r.json"
     path.write_text(json.dumps({**raw, field: value}))
     with pytest.raises(ValueError) as err:
@@ -1702,11 +1707,7 @@ def test_a_file_with_a_matrix_or_figure_that_is_no_number_is_named(
     and an integer past a float was an OverflowError past load's ValueError (depth
     --rectification: "internal OverflowError ... (please report this)"). Each is refused
     naming the field; a null entry is still NaN, refused as damaged."""
-    rect = UncalibratedRectification(
-        np.eye(3), np.eye(3), (640, 360), (600, 400), np.eye(3), 123, 0.11, 0.42, (3.5, 41.25),
-        48, (0.02, 0.03), (1.001, 0.998),
-    )  # fmt: skip
-    raw = rect.as_dict()
+    raw = _hand_made_rectification()
     path = tmp_path / "r.json"
     path.write_text(json.dumps({**raw, field: value}))
     with pytest.raises(ValueError) as err:
