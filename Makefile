@@ -8,6 +8,12 @@ BUILD_STAMP := $(VENV)/.build-stamp
 RUST_SRC := $(shell find rust -name '*.rs' -o -name Cargo.toml) Cargo.toml pyproject.toml
 PY_SRC := $(shell find python -type f -not -name '*.so' -not -path '*/__pycache__/*')
 
+# A fresh CI build never reuses rustc's incremental caches; not writing them cuts the core's debug
+# test build by about 9 % of CPU (56.5/61.2 -> 51.4/56.2 s user+sys, alternated). Local builds keep them.
+ifdef CI
+export CARGO_INCREMENTAL ?= 0
+endif
+
 .PHONY: help system-deps setup build demo test test-rust test-py lint fmt bench clean
 
 help:  ## list targets
