@@ -66,11 +66,12 @@ lint: $(STAMP)  ## cargo fmt/clippy, ruff, mypy
 test-py: build  ## pytest (parity, API, CLI, accuracy)
 	$(PY) -m pytest -q -n auto --dist loadfile --durations=5
 
-# The core's debug test build and run overlap the venv's set-up and the release build: pip and
-# the release build's link steps use one core, and cargo locks each profile's folder apart.
+# The core's debug test build and run and the linters overlap the venv's set-up and the release
+# build: pip, mypy and the release build's link steps use one core, and cargo locks each
+# profile's folder apart (clippy and cargo test share one: they take turns).
 test: system-deps  ## everything CI runs
-	$(MAKE) --no-print-directory -j2 --output-sync=target build test-rust
-	$(MAKE) --no-print-directory lint test-py
+	$(MAKE) --no-print-directory -j2 --output-sync=target build test-rust lint
+	$(MAKE) --no-print-directory test-py
 
 fmt:  ## format Rust and Python in place
 	cargo fmt --all
