@@ -2657,15 +2657,18 @@ def test_keep_previous_takes_a_legal_name_whose_suffix_is_long(tmp_path: Path) -
     assert second is not None and second.name == "x." + "b" * 242 + ".previous.2"
 
 
-@pytest.mark.parametrize("mode", ["a", "ab", "x", "xb", "r+", "rb", None])
+@pytest.mark.parametrize("mode", ["a", "ab", "x", "xb", "r+", "rb", None, "wbt", "ww", "w+b+"])
 def test_atomic_write_refuses_a_mode_that_keeps_the_old_contents(
     tmp_path: Path, mode: str | None
 ) -> None:
     """atomic_write(p, "a") replaced a log with the body's lines alone, its old lines lost,
     and "x" replaced the existing file it is there to keep, without a word: only a mode that
-    writes a whole new file is taken now, the file left as it was."""
+    writes a whole new file is taken now, the file left as it was. "wbt" got fdopen's "can't
+    have text and binary mode at once" after the temporary file was made, its descriptor left
+    open: it is refused before anything is made."""
     dest = tmp_path / "log.txt"
     dest.write_bytes(b"line1\n")
+    open_fds = len(os.listdir("/proc/self/fd"))
     with pytest.raises(
         ValueError,
         match=r"^mode: expected 'wb' or 'w' \(atomic_write replaces the whole file\), got "
@@ -2675,6 +2678,7 @@ def test_atomic_write_refuses_a_mode_that_keeps_the_old_contents(
         with atomic_write(dest, mode) as fh:  # type: ignore[arg-type]
             fh.write(b"line2\n")
     assert dest.read_bytes() == b"line1\n" and os.listdir(tmp_path) == ["log.txt"]
+    assert len(os.listdir("/proc/self/fd")) == open_fds
     for ok in ("w", "wt", "wb", "w+b"):
         with atomic_write(dest, ok) as fh:
             fh.write("new" if "b" not in ok else b"new")

@@ -670,7 +670,15 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         or put in place (a full disk, a rename refused): the message names ``path``, and the
         temporary file is removed.
     """
-    if not isinstance(mode, str) or "w" not in mode or set(mode) - set("wbt+"):
+    if (
+        not isinstance(mode, str)
+        or "w" not in mode
+        or set(mode) - set("wbt+")
+        # checked here, not by fdopen: its "can't have text and binary mode" came after the
+        # temporary file was made, and its descriptor was left open
+        or len(set(mode)) != len(mode)
+        or {"b", "t"} <= set(mode)
+    ):
         # the temporary file replaces the whole file: "a" left the body's lines alone (a log's
         # old lines lost), "x" replaced the existing file it is there to keep, without a word
         raise ValueError(
