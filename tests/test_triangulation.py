@@ -843,3 +843,19 @@ def test_undistortion_names_a_camera_that_is_no_numbers() -> None:
         undistort_normalized([[300.0, 200.0]], K.astype(object), D.astype(object))[0],
         undistort_normalized([[300.0, 200.0]], K, D)[0],
     )
+
+
+def test_undistortion_refuses_a_bool_camera() -> None:
+    """A bool K or D was read as numbers, where triangulate refuses bool points: np.eye(3,
+    dtype=bool) was a camera of focal length 1 px, a mask of five a D of zeros. Both are
+    refused naming the argument."""
+    K = np.diag([600.0, 600.0, 1.0])
+    with pytest.raises(ValueError) as err:
+        undistort_normalized([[300.0, 200.0]], np.eye(3, dtype=bool), None)
+    assert str(err.value) == (
+        "K: expected a 3 x 3 camera matrix of finite numbers with positive focal lengths, got "
+        "array of shape (3, 3) dtype bool"
+    )
+    with pytest.raises(ValueError) as err:
+        undistort_normalized([[300.0, 200.0]], K, np.zeros(5, dtype=bool))
+    assert str(err.value).startswith("D: expected finite coefficients, got array([False, ")

@@ -95,12 +95,13 @@ def _reals(x: object, name: str, expected: str) -> F64:
     """``x`` as float64, refused naming ``name`` unless of real numbers: text was NumPy's
     "could not convert string to float: 'abc'", a ragged list "setting an array element with
     a sequence", neither naming K or D, and a complex one lost its imaginary part (a
-    ComplexWarning alone)."""
+    ComplexWarning alone). Bools are refused, as triangulate's points are: an identity mask
+    was a camera matrix of focal length 1, a mask of five a D of zeros."""
     try:
         raw = _real_array(x)  # (an object array of numbers too)
     except ValueError:  # ragged
         raw = None
-    if raw is None:
+    if raw is None or raw.dtype.kind == "b":
         raise ValueError(f"{name}: expected {expected}, got {_shown(x)}")
     return raw.astype(np.float64)
 
