@@ -409,6 +409,22 @@ def test_middlebury_matrix_ended_as_a_matlab_statement(tmp_path: Path) -> None:
         parse_middlebury_calib(tmp_path / "calib.txt")
 
 
+def test_middlebury_matrix_without_its_closing_bracket_is_refused(tmp_path: Path) -> None:
+    """cam0=[... 0 0 1 without the ']' (a line cut short) was read as if complete; it is
+    refused naming the key and the line."""
+    for cam in (
+        "[542.019 0 31.5; 0 542.019 23.5; 0 0 1",
+        "[542.019 0 31.5; 0 542.019 23.5; 0 0 1;",
+    ):
+        (tmp_path / "calib.txt").write_text(f"baseline=59.5\ncam0={cam}\n")
+        with pytest.raises(ValueError) as err:
+            parse_middlebury_calib(tmp_path / "calib.txt")
+        assert (
+            str(err.value)
+            == f"{tmp_path / 'calib.txt'}:2: cannot parse cam0={cam!r} (no closing ']')"
+        )
+
+
 def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
     # Middlebury 2014 style: different principal points, doffs = cx1 - cx0
     (tmp_path / "calib.txt").write_text(

@@ -2525,6 +2525,9 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
                 # a MATLAB statement's ';' after the ']' (cam0=[...];) was "could not convert
                 # string to float: '1]'"
                 body = re.sub(r"\]\s*;$", "]", val)
+                if not body.endswith("]"):
+                    # a line cut short (or a ']' forgotten) was read as if it were complete
+                    raise ValueError("no closing ']'")
                 rows = [re.split(r"[\s,]+", r.strip()) for r in body.strip("[]").split(";")]
                 rows = [[x for x in r if x] for r in rows]
                 if len(rows) > 1 and not rows[-1]:
