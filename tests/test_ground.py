@@ -1088,6 +1088,36 @@ def test_a_scan_rebuilt_from_scan_json_works_as_the_original() -> None:
 
 
 @pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("normal", ["a", "b", "c"], "normal: expected 3 numbers, got ['a', 'b', 'c']"),
+        ("normal", None, "normal: expected 3 numbers, got None"),
+        ("height", "1.5", "height: expected a number, got '1.5'"),
+        ("rms_px", None, "rms_px: expected a number, got None"),
+        ("disparity_plane", ("a", 0, 1), "disparity_plane: expected 3 numbers (a, b, c), got "
+         "('a', 0, 1)"),
+    ],
+)  # fmt: skip
+def test_a_plane_of_fields_that_are_no_numbers_is_refused_naming_the_field(
+    field: str, value: object, says: str
+) -> None:
+    """GroundPlane(['a', 'b', 'c'], ...) was NumPy's "could not convert string to float: 'a'",
+    and a height of "1.5" or None built a plane whose repr and every use failed with Python's
+    "unsupported operand type(s) for /": neither named the field. Each is refused when the
+    plane is made."""
+    plane, _ = _level_floor()
+    fields = {
+        "normal": plane.normal, "height": 1.0, "disparity_plane": (0.0, 0.0, 0.0),
+        "inliers": plane.inliers, "inlier_share": 1.0, "rms_px": 0.0,
+    }  # fmt: skip
+    with pytest.raises(ValueError) as exc:
+        GroundPlane(**{**fields, field: value})
+    assert str(exc.value) == says
+    # as ground.json gives them: lists
+    GroundPlane(**{**fields, "normal": [0.0, -1.0, 0.0], "disparity_plane": [0.0, 0.1, -5.0]})
+
+
+@pytest.mark.parametrize(
     ("inliers", "says"),
     [
         (None, "None"),
@@ -1759,6 +1789,25 @@ def test_cell_of_points_before_the_origin_heights_of_bad_shapes_and_the_warning_
     for bad in (np.zeros((5, 2)), np.zeros((2, 4)), 1.0):
         with pytest.raises(ValueError, match=r"points: expected shape \(\.\.\., 3\)"):
             plane.height_of(bad)
+
+
+def test_cell_of_a_point_that_is_no_finite_number_is_refused_naming_it() -> None:
+    """cell_of(nan, 0) was math.floor's "cannot convert float NaN to integer", (inf, 0) an
+    OverflowError, ("1", 0) "unsupported operand type(s)": none named the coordinate. Each is
+    a ValueError naming x or y now."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.zeros((4, 4), np.int8), 0.1, (0.0, -0.2))
+    for x, y, says in (
+        (math.nan, 0.0, "x: expected a finite number of metres, got nan"),
+        (0.0, -math.inf, "y: expected a finite number of metres, got -inf"),
+        ("1", 0.0, "x: expected a number, got '1'"),
+        (0.0, None, "y: expected a number, got None"),
+    ):
+        with pytest.raises(ValueError) as exc:
+            grid.cell_of(x, y)  # type: ignore[arg-type]
+        assert str(exc.value) == says
+    assert grid.cell_of(np.float32(0.05), 0) == (2, 0)
 
 
 def test_a_cell_with_floor_and_obstacle_points_is_occupied() -> None:

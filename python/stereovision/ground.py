@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, known_unit, real_number
+from stereovision._validate import NOT_NUMBERS, _real_array, known_unit, real_number
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -175,10 +175,27 @@ class GroundPlane:
         # a plane rebuilt from ground.json (as_dict: the normal a list) described itself and
         # marked obstacles, then failed in floor_frame with Python's "can't multiply sequence
         # by non-int of type 'float'" (camera_in_floor, occupancy_grid, laser_scan, as_dict)
-        normal = np.asarray(self.normal, np.float64)  # a fitted plane's: the same array
+        # ['a', 'b', 'c'] was NumPy's "could not convert string to float: 'a'", naming no field
+        raw = _real_array(self.normal)
+        if raw is None or raw.dtype.kind == "b":
+            raise ValueError(f"normal: expected 3 numbers, got {reprlib.repr(self.normal)}")
+        normal = raw.astype(np.float64, copy=False)  # a fitted plane's: the same array
         if normal.shape != (3,):
             raise ValueError(f"normal: expected 3 numbers, got shape {normal.shape}")
         object.__setattr__(self, "normal", normal)
+        # a height of "1.5" or None built, then repr and every use failed in Python's words
+        # ("unsupported operand type(s) for /: 'str' and 'float'"), naming no field
+        for name in ("height", "inlier_share", "rms_px", "below_share"):
+            _number(getattr(self, name), name)
+        try:
+            coef = _real_array(self.disparity_plane)
+        except ValueError:  # ragged
+            coef = None
+        if coef is None or coef.dtype.kind == "b" or coef.shape != (3,):
+            raise ValueError(
+                "disparity_plane: expected 3 numbers (a, b, c), got "
+                + reprlib.repr(self.disparity_plane)
+            )
         # None (no mask at hand: a plane rebuilt from ground.json) built, then repr and support
         # were AttributeError "'NoneType' object has no attribute 'shape'"
         mask = np.asarray(self.inliers)  # a fitted plane's: the same array
@@ -940,7 +957,19 @@ class OccupancyGrid:
         -------
         tuple of int
             ``(row, col)``; outside the grid when the point is (negative or past its size).
+
+        Raises
+        ------
+        ValueError
+            If ``x`` or ``y`` is not a finite number.
         """
+        # NaN was math.floor's "cannot convert float NaN to integer", naming neither, inf an
+        # OverflowError, "1" Python's "unsupported operand type(s)"
+        for name, v in (("x", x), ("y", y)):
+            if not math.isfinite(_number(v, name)):
+                raise ValueError(
+                    f"{name}: expected a finite number of metres, got {reprlib.repr(v)}"
+                )
         return (
             math.floor((y - self.origin[1]) / self.resolution),
             math.floor((x - self.origin[0]) / self.resolution),
