@@ -1083,11 +1083,11 @@ def test_an_extension_that_is_no_image_formats_is_refused_before_any_read(
 def test_an_image_the_format_cannot_hold_is_refused_not_saved_as_8_bits(tmp_path: Path) -> None:
     """save_pair of a float image in [0, 1] wrote it as 8 bits, 0 and 1 (a black picture), and
     a 16-bit one as .jpg clipped to white, without a word: refused now, nothing written; a
-    format that holds the type keeps it."""
+    format that holds the type keeps it (and is the one advised: a float32 image as .png was
+    told to become uint8)."""
     img = _numbered(1)
     for bad, ext, advice in (
-        (img.astype(np.float32) / 255, ".png", "convert it to uint8 first (a float image in "
-         "[0, 1]: times 255)"),
+        (img.astype(np.float32) / 255, ".png", ".tiff holds float32"),
         (img.astype(np.uint16) * 257, ".jpg", ".png and .tiff hold uint16"),
         (img > 100, ".png", "convert it to uint8 first (True as 255)"),
     ):  # fmt: skip
@@ -1150,6 +1150,11 @@ def test_save_pairs_advice_names_a_format_that_holds_the_type(tmp_path: Path, ex
     if ext in (".hdr", ".pfm"):
         assert said["float16"] == "convert it to float32 first (no loss)"
         assert said["bool"] == "convert it to uint8 first (True as 255)"
+    if ext in (".png", ".jpg"):
+        # a float32 image was told to become uint8 (256 levels), where .tiff keeps it
+        assert said["float32"] == ".tiff holds float32"
+        assert said["float64"] == ".tiff holds float64"
+        assert said["float16"] == "convert it to float32 first (.tiff holds float32)"
     if ext == ".jpg":
         assert said["uint16"] == ".png and .tiff hold uint16"
         assert said["int16"] == ".tiff holds int16"

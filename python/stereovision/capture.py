@@ -2634,9 +2634,11 @@ def _lossless_advice(dtype: np.dtype, ext: str, writes: str) -> str:
     if dtype.kind == "f":
         if writes == "float32":  # .hdr, .pfm: float32 as it is
             return f".tiff holds {dtype}" if holders else "convert it to float32 first (no loss)"
-        if ext == ".tiff":  # float16
-            return "convert it to float32 first (.tiff holds float32)"
-        return "convert it to uint8 first (a float image in [0, 1]: times 255)"
+        # a float32 image as .png was told to become uint8 "(a float image in [0, 1]: times
+        # 255)", its values cut to 256 levels, where .tiff keeps them
+        if holders:
+            return f".tiff holds {dtype}"
+        return "convert it to float32 first (.tiff holds float32)"  # float16
     if holders:
         return f"{' and '.join(holders)} hold{'s' if len(holders) == 1 else ''} {dtype}"
     # int64 (a list's ints): no format here holds it; .tiff cuts it to int32
