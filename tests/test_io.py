@@ -1264,6 +1264,23 @@ def test_write_ply_drops_a_point_with_one_nan_coordinate(tmp_path: Path) -> None
     assert got_c is not None and got_c.tolist() == [[1, 1, 1], [4, 4, 4]]
 
 
+def test_write_ply_refuses_float64_points_beyond_float32(tmp_path: Path) -> None:
+    """A float64 point of 1e39 m became inf in the float32 cast: dropped without a word
+    (NumPy's overflow warning alone), or written as inf with drop_invalid=False. Refused now,
+    nothing written; a NaN point is still dropped."""
+    pts = np.array([[1.0, 2.0, 3.0], [1e39, 0.0, 1.0]])
+    for drop, fate in ((True, "would become inf (the point dropped)"),
+                       (False, "would be written as inf")):  # fmt: skip
+        with pytest.raises(ValueError) as exc:
+            write_ply(tmp_path / "c.ply", pts, drop_invalid=drop)
+        assert str(exc.value) == (
+            f"points: 1 finite value(s) beyond float32's range (e.g. 1e+39) {fate}"
+        )
+    assert list(tmp_path.iterdir()) == []
+    write_ply(tmp_path / "c.ply", np.array([[1.0, 2.0, 3.0], [np.nan, 0.0, 1.0]]))
+    assert read_ply(tmp_path / "c.ply")[0].tolist() == [[1, 2, 3]]
+
+
 def _ply(fmt: str, props: str, count: int) -> bytes:
     return f"ply\nformat {fmt} 1.0\nelement vertex {count}\n{props}end_header\n".encode("ascii")
 

@@ -1477,8 +1477,9 @@ def write_ply(
     Raises
     ------
     ValueError
-        If ``points`` is not ``(..., 3)`` real, ``colors`` does not match it or is not
-        ``uint8``, or ``comment`` is not one line of printable ASCII.
+        If ``points`` is not ``(..., 3)`` real or holds finite values beyond float32's range
+        (they would become inf), ``colors`` does not match it or is not ``uint8``, or
+        ``comment`` is not one line of printable ASCII.
     FileNotFoundError
         If the folder of ``path`` does not exist.
     TypeError
@@ -1495,6 +1496,12 @@ def write_ply(
     pts = np.asarray(points)
     if pts.dtype.kind not in "iuf" or pts.ndim < 2 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected a real (N, 3) array, got {_describe(pts)}")
+    from stereovision._validate import refuse_beyond_float32
+
+    # a float64 point past float32's range became inf in the cast: dropped without a word
+    # (drop_invalid), else written as inf, with NumPy's overflow warning alone
+    fate = "would become inf (the point dropped)" if drop_invalid else "would be written as inf"
+    refuse_beyond_float32(pts, "points", fate)
     # no copy of float32 points, no filtered copy when every point is finite: a 15 M point map
     # held four copies of itself on the way to the file
     pts = pts.reshape(-1, 3).astype(np.float32, copy=False)
