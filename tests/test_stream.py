@@ -3614,6 +3614,28 @@ def test_the_view_refuses_a_left_it_cannot_show(capfd: pytest.CaptureFixture[str
     assert "Traceback" not in capfd.readouterr().err
 
 
+def test_the_view_refuses_a_float_left_outside_0_1() -> None:
+    """FrameServer.update showed a float left as [0, 1]: one of 0-255 floats came out all
+    white, without a word. It is refused in the package's words for such an image (a NaN pixel
+    does not hide the range); a [0, 1] one with a NaN is still taken."""
+    disparity = np.zeros((4, 6), np.float32)
+    left = np.full((4, 6), 200.0, np.float32)
+    left[0, 0] = np.nan
+    server = FrameServer("127.0.0.1", 0)
+    try:
+        with pytest.raises(ValueError) as err:
+            server.update(left, disparity, 16)
+        assert str(err.value) == (
+            "left: float image values must lie in [0, 1], got range [200, 200] (divide 8-bit "
+            "data by 255, or pass the uint8 array itself)"
+        )
+        assert server.latest_jpeg() is None
+        server.update(left / 255, disparity, 16)
+        assert server.latest_jpeg() is not None
+    finally:
+        server.close()
+
+
 def test_the_view_refuses_a_left_of_no_image_dtype(capfd: pytest.CaptureFixture[str]) -> None:
     """FrameServer.update took a left of any dtype: a list of grey levels (int64) was shown
     white (as floats past 1), strings failed in the server's thread (NumPy's UFuncTypeError).

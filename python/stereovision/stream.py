@@ -44,6 +44,7 @@ from stereovision._jsonout import json_line
 from stereovision._validate import (
     HELD_WARNINGS,
     _shown,
+    _unit_range_error,
     as_image_array,
     finite_number,
     first_line,
@@ -484,10 +485,10 @@ class FrameServer:
         Raises
         ------
         ValueError
-            If ``left`` is no image (uint8, uint16 or float), or ``disparity`` not a 2-D map of
-            its size: the frame is composed side by side in the server's thread, where every
-            request then failed (no answer, a traceback on stderr). If ``max_disparity``, the
-            top of the colour scale, is not a positive number.
+            If ``left`` is no image (uint8, uint16 or float in [0, 1]), or ``disparity`` not a
+            2-D map of its size: the frame is composed side by side in the server's thread,
+            where every request then failed (no answer, a traceback on stderr). If
+            ``max_disparity``, the top of the colour scale, is not a positive number.
         """
         # NaN (np.nanmax of a map without a value) coloured every pixel of every frame as the
         # cast of NaN, with NumPy's RuntimeWarning from the server's thread
@@ -505,6 +506,14 @@ class FrameServer:
         # the package's image dtypes: int64 (a list of grey levels) was shown white as floats
         # past 1, strings failed in the server's thread; a big-endian uint16 in native order
         left = as_image_array(left, "left")
+        if left.dtype.kind == "f":
+            # the view shows floats as [0, 1]: a left of 0-255 floats was shown all white, in
+            # the words the package refuses such an image with (as_bgr_uint8's)
+            finite = left[np.isfinite(left)]
+            if finite.size:
+                err = _unit_range_error(float(finite.min()), float(finite.max()), "left")
+                if err is not None:
+                    raise ValueError(err)
         lh, lw = left.shape[:2]
         if np.ndim(disparity) != 2 or np.shape(disparity) != (lh, lw):
             raise ValueError(
