@@ -2719,3 +2719,23 @@ def test_report_save_and_write_refuse_a_bytes_name_naming_it(tmp_path: Path) -> 
             f"decode it first (os.fsdecode({arg}))"
         )
     assert not list(tmp_path.iterdir())
+
+
+def test_a_dark_16_bit_board_image_is_read_at_its_own_range(data_dir: Path, tmp_path: Path) -> None:
+    """A 12-bit camera's frame in a 16-bit PNG was read by imread(gray=True), its top 8 bits:
+    0-4095 became 0-15 grey levels (a 10-bit one's 0-3), and the board's corners were found
+    from those (OpenCV's chessboard pairs as 10-bit PNGs: RMS 0.30 px, 0.20 px at 8 bits). It
+    is stretched by its own range now, as a uint16 array is; an 8-bit file is read as before."""
+    jpg = data_dir / "chessboard" / "left01.jpg"
+    grey8 = cv2.imread(str(jpg), cv2.IMREAD_GRAYSCALE)[:240, :320]  # (a crop: fast)
+    deep = np.rint(grey8 * (4095 / 255)).astype(np.uint16)
+    cv2.imwrite(str(tmp_path / "left01.png"), deep)
+    for item in (tmp_path / "left01.png", deep):
+        grey, name = calmod._load_gray(item, "left_images[0]")
+        assert grey.dtype == np.uint8 and int(grey.max()) == int(grey8.max()) == 255
+        assert np.abs(grey.astype(int) - grey8).max() <= 1
+    assert name is None
+    from stereovision.io import imread
+
+    same, name = calmod._load_gray(jpg, "left_images[0]")
+    assert name == "left01.jpg" and np.array_equal(same, imread(jpg, gray=True))
