@@ -735,6 +735,27 @@ def test_refine_fits_the_turn_to_the_matches_within_1_px() -> None:
         refine_rectification(flat, flat, rig, check=lost)
 
 
+def test_refine_refuses_a_check_of_a_pair_of_another_size() -> None:
+    """refine_rectification took a check made on another size of the pair (a half-size copy's)
+    and turned the full-size rig by that copy's rows: cones 2 px apart, checked at 225x187,
+    were still 1.07 px apart "fixed", without a word. It refuses, as align_rows does, naming
+    both sizes."""
+    from stereovision.rectification_check import RectificationCheck
+
+    w, h = 640, 480
+    rig = dataclasses.replace(_rig(w, h, (0.0, 0.0, 0.0)), rectified=True)
+    xl, yl = _grid(60)
+    pts = np.column_stack([xl, yl, xl - 20, yl + 1.0]).astype(np.float32)
+    flat = np.full((h, w), 128, np.uint8)
+    half = RectificationCheck(60, 1.0, 1.0, -1.0, 0.0, 0.0, False, 0.5, points=pts, size=(320, 240))
+    with pytest.raises(
+        ValueError,
+        match=r"^check: made on a 320x240 px pair, the calibration's images are 640x480 px: "
+        r"check the pair that is refined$",
+    ):
+        refine_rectification(flat, flat, rig, check=half)
+
+
 def test_align_rows_leaves_a_pair_without_a_row_model_as_it_is() -> None:
     from stereovision.rectification_check import RectificationCheck, align_rows
 

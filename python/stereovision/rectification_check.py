@@ -560,14 +560,24 @@ def refine_rectification(
     Raises
     ------
     ValueError
-        Too little texture, a pair that looks swapped or fits no row model, or a correction of
-        more than :data:`MAX_CORRECTION_DEG` degrees (not a drift: calibrate again).
+        Too little texture, a pair that looks swapped or fits no row model, a correction of
+        more than :data:`MAX_CORRECTION_DEG` degrees (not a drift: calibrate again), or a
+        ``check`` made on a pair of another size than the calibration's images.
     """
     _require_type(calib, "Calibration", "calib")
     # before rectified_calibration(alpha), which takes any finite scaling (OpenCV's -1)
     _check_alpha(alpha)
     from dataclasses import replace
 
+    if check is not None and check.size is not None and check.size != calib.image_size:
+        # its points are another pair's pixels: a check of cones' half-size copy (rows 1 px
+        # apart there) turned the full-size rig by that copy's rows, and the "fixed" rig was
+        # still 1.07 px off (2 px before), without a word
+        (cw, ch), (iw, ih) = check.size, calib.image_size
+        raise ValueError(
+            f"check: made on a {cw}x{ch} px pair, the calibration's images are {iw}x{ih} px: "
+            "check the pair that is refined"
+        )
     before = (
         check
         if check is not None
