@@ -859,3 +859,19 @@ def test_undistortion_refuses_a_bool_camera() -> None:
     with pytest.raises(ValueError) as err:
         undistort_normalized([[300.0, 200.0]], K, np.zeros(5, dtype=bool))
     assert str(err.value).startswith("D: expected finite coefficients, got array([False, ")
+
+
+def test_undistortion_refuses_a_camera_matrix_not_of_opencvs_form() -> None:
+    """A transposed K (MATLAB's IntrinsicMatrix is K.T) was read with its centre at (0, 0):
+    the principal point (320, 240) came out at (0.457, 0.343), not (0, 0), without a word.
+    Refused in Calibration's words, with the transpose named where it would do."""
+    K = np.array([[700.0, 0.0, 320.0], [0.0, 700.0, 240.0], [0.0, 0.0, 1.0]])
+    assert undistort_normalized([[320.0, 240.0]], K, None)[0].tolist() == [[0.0, 0.0]]
+    form = "K: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
+    with pytest.raises(ValueError) as err:
+        undistort_normalized([[320.0, 240.0]], K.T, None)
+    assert str(err.value) == form + f"{K.T.tolist()} (transposed? pass K.T)"
+    scaled = K * 2.0  # a bottom row of (0, 0, 2): no transpose to suggest
+    with pytest.raises(ValueError) as err:
+        undistort_normalized([[320.0, 240.0]], scaled, np.zeros(5))
+    assert str(err.value) == form + f"{scaled.tolist()}"

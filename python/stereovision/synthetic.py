@@ -17,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import int_in_range, positive_finite, real_number
+from stereovision.triangulation import _check_matrix_form
 
 __all__ = ["render_plane"]
 
@@ -176,9 +177,10 @@ def render_plane(
         For a bad size, supersampling or model; a ``units_per_pixel`` that is not a positive
         number, a ``background`` that is no number or not a value of an integer texture, an
         ``origin_px`` that is not two finite numbers; a texture that is empty or not ``(H, W)``
-        or ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3 or of a focal length that is not
-        positive, ``D`` of a length the model does not take, ``rvec`` or ``tvec`` not 3
-        numbers; a camera in the plane (seen edge-on).
+        or ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3, of a focal length that is not
+        positive or not of the form ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` (a transposed
+        one), ``D`` of a length the model does not take, ``rvec`` or ``tvec`` not 3 numbers; a
+        camera in the plane (seen edge-on).
     """
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
@@ -245,6 +247,8 @@ def render_plane(
     # one a mirrored picture. Calibration's words
     if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
         raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
+    # a transposed K (MATLAB's IntrinsicMatrix) drew the plane seen from a centre at (0, 0)
+    _check_matrix_form(Kf, "K")
     Rb, _ = cv2.Rodrigues(rv.reshape(3, 1))
     plane = np.column_stack([Rb[:, 0], Rb[:, 1], t])
     if abs(np.linalg.det(plane)) <= 1e-12 * max(1.0, float(np.abs(t).max())):

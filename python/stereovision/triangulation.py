@@ -106,6 +106,18 @@ def _reals(x: object, name: str, expected: str) -> F64:
     return raw.astype(np.float64)
 
 
+def _check_matrix_form(K: F64, name: str) -> None:
+    """Refuse a 3 x 3 ``K`` not of the form ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]``, in
+    Calibration's words: a transposed one (MATLAB's ``IntrinsicMatrix`` is ``K.T``) was read
+    with its centre at (0, 0) and every ray ``(cx, cy) / f`` off, without a word."""
+    if K[1, 0] != 0 or not np.allclose(K[2], (0.0, 0.0, 1.0), rtol=0, atol=1e-12):
+        transposed = K[0, 1] == 0 and np.allclose(K[:, 2], (0.0, 0.0, 1.0), rtol=0, atol=1e-12)
+        raise ValueError(
+            f"{name}: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
+            f"{K.tolist()}" + (f" (transposed? pass {name}.T)" if transposed else "")
+        )
+
+
 def undistort_normalized(
     pts: npt.ArrayLike,
     K: npt.ArrayLike,
@@ -145,8 +157,9 @@ def undistort_normalized(
     Raises
     ------
     ValueError
-        On a bad shape, a ``K`` that is no 3 x 3 camera matrix (non-finite, or a focal length
-        not positive), non-finite or non-zero tilt coefficients, a ``max_iter`` that is not an
+        On a bad shape, a ``K`` that is no 3 x 3 camera matrix (non-finite, a focal length
+        not positive, or not of the form ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]``: a
+        transposed one), non-finite or non-zero tilt coefficients, a ``max_iter`` that is not an
         integer >= 1 or a ``tol`` that is not a positive finite number.
     """
     p = _points(pts, "pts")
@@ -162,6 +175,7 @@ def undistort_normalized(
             f"K: expected a 3 x 3 camera matrix of finite numbers with positive focal lengths, "
             f"got shape {Km.shape}" + (f": {Km.tolist()}" if Km.size <= 9 else "")
         )
+    _check_matrix_form(Km, "K")
     d = np.zeros(14)
     # None is no distortion, as OpenCV takes it (np.asarray(None) is one NaN: "got 1")
     dist = np.zeros(0) if D is None else _reals(D, "D", "finite coefficients").ravel()
