@@ -3,6 +3,8 @@ a ramp, so each pixel's value is the texture coordinate its centre sees."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -303,3 +305,25 @@ def test_a_transposed_camera_matrix_is_refused() -> None:
             render_plane(
                 TEX, 0.01, k.T, d, np.zeros(3), [0, 0, 1.0], image_size=(20, 12), model=model
             )
+
+
+def test_a_texture_of_no_grey_levels_is_refused() -> None:
+    """A bool texture (a mask) was rendered through float32 and cast back to bool: every
+    blended edge and the background (60) came out True, 74 % True of a half-True board; a
+    complex one lost its imaginary part with NumPy's ComplexWarning alone. Both are refused;
+    the mask as uint8 renders."""
+    mask = np.kron(np.indices((8, 8)).sum(0) % 2, np.ones((8, 8), np.int64)).astype(bool)
+    k = np.array([[100.0, 0.0, 9.5], [0.0, 100.0, 5.5], [0.0, 0.0, 1.0]])
+    args = (0.01, k, D, np.zeros(3), [-0.3, -0.3, 1.0])
+    with pytest.raises(ValueError) as err:
+        render_plane(mask, *args, image_size=(20, 12))
+    assert str(err.value) == (
+        "texture: expected integer or float grey levels, got bool (a mask: pass "
+        "mask.astype(np.uint8) * 255)"
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the ComplexWarning: no silent cast
+        with pytest.raises(ValueError, match=r"^texture: .* got complex64$"):
+            render_plane(mask.astype(np.complex64), *args, image_size=(20, 12))
+    grey = render_plane(mask.astype(np.uint8) * 255, *args, image_size=(20, 12))
+    assert grey.dtype == np.uint8 and 0.4 < (grey > 127).mean() < 0.6

@@ -145,8 +145,8 @@ def render_plane(
     Parameters
     ----------
     texture : array_like
-        Grey ``(H, W)`` or ``(H, W, C)`` image of 1 to 4 channels (colour ``(H, W, 3)``), any
-        dtype ``cv2.remap`` takes.
+        Grey ``(H, W)`` or ``(H, W, C)`` image of 1 to 4 channels (colour ``(H, W, 3)``), of
+        integers or floats (not bool).
     units_per_pixel : float
         Size of one texture pixel on the plane (in the unit of ``tvec``).
     K, D : array_like
@@ -176,11 +176,12 @@ def render_plane(
     ValueError
         For a bad size, supersampling or model; a ``units_per_pixel`` that is not a positive
         number, a ``background`` that is no number or not a value of an integer texture, an
-        ``origin_px`` that is not two finite numbers; a texture that is empty or not ``(H, W)``
-        or ``(H, W, C)`` with 1 to 4 channels; ``K`` not 3 x 3, of a focal length that is not
-        positive or not of the form ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` (a transposed
-        one), ``D`` of a length the model does not take, ``rvec`` or ``tvec`` not 3 numbers; a
-        camera in the plane (seen edge-on).
+        ``origin_px`` that is not two finite numbers; a texture that is empty, not ``(H, W)``
+        or ``(H, W, C)`` with 1 to 4 channels, or not of integers or floats (bool, complex);
+        ``K`` not 3 x 3, of a focal length that is not positive or not of the form
+        ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` (a transposed one), ``D`` of a length the
+        model does not take, ``rvec`` or ``tvec`` not 3 numbers; a camera in the plane (seen
+        edge-on).
     """
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
@@ -198,6 +199,13 @@ def render_plane(
         raise ValueError(
             f"texture: expected a non-empty (H, W) or (H, W, 1-4) image, got shape {tex.shape}"
         )
+    # remap works in float32: a bool texture (a mask) came back as any value over 0, True at
+    # every blended edge and on the background (74 % True of a half-True board), and a complex
+    # one lost its imaginary part with NumPy's ComplexWarning alone (an object array of
+    # numbers is read as before)
+    if tex.dtype.kind not in "iufO":
+        hint = " (a mask: pass mask.astype(np.uint8) * 255)" if tex.dtype.kind == "b" else ""
+        raise ValueError(f"texture: expected integer or float grey levels, got {tex.dtype}{hint}")
     # the package's numbers (positive_finite): "0.01" and True (1) were taken as sizes
     s = positive_finite(units_per_pixel, "units_per_pixel")
     if not real_number(background):  # "60" was 60, True 1
