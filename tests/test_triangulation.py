@@ -875,3 +875,30 @@ def test_undistortion_refuses_a_camera_matrix_not_of_opencvs_form() -> None:
     with pytest.raises(ValueError) as err:
         undistort_normalized([[320.0, 240.0]], scaled, np.zeros(5))
     assert str(err.value) == form + f"{scaled.tolist()}"
+
+
+def test_a_map_of_fixed_point_disparities_is_warned_about() -> None:
+    """A KITTI disparity PNG read as it is (uint16, d * 256) gave depths 256 times too small,
+    silently (KITTI 000005_10's GT: median 0.038 m for 9.78 m). A disparity wider than the
+    calibration's images is no match: warned of, naming the PNG reader and OpenCV's d * 16,
+    at the caller's line; a map in pixels warns of nothing."""
+    c = rect_calib(doffs=12.5)  # 640x480, f 700 px, B 0.12 m
+    px = np.array([[20.0, np.nan, 7.5], [200.0, 40.0, 0.5]])
+    png = np.round(np.nan_to_num(px) * 256).astype(np.uint16)
+    says = r"^disparity: values up to 51200 px, wider than the calibration's images \(640 px\)"
+    for call in (
+        lambda: depth_from_disparity(png, c),
+        lambda: reproject(png, c),
+        lambda: c.depth_from_disparity(png),
+        lambda: c.reproject(png),
+    ):
+        with pytest.warns(UserWarning, match=says) as w:
+            call()
+        assert "export.read_disparity_png" in str(w[0].message) and "d * 16" in str(w[0].message)
+        assert w[0].filename == __file__  # the caller's line
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        z = depth_from_disparity(png / 256.0, c)
+        reproject(px, c)
+        depth_from_disparity(np.full((2, 2), np.nan), c)  # no disparity at all
+    assert z[0, 0] == pytest.approx(700 * 0.12 / (20 + 12.5), rel=1e-6)

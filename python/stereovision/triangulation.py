@@ -394,6 +394,27 @@ def _warn_if_resized(shape: tuple[int, ...], calib: Calibration, stacklevel: int
     )
 
 
+def _warn_if_fixed_point(d: F64, calib: Calibration, stacklevel: int) -> None:
+    """Warn when the map's largest disparity is past the calibration's image width: no pixel of
+    the pair has its match that far away, so the map holds fixed-point values (a 16-bit
+    disparity PNG, KITTI's ``d * 256``; OpenCV's StereoBM / StereoSGBM int16, ``d * 16``),
+    whose depths read as pixels are that factor too small, silently."""
+    width = calib.image_size[0]
+    top = float(np.max(d, where=np.isfinite(d), initial=-np.inf))
+    if top <= width:
+        return
+    import warnings
+
+    warnings.warn(
+        f"disparity: values up to {top:g} px, wider than the calibration's images ({width} px): "
+        "no match lies that far; fixed-point values (a 16-bit disparity PNG, KITTI's d * 256: "
+        "read it with stereovision.export.read_disparity_png; OpenCV StereoSGBM's int16, "
+        "d * 16: divide by 16) give depths that many times too small",
+        UserWarning,
+        stacklevel=stacklevel + 1,
+    )
+
+
 def depth_from_disparity(
     disparity: npt.ArrayLike, calib: Calibration, unit: str = "m"
 ) -> npt.NDArray[np.float32]:
@@ -428,7 +449,9 @@ def depth_from_disparity(
     -----
     UserWarning
         When the map is the calibration's image size scaled by one factor (a resized pair's
-        map, whose depths would be off by that factor: :meth:`Calibration.scaled_to`).
+        map, whose depths would be off by that factor: :meth:`Calibration.scaled_to`), or
+        holds a disparity past the calibration's image width (fixed-point values: a 16-bit
+        disparity PNG's ``d * 256``, OpenCV's ``d * 16``).
     """
     return _depth_from_disparity(disparity, calib, unit, 2)
 
@@ -440,6 +463,7 @@ def _depth_from_disparity(
     _require_type(calib, "Calibration", "calib")
     d = _disparity(disparity)
     _warn_if_resized(d.shape, calib, stacklevel + 1)
+    _warn_if_fixed_point(d, calib, stacklevel + 1)
     return _depth(d, calib, unit)
 
 
@@ -488,7 +512,8 @@ def reproject(
     Warns
     -----
     UserWarning
-        As :func:`depth_from_disparity`, for a map of the pair resized.
+        As :func:`depth_from_disparity`, for a map of the pair resized or of fixed-point
+        values.
     """
     return _reproject(disparity, calib, unit, 2)
 
@@ -500,6 +525,7 @@ def _reproject(
     _require_type(calib, "Calibration", "calib")
     d = _disparity(disparity)
     _warn_if_resized(d.shape, calib, stacklevel + 1)
+    _warn_if_fixed_point(d, calib, stacklevel + 1)
     z = _depth(d, calib, unit).astype(np.float64)
     cal = calib if calib.rectified else calib.rectified_calibration()
     h, w = z.shape
