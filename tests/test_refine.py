@@ -574,3 +574,15 @@ def test_a_complex_array_is_named_not_cast_to_its_real_part(name: str) -> None:
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=rf"^{name} must be real numbers, got dtype complex"):
             refine_disparity(**args, max_disparity=8)  # type: ignore[arg-type]
+
+
+def test_results_compare_and_hash_by_identity() -> None:
+    """Two refinements of one map: ``a == b`` (and ``b in [a]``) compared their arrays and
+    raised NumPy's 'truth value of an array ... is ambiguous', and a result could not go in a
+    set or key a dict. A result is equal to itself only, and hashable."""
+    img = np.random.default_rng(0).random((20, 30)).astype(np.float32)
+    d = np.zeros((20, 30), np.float32)
+    a = refine_disparity(img, img, d, max_disparity=4)
+    b = refine_disparity(img, img, d, max_disparity=4)
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

@@ -902,3 +902,15 @@ def test_a_map_of_fixed_point_disparities_is_warned_about() -> None:
         reproject(px, c)
         depth_from_disparity(np.full((2, 2), np.nan), c)  # no disparity at all
     assert z[0, 0] == pytest.approx(700 * 0.12 / (20 + 12.5), rel=1e-6)
+
+
+def test_results_compare_and_hash_by_identity() -> None:
+    """Two results of two points: ``a == b`` (and ``b in [a]``) compared their arrays and
+    raised NumPy's 'truth value of an array ... is ambiguous', and a result could not go in a
+    set or key a dict. A result is equal to itself only, and hashable (as DepthResult,
+    GroundPlane and TemporalFilter)."""
+    c = rect_calib()
+    pts = ([[331.5, 238.2], [100.0, 100.0]], [[321.5, 238.2], [90.0, 100.0]])
+    a, b = triangulate(*pts, c), triangulate(*pts, c)
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

@@ -55,7 +55,7 @@ DEFAULTS: dict[str, object] = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity (== raised)
 class RefineResult:
     """Output of :func:`refine_disparity`.
 

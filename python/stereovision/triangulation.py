@@ -48,7 +48,7 @@ PARALLEL_SIN2_TOL = 1e-12
 F64 = npt.NDArray[np.float64]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity (== raised)
 class TriangulationResult:
     """3-D points of :func:`triangulate`.
 
