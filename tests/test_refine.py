@@ -586,3 +586,19 @@ def test_results_compare_and_hash_by_identity() -> None:
     b = refine_disparity(img, img, d, max_disparity=4)
     assert a == a and a != b and b not in [a]
     assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2
+
+
+def test_a_depth_result_given_for_its_map_is_named() -> None:
+    """refine_disparity(left, right, res) with a depth_map result was "disparity must be real
+    numbers, got dtype object" (its confidence alike), not what to pass. It is a TypeError
+    naming the array, as depth_from_disparity's; the arrays themselves refine."""
+    rng = np.random.default_rng(0)
+    left = rng.random((24, 40)).astype(np.float32)
+    right = np.roll(left, -2, axis=1)
+    res = sv.depth_map(left, right, max_disparity=8)
+    with pytest.raises(TypeError, match=r"^disparity: got a DepthResult; pass its array, "):
+        refine_disparity(left, right, res, max_disparity=8)
+    with pytest.raises(TypeError, match=r"^confidence: got a DepthResult; pass its array, result"):
+        refine_disparity(left, right, res.disparity, res, max_disparity=8)
+    out = refine_disparity(left, right, res.disparity, res.confidence, max_disparity=8)
+    assert out.disparity.shape == (24, 40)

@@ -30,6 +30,7 @@ from stereovision._validate import (
     check_index_range,
     check_unit_range,
     disparity_range,
+    not_a_result,
     number_shown,
     real_number,
     refuse_unknown,
@@ -163,6 +164,9 @@ def refine_disparity(
 
     Raises
     ------
+    TypeError
+        A :class:`~stereovision.DepthResult` given for ``disparity`` or ``confidence`` (pass
+        its array: ``result.disparity``, ``result.confidence``).
     ValueError
         Shapes differ, an array is not real (complex), an image is empty, not finite or has
         values outside ``[0, 1]``, a confidence is NaN or outside ``[0, 1]`` where the disparity
@@ -172,6 +176,10 @@ def refine_disparity(
     # the valid keys and the nearest spelling too ("unknown refinement parameter(s):
     # ['win_sigmma']" named neither), as the matchers' own parameters are refused
     refuse_unknown("refinement parameter", params, DEFAULTS, "stereovision.refine.DEFAULTS")
+    # a depth_map result for its map was "disparity must be real numbers, got dtype object",
+    # not what to pass; the words of depth_from_disparity and the other takers of its arrays
+    not_a_result(disparity, "disparity", "disparity")
+    not_a_result(confidence, "confidence", "confidence")
     lft, rgt, dsp = _grey(left, "left"), _grey(right, "right"), _grey(disparity, "disparity")
     check_unit_range(lft, "left")
     check_unit_range(rgt, "right")
