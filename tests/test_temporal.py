@@ -1044,3 +1044,21 @@ def test_a_large_k_restarts_no_pixel_even_at_the_largest_grey_difference(data_di
         assert filt.restarts == 0
         for img in out:
             assert set(np.unique(img[100:112, 200:212])) <= {127, 128}, k
+
+
+def test_a_dropped_frame_or_a_path_is_named_as_no_image() -> None:
+    """A frame the camera dropped (``cap.read()``'s None) or a file cv2.imread could not read
+    was "left: expected a uint8 image, got object" (a path: "got <U10"), and noise_sigma's
+    "expected an (H, W) or (H, W, C) image ..., got ()"; they are said in the package's words,
+    and no frame is counted."""
+    img = np.zeros((20, 20), np.uint8)
+    tf = TemporalFilter()
+    with pytest.raises(ValueError, match=r"^right: got None, not an image \(cv2\.imread returns"):
+        tf(img, None)
+    with pytest.raises(ValueError, match=r"^left: got the path '/tmp/l\.png', not an image"):
+        tf("/tmp/l.png", "/tmp/r.png")
+    assert tf.frames == 0
+    with pytest.raises(ValueError, match=r"^image: got None, not an image"):
+        noise_sigma(None)
+    with pytest.raises(ValueError, match=r"^image: got the path 'left\.png', not an image"):
+        noise_sigma("left.png")

@@ -41,7 +41,13 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import NOT_NUMBERS, check_index_range, real_number
+from stereovision._validate import (
+    NOT_NUMBERS,
+    as_image_array,
+    check_index_range,
+    path_given,
+    real_number,
+)
 
 __all__ = ["MOTION_MARGIN", "TemporalFilter", "noise_sigma"]
 
@@ -158,7 +164,8 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     Raises
     ------
     ValueError
-        If the image is not 2-D grey or 3-D colour of 1, 3 or 4 channels, is smaller than
+        If the image is None (``cv2.imread``'s answer for a file it cannot read) or a path, is
+        not 2-D grey or 3-D colour of 1, 3 or 4 channels, is smaller than
         3 x 3, is not of numbers (bool, complex), or is of integers other than uint16 outside
         0-255 (an int image's levels in 0-255 read as its uint8 image).
     """
@@ -166,9 +173,18 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     return 0.0 if estimate is None else estimate
 
 
+def _refuse_no_image(img: object, name: str) -> None:
+    """None (``cv2.imread``'s answer for a file it cannot read, a camera's dropped frame) or a
+    path, in the package's words (:func:`as_image_array`'s): they were "expected a uint8 image,
+    got object" (``<U10`` for a path), and :func:`noise_sigma`'s "got ()"."""
+    if img is None or path_given(img) is not None:
+        as_image_array(img, name)  # raises
+
+
 def _measured_noise(image: npt.ArrayLike) -> float | None:
     """:func:`noise_sigma`, None where it has no pixel to measure (all black or white) rather
     than its 0: the stream's summary said such a frame's noise was 0.0."""
+    _refuse_no_image(image, "image")
     img = np.asarray(image)
     if img.ndim not in (2, 3) or img.shape[0] < 3 or img.shape[1] < 3:
         raise ValueError(
@@ -344,8 +360,11 @@ class TemporalFilter:
         Raises
         ------
         ValueError
-            If an image is not ``uint8`` or the two differ in shape.
+            If an image is None (a frame the camera dropped, a file ``cv2.imread`` could not
+            read) or a path, is not ``uint8``, or the two differ in shape.
         """
+        _refuse_no_image(left, "left")
+        _refuse_no_image(right, "right")
         imgs = [np.asarray(left), np.asarray(right)]
         for name, img in zip(("left", "right"), imgs, strict=True):
             if img.dtype != np.uint8:
