@@ -602,3 +602,13 @@ def test_a_depth_result_given_for_its_map_is_named() -> None:
         refine_disparity(left, right, res.disparity, res, max_disparity=8)
     out = refine_disparity(left, right, res.disparity, res.confidence, max_disparity=8)
     assert out.disparity.shape == (24, 40)
+
+
+def test_an_image_that_is_none_or_a_path_is_named_as_no_image() -> None:
+    """cv2.imread's None for a file it could not read was "left must be real numbers, got
+    dtype object" (a path: "got dtype <U5"); both are said in the package's words."""
+    img = np.zeros((20, 20), np.float32)
+    with pytest.raises(ValueError, match=r"^left: got None, not an image \(cv2\.imread returns"):
+        refine_disparity(None, img, img, max_disparity=4)
+    with pytest.raises(ValueError, match=r"^right: got the path 'r\.png', not an image: read it"):
+        refine_disparity(img, "r.png", img, max_disparity=4)

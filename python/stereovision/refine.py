@@ -27,11 +27,13 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     _warn_low_uint16,
+    as_image_array,
     check_index_range,
     check_unit_range,
     disparity_range,
     not_a_result,
     number_shown,
+    path_given,
     real_number,
     refuse_unknown,
 )
@@ -106,6 +108,9 @@ def _number(v: object, name: str, whole: bool = False) -> float:
 
 
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
+    if name in ("left", "right") and (a is None or path_given(a) is not None):
+        # "left must be real numbers, got dtype object" (a path: "<U8") of cv2.imread's None
+        as_image_array(a, name)  # raises in the package's words
     arr = np.asarray(a)
     # The float32 cast dropped a complex array's imaginary part with only NumPy's warning.
     if arr.dtype.kind not in "biuf":
@@ -168,7 +173,8 @@ def refine_disparity(
         A :class:`~stereovision.DepthResult` given for ``disparity`` or ``confidence`` (pass
         its array: ``result.disparity``, ``result.confidence``).
     ValueError
-        Shapes differ, an array is not real (complex), an image is empty, not finite or has
+        An image that is None (``cv2.imread``'s answer for a file it cannot read) or a path,
+        shapes differ, an array is not real (complex), an image is empty, not finite or has
         values outside ``[0, 1]``, a confidence is NaN or outside ``[0, 1]`` where the disparity
         has a value, a parameter is unknown, no number (a bool, a string) or out of range,
         ``fill_plane`` not a bool.
