@@ -1148,7 +1148,7 @@ def test_scan_scenes_finds_a_scene_linked_by_a_hidden_and_a_visible_name(tmp_pat
 def test_scene_max_disparity_ignores_a_gt_without_positive_disparity() -> None:
     # an all-zero (or negative) GT gives no range: the calibration's ndisp, else the width's
     zero = np.zeros((2, 2), np.float32)
-    assert scene_max_disparity(zero, width=100, ndisp=100) == 112
+    assert scene_max_disparity(zero, width=200, ndisp=100) == 112
     assert scene_max_disparity(-zero - 3.0, width=200) == 64  # 200 // 4 = 50 -> 64
 
 
@@ -1661,6 +1661,25 @@ def test_scene_range_ignores_infinite_gt_and_calib_ndisp_inf_names_the_file(
         ValueError, match=r"calib\.txt:1: cannot parse cam0=.*, got rows of 3, 3, 3, 3 numbers\)$"
     ):
         load_scene(d)
+
+
+def test_scene_range_of_an_ndisp_the_images_have_no_room_for(tmp_path: Path) -> None:
+    """ETH3D's calib.txt gives ndisp = the width (941 on playground): a scene without GT took
+    round_up16(941) = 944 px, wider than its images, and bench and view refused it as too
+    narrow for its own range. Such an ndisp bounds nothing (the width's quarter); one the
+    images have room for is the range, as before."""
+    from stereovision.io import scene_too_narrow
+
+    assert scene_max_disparity(None, width=941, ndisp=941) == 240  # 941 // 4 = 235 -> 240
+    assert scene_max_disparity(None, width=941, ndisp=930) == 240  # 944 px: no room either
+    assert scene_max_disparity(None, width=941, ndisp=920) == 928
+    d = _scene(tmp_path / "eth3d" / "s", 70, 8)
+    (d / "calib.txt").write_text(
+        "cam0=[100 0 35; 0 100 4; 0 0 1]\ncam1=[100 0 35; 0 100 4; 0 0 1]\ndoffs=0\n"
+        "baseline=60\nwidth=70\nheight=8\nndisp=70\n"
+    )
+    s = load_scene(d)
+    assert (s.max_disparity, scene_too_narrow(s)) == (32, None)  # 70 // 4 = 17 -> 32
 
 
 def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:

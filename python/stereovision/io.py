@@ -1822,8 +1822,8 @@ class Scene:
         (OpenCV's ``Q``, unit m); None without either.
     max_disparity : int
         Disparity search range for every method (multiple of 16): ``1.1 x`` the largest finite
-        GT disparity rounded up; without GT the calibration's ``ndisp`` rounded up, else a
-        quarter of the width rounded up.
+        GT disparity rounded up; without GT the calibration's ``ndisp`` rounded up when the
+        images are wider than that, else a quarter of the width rounded up.
     path : pathlib.Path
         The scene directory.
     """
@@ -1888,8 +1888,9 @@ def scene_max_disparity(
     Returns
     -------
     int
-        ``round_up16(1.1 * max finite GT)``; without usable GT ``round_up16(ndisp)``, else
-        ``round_up16(width // 4)``.
+        ``round_up16(1.1 * max finite GT)``; without usable GT ``round_up16(ndisp)`` when it is
+        below ``width``, else ``round_up16(width // 4)`` (an ``ndisp`` the images have no room
+        for bounds nothing: ETH3D's calib.txt gives the width).
 
     Raises
     ------
@@ -1912,7 +1913,10 @@ def scene_max_disparity(
             # rounded up to 896 where the rule gives 880 (also 1440, 1600, 1760 px ...)
             margin = Fraction(repr(MAX_DISPARITY_MARGIN)) * Fraction(float(finite.max()))
             return round_up16(math.ceil(margin))
-    if ndisp is not None:
+    # an ndisp whose range the images have no room for bounds nothing: ETH3D's calib.txt gives
+    # the width (941 on playground: 944 px), and such a scene without GT was too narrow for its
+    # own range (bench and view refused it)
+    if ndisp is not None and round_up16(ndisp) < width:
         return round_up16(ndisp)
     return round_up16(width // _WIDTH_FRACTION)
 
