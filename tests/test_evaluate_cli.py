@@ -170,6 +170,37 @@ def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
     ]
 
 
+def test_eval_of_a_pair_named_in_another_case_says_the_names_are_lower_case(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Left.png + Right.png (or left.PNG) were said to be 'found: a scene's images are PNG',
+    which they are: the names are the trouble (Linux tells them from left.png)."""
+    said = {}
+    for folder, names in {
+        "capital": ("Left.png", "Right.png"),
+        "suffix": ("left.PNG", "right.PNG"),
+        "both": ("Left.png", "right.jpg"),
+        "half": ("left.png", "Right.png"),
+    }.items():
+        (tmp_path / folder).mkdir()
+        for name in names:
+            (tmp_path / folder / name).write_bytes(b"")  # only the names are looked at
+        proc = _eval(capfd, str(tmp_path / folder))
+        assert proc.returncode == 2 and proc.stdout == ""
+        said[folder] = proc.stderr.removeprefix("stereovision: error: ").rstrip("\n")
+    lower = "a scene's images are named left.png and right.png, in lower case"
+    assert said == {
+        "capital": f"no scene (left.png + right.png) under {tmp_path / 'capital'} "
+        f"(Left.png, Right.png found: {lower})",
+        "suffix": f"no scene (left.png + right.png) under {tmp_path / 'suffix'} "
+        f"(left.PNG, right.PNG found: {lower})",
+        "both": f"no scene (left.png + right.png) under {tmp_path / 'both'} (Left.png, "
+        "right.jpg found: a scene's images are PNG, named left.png and right.png, in lower case)",
+        "half": f"{tmp_path / 'half'}: has left.png but no right.png (a scene folder holds both)"
+        f"; Right.png found: {lower}",
+    }
+
+
 def test_eval_of_a_scene_where_ours_has_no_gt_depth(
     terrace: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

@@ -2195,19 +2195,27 @@ def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] =
     # the folder itself half a scene: in scan_scenes' words, which tell a right.png that is a
     # folder ("has left.png but no right.png" here) or a broken link (said as a half scene
     # skipped under the folder) from a missing one
-    own = [why for f, why in half if f == folder]
-    if own:
-        return f"{given}: {own[0]}"
-    have = [n for n in pair if (folder / n).is_file()]
-    if len(have) == 1:
-        missing = pair[1 - pair.index(have[0])]
-        return f"{given}: has {have[0]} but no {missing} (a scene folder holds both)"
     others = sorted(
         q.name
         for q in folder.iterdir()
         if q.is_file() and q.stem.lower() in ("left", "right") and q.name not in pair
     )
-    found = f" ({', '.join(others)} found: a scene's images are PNG)" if others else ""
+    # Left.png or right.PNG is a PNG: "a scene's images are PNG" sent the user looking for
+    # another format, where the names are the trouble
+    cased = [n for n in others if n.lower() in pair]
+    lower = "named left.png and right.png, in lower case"
+    own = [why for f, why in half if f == folder]
+    have = [n for n in pair if (folder / n).is_file()]
+    if own or len(have) == 1:
+        if not own:
+            missing = pair[1 - pair.index(have[0])]
+            own = [f"has {have[0]} but no {missing} (a scene folder holds both)"]
+        hint = f"; {', '.join(cased)} found: a scene's images are {lower}" if cased else ""
+        return f"{given}: {own[0]}{hint}"
+    why = "a scene's images are " + (
+        lower if len(cased) == len(others) else f"PNG, {lower}" if cased else "PNG"
+    )
+    found = f" ({', '.join(others)} found: {why})" if others else ""
     middlebury = [f for f, why in half if why == _MIDDLEBURY_NAMES]
     if middlebury:
         shown = ", ".join(str(f) for f in middlebury[:3])
