@@ -278,6 +278,24 @@ def test_bench_of_a_scene_narrower_than_its_range_names_the_width_needed(
     ]
 
 
+def test_bench_names_two_scenes_of_one_name_by_their_parents(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """day1/cam/tiny and day2/cam/tiny were both 'cam/tiny' in bench's table and JSON lines
+    (as in eval's): each is named by as many parents as tell it from the other."""
+    for day in ("day1", "day2"):
+        (tmp_path / day / "cam").mkdir(parents=True)
+        syn.narrow_scene(tmp_path / day / "cam", 20, 40)
+
+    def one_case(scene: Any, runs: int) -> list[BenchCase]:  # the names, not the timing
+        return [BenchCase(scene.name, "fast", "method", 40, 20, 16, runs, 1.0, 1.0, {})]
+
+    monkeypatch.setattr(stereovision.bench, "bench_scene", one_case)
+    assert main(["bench", str(tmp_path), "--json"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [r["scene"] for r in rows] == ["day1/cam/tiny", "day2/cam/tiny"]
+
+
 def test_bench_of_a_scene_no_higher_than_stereobms_block_times_the_others(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

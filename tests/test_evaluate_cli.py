@@ -201,6 +201,21 @@ def test_eval_of_a_pair_named_in_another_case_says_the_names_are_lower_case(
     }
 
 
+def test_eval_names_two_scenes_of_one_name_by_their_parents(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """day1/cam/tiny and day2/cam/tiny were both 'cam/tiny' (load_scene's family/scene) in the
+    table, the depth lines and the JSON lines: two rows no one could tell apart. Each is named
+    by as many parents as tell it from the other; a scene of its own name is named as before."""
+    for folder in ("day1/cam", "day2/cam", "day3/lab"):
+        (tmp_path / folder).mkdir(parents=True)
+        syn.narrow_scene(tmp_path / folder, 4, 24)
+    proc = _eval(capfd, str(tmp_path), "--json", "--no-opencv", "--method", "fast")
+    assert proc.returncode == 0, proc.stderr
+    scenes = [row["scene"] for row in _rows(proc.stdout)]
+    assert scenes == ["day1/cam/tiny", "day2/cam/tiny", "lab/tiny"]
+
+
 def test_eval_of_a_scene_where_ours_has_no_gt_depth(
     terrace: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

@@ -383,12 +383,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     from stereovision import baselines
     from stereovision.cli import MAX_RUNS, scene_failed_line
-    from stereovision.io import load_scene, scene_too_narrow
+    from stereovision.io import load_scene, scene_names, scene_too_narrow
 
     _check_runs(args.runs, "--runs")
     if args.runs > MAX_RUNS:  # any count was taken: --runs 10**20 ran until killed
         raise ValueError(f"--runs: at most {MAX_RUNS}, got {args.runs}")
     dirs = _scene_dirs(args.scenes)
+    # as eval: day1/cam/0001 and day2/cam/0001 were both cam/0001 in the table and the JSON
+    names = dict(zip(dirs, scene_names(dirs), strict=True))
     all_cases: list[BenchCase] = []
     failed: list[str] = []
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
@@ -411,6 +413,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
             try:
                 scene = load_scene(d)
+                scene.name = names[d]
                 narrow = scene_too_narrow(scene)
                 if narrow:
                     # as eval says it: "disparity range 16 is not smaller than the image width 8

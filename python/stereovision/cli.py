@@ -1849,6 +1849,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
         distinct_scenes,
         load_scene,
         scan_scenes,
+        scene_names,
         scene_too_narrow,
     )
 
@@ -1873,6 +1874,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
         print(
             f"stereovision: {escaped(str(s))} given more than once: evaluated once", file=sys.stderr
         )
+    # two scenes of one family/scene name (day1/cam/0001, day2/cam/0001) shared a name in the
+    # table, the JSON lines and the depth lines: each is named by as many parents as needed
+    names = dict(zip(dirs, scene_names(dirs), strict=True))
     rows = []
     header = (
         f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
@@ -1888,6 +1892,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
         for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
             try:
                 scene = load_scene(d)
+                scene.name = names[d]
                 # a GT map with no known pixel (all +inf) is no ground truth either: its figures
                 # would all be NaN (and NaN in the --json line, which is not JSON)
                 why = (

@@ -2072,6 +2072,36 @@ def distinct_scenes(dirs: Sequence[Path]) -> tuple[list[Path], list[Path]]:
     return kept, dropped
 
 
+def scene_names(dirs: Sequence[Path]) -> list[str]:
+    """The names ``eval`` and ``bench`` show the scenes of ``dirs`` by: :func:`load_scene`'s
+    ``family/scene``, with as many more of a folder's parents as tell it from another of
+    ``dirs`` of that name (``day1/cam/0001`` and ``day2/cam/0001``, both ``cam/0001`` to
+    :func:`load_scene`: two rows of one name in the table and the JSON lines).
+
+    Parameters
+    ----------
+    dirs : sequence of pathlib.Path
+        Distinct scene folders (:func:`distinct_scenes`).
+
+    Returns
+    -------
+    list of str
+        One name per folder, in order.
+    """
+    parts = [_absolute_as_read(Path(d)).parts[1:] for d in dirs]  # the anchor '/' left out
+    depth = [2] * len(parts)
+    while True:
+        names = ["/".join(p[-k:]) for p, k in zip(parts, depth, strict=True)]
+        count: dict[str, int] = {}
+        for n in names:
+            count[n] = count.get(n, 0) + 1
+        longer = [i for i, n in enumerate(names) if count[n] > 1 and depth[i] < len(parts[i])]
+        if not longer:
+            return names
+        for i in longer:
+            depth[i] += 1
+
+
 def find_scenes(root: PathLike) -> list[Path]:
     """Scene directories under ``root`` (any depth, through links to folders outside it, each
     once, hidden folders excepted) that contain ``left.png`` and ``right.png``.
