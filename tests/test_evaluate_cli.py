@@ -466,6 +466,13 @@ def test_eval_names_a_narrow_scene_among_several_once(
         f"failed {narrow}: images 8 px wide, not wider than the scene's disparity range "
         "(16 px, evaluation.md's rule: 16 at least): a scene needs images at least 17 px wide"
     )
+    # load_scene's 'scene FOLDER: ...' was said 'failed FOLDER: scene FOLDER: ...'
+    from stereovision.io import write_pfm
+
+    write_pfm(narrow / "gt_disp.pfm", np.full((3, 7), 2.0, np.float32))
+    proc = _eval(capfd, str(tmp_path), "--no-opencv", "--method", "fast")
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.splitlines()[0] == f"failed {narrow}: gt_disp.pfm is 7x3, left.png 8x3"
 
 
 def _low_scene(data_dir: Path, tmp_path: Path, rows: int = 12) -> Path:

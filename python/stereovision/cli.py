@@ -1744,10 +1744,14 @@ def _eval_time_line(row: dict[str, Any]) -> str:
 
 def scene_failed_line(folder: Path, error: BaseException) -> str:
     """The line saying one damaged scene of many (``eval``, ``bench``) failed, its folder named
-    once: a message that names it already (a scene too narrow for its range) is kept as is."""
+    once: a message that names it already (a scene too narrow for its range, load_scene's
+    ``scene FOLDER: gt_disp.pfm is ...``) is said without that name."""
     # a folder named with a newline cut the line in two (batch escapes its pairs' names)
     said, shown = escape_paths(str(error), [folder]), escaped(str(folder))
-    return f"failed {said if said.startswith(f'{shown}: ') else f'{shown}: {said}'}"
+    # 'failed X: scene X: gt_disp.pfm is 299x200, left.png 300x200' named it twice
+    for named in (f"{shown}: ", f"scene {shown}: "):
+        said = said.removeprefix(named)
+    return f"failed {shown}: {said}"
 
 
 def _members_line(name: str, row: dict[str, Any]) -> str:
