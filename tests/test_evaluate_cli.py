@@ -216,6 +216,36 @@ def test_eval_names_two_scenes_of_one_name_by_their_parents(
     assert scenes == ["day1/cam/tiny", "day2/cam/tiny", "lab/tiny"]
 
 
+@pytest.mark.parametrize("json_flag", [["--json"], []])
+def test_eval_writes_each_scene_s_line_out_before_the_next_scene(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, json_flag: list[str]
+) -> None:
+    """In a pipe or a file (block-buffered) eval's lines waited in the buffer until the run's
+    end: a kill during a later scene (the OOM killer, a CI timeout) lost the scenes done, 0
+    bytes written, and a reader saw nothing meanwhile. Each scene's line is out before the
+    next scene is matched (as bench's and stream's JSON lines)."""
+    import io
+
+    from stereovision import cli
+
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        syn.narrow_scene(tmp_path / folder, 4, 24)
+    raw = io.BytesIO()
+    monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(raw, encoding="utf-8"))
+    written: list[str] = []
+    dense = {"bad_2.0": 1.0, "bad_1.0": 2.0, "density": 100.0}
+
+    def fake(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> dict[str, Any]:
+        written.append(raw.getvalue().decode())  # what a reader has when it is matched
+        return {"scene": scene.name, "max_disparity": 16, "ours": dense, "ours+fill": dense}
+
+    monkeypatch.setattr(cli, "_eval_scene", fake)
+    assert main(["eval", str(tmp_path), "--no-opencv", *json_flag]) == 0
+    assert written[0] == ""
+    assert written[1].count("a/tiny") == 1 and "b/tiny" not in written[1]
+
+
 def test_eval_of_a_scene_where_ours_has_no_gt_depth(
     terrace: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

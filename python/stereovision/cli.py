@@ -1931,8 +1931,12 @@ def cmd_eval(args: argparse.Namespace) -> int:
             if "sgbm" in row and "bm" not in row:  # StereoBM cannot run on it: say why it is blank
                 no_bm = bm_reference_refusal(scene.max_disparity, scene.left.shape)
                 tqdm.write(f"{escaped(str(d))}: no StereoBM figures: {no_bm}", file=sys.stderr)
+            # each scene's line out as it is made (as bench's and stream's): in a pipe or a file
+            # they waited in the buffer, lost to a kill (the OOM killer, a CI timeout) on a later
+            # scene, and a reader saw nothing of a run of minutes until its end
             if args.json:
-                print(json_line({k: v for k, v in row.items() if not k.startswith("_")}))
+                line = json_line({k: v for k, v in row.items() if not k.startswith("_")})
+                print(line, flush=True)
                 continue
             if len(rows) == 1:  # the header over the first row: none over an error alone
                 tqdm.write(header)
@@ -1942,6 +1946,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
             name = escaped(row["scene"])  # one line, as the other lines name it
             tqdm.write(f"{name:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+            sys.stdout.flush()
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (Terminated): the scenes evaluated are kept
         # the mean, time and depth lines come after the loop: the medians of the scenes timed
         # were lost (bench keeps its scenes' timing likewise)
