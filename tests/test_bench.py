@@ -646,6 +646,18 @@ def test_bench_scene_refuses_runs_that_are_no_integer_before_any_work(runs: obje
         bench_scene(types.SimpleNamespace(), runs=runs)  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize("folder", ["data/cones", Path("data/cones")])
+def test_bench_scene_of_a_folder_says_to_load_it(folder: object) -> None:
+    """bench_scene("data/cones") failed with "AttributeError: 'str' object has no attribute
+    'left'", naming neither the argument nor what it takes."""
+    with pytest.raises(TypeError) as info:
+        bench_scene(folder, runs=5)  # type: ignore[arg-type]
+    assert str(info.value) == (
+        "scene: got the path 'data/cones', not a scene: load it first "
+        "(stereovision.io.load_scene(path))"
+    )
+
+
 def test_bench_of_several_scenes_goes_on_past_a_damaged_one(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
