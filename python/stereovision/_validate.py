@@ -370,19 +370,21 @@ def _warn_low_uint16(arr: np.ndarray, name: str, effect: str | None = None) -> N
     8 bits), so its 8-bit copy (colours, the fill's colour segments) has 0-16 grey levels of a
     12-bit camera's image; the matchers read all its bits, the automatic range stretches it.
     ``effect``, with its leading separator, says what the scaling does to another reader
-    (refine's contrast floor) instead. Alpha is no grey level: a BGRA image's is left out (an
+    (refine's contrast floor, OpenCV's matchers) instead; a ``{bits}`` in it is the bits the
+    8-bit copy keeps. Alpha is no grey level: a BGRA image's is left out (an
     opaque one is 65535, which hid 12-bit colours, scaled as dark as any other's)."""
     import warnings
 
     colour = arr[:, :, :3] if arr.ndim == 3 and arr.shape[2] == 4 else arr
     top = int(colour.max())
     if top < LOW_UINT16_MAX:
+        bits = f"{max(0.0, np.log2(max(top, 1) / 257)):.0f}"
         if effect is None:
             effect = (
                 "; the matchers read all its bits, but its 8-bit copy (colours, the fill's "
-                f"colour segments) keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits "
-                "of it"
+                "colour segments) keeps about {bits} bits of it"
             )
+        effect = effect.replace("{bits}", bits)
         warnings.warn(
             f"{name}: uint16 image whose largest value is {top} (12-bit or 8-bit data in a "
             f"16-bit container?): it is scaled as 16-bit{effect}; {LOW_UINT16_ADVICE}",
@@ -517,7 +519,7 @@ def as_gray_float(img: object, name: str = "left", *, warn: bool = True) -> npt.
     return np.ascontiguousarray(out, dtype=np.float32)
 
 
-def as_bgr_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
+def as_bgr_uint8(img: object, name: str = "image", *, warn: bool = True) -> npt.NDArray[np.uint8]:
     """Return ``img`` as a C-contiguous ``(H, W, 3)`` ``uint8`` BGR image (for OpenCV).
 
     ``uint8`` BGR input is returned as is (no copy when already contiguous). Grey input is
@@ -530,6 +532,9 @@ def as_bgr_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
         Image accepted by :func:`as_gray_float`.
     name : str
         Argument name used in error messages.
+    warn : bool
+        Warn about a ``uint16`` image whose values all lie below 4096, as
+        :func:`as_gray_float` does; False for an image its caller has warned about.
 
     Returns
     -------
@@ -543,7 +548,7 @@ def as_bgr_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
     """
     arr = as_image_array(img, name)
     if arr.dtype != np.uint8:
-        arr = np.rint(_to_unit_float(arr, name) * np.float32(255.0)).astype(np.uint8)
+        arr = np.rint(_to_unit_float(arr, name, warn) * np.float32(255.0)).astype(np.uint8)
     if arr.ndim == 2:
         arr = arr[:, :, None]
     if arr.shape[2] == 1:
@@ -553,7 +558,7 @@ def as_bgr_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
     return np.ascontiguousarray(arr)
 
 
-def as_gray_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
+def as_gray_uint8(img: object, name: str = "image", *, warn: bool = True) -> npt.NDArray[np.uint8]:
     """Return ``img`` as a C-contiguous ``(H, W)`` ``uint8`` grey image (for OpenCV).
 
     Colour input goes through :func:`as_bgr_uint8` and ``cv2.cvtColor(..., COLOR_BGR2GRAY)``,
@@ -565,6 +570,8 @@ def as_gray_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
         Image accepted by :func:`as_gray_float`.
     name : str
         Argument name used in error messages.
+    warn : bool
+        As :func:`as_bgr_uint8`'s.
 
     Returns
     -------
@@ -581,9 +588,10 @@ def as_gray_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
     arr = as_image_array(img, name)
     if arr.ndim == 2 or arr.shape[2] == 1:
         if arr.dtype != np.uint8:
-            arr = np.rint(_to_unit_float(arr, name) * np.float32(255.0)).astype(np.uint8)
+            arr = np.rint(_to_unit_float(arr, name, warn) * np.float32(255.0)).astype(np.uint8)
         return np.ascontiguousarray(arr.reshape(arr.shape[:2]))
-    return np.asarray(cv2.cvtColor(as_bgr_uint8(arr, name), cv2.COLOR_BGR2GRAY), dtype=np.uint8)
+    bgr = as_bgr_uint8(arr, name, warn=warn)
+    return np.asarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY), dtype=np.uint8)
 
 
 def _channels_text(shape: tuple[int, ...]) -> str:

@@ -30,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    _warn_low_uint16,
     as_bgr_uint8,
     as_gray_uint8,
     as_image_array,
@@ -223,6 +224,19 @@ def _equal_channels(img: np.ndarray) -> bool:
     )
 
 
+#: What the 8-bit copy of a 12-bit image in 16 bits does to OpenCV's matchers, in the low-values
+#: warning: the package's own words ("the matchers read all its bits") are its matchers'.
+_OPENCV_READS_8_BITS = "; OpenCV's matchers read its 8-bit copy, about {bits} bits of it"
+
+
+def _opencv_8bit(img: np.ndarray, name: str, grey: bool) -> npt.NDArray[np.uint8]:
+    """``img`` as OpenCV's matchers read it: grey or BGR ``uint8``, a ``uint16`` image whose
+    values all lie below 4096 (12-bit data) warned about in those matchers' terms."""
+    if img.dtype == np.uint16:
+        _warn_low_uint16(img, name, _OPENCV_READS_8_BITS)
+    return (as_gray_uint8 if grey else as_bgr_uint8)(img, name, warn=False)
+
+
 def _from_opencv(raw: np.ndarray) -> npt.NDArray[np.float32]:
     disp = raw.astype(np.float32) / np.float32(_OPENCV_DISP_SCALE)
     disp[disp < 0] = np.nan
@@ -257,7 +271,7 @@ def opencv_bm(left: object, right: object, max_disparity: float) -> npt.NDArray[
     num = round_up16(max_disparity)
     _refuse_bm_range(num, la.shape, BM_BLOCK_SIZE)
     matcher = cv2.StereoBM.create(numDisparities=num, blockSize=BM_BLOCK_SIZE)
-    raw = matcher.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right"))
+    raw = matcher.compute(_opencv_8bit(la, "left", True), _opencv_8bit(ra, "right", True))
     return _from_opencv(raw)
 
 
@@ -314,7 +328,7 @@ def opencv_sgbm(left: object, right: object, max_disparity: float) -> npt.NDArra
         speckleRange=_SGBM_SPECKLE_RANGE,
         mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY,
     )
-    raw = matcher.compute(as_bgr_uint8(la, "left"), as_bgr_uint8(ra, "right"))
+    raw = matcher.compute(_opencv_8bit(la, "left", False), _opencv_8bit(ra, "right", False))
     return _from_opencv(raw)
 
 
@@ -372,7 +386,7 @@ def ros_stereo_image_proc(
         _refuse_bm_range(num, la.shape, 15)
     else:
         _refuse_sgbm_range(num, la.shape[1], 15)
-    gl, gr = as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")
+    gl, gr = _opencv_8bit(la, "left", True), _opencv_8bit(ra, "right", True)
     matcher: cv2.StereoMatcher
     if algo == "bm":
         bm = cv2.StereoBM.create()
@@ -446,7 +460,9 @@ def stereovision_1_0(
     if algo == "bm":
         _refuse_bm_range(num, la.shape, 21)
         bm = cv2.StereoBM.create(numDisparities=num, blockSize=21)
-        return _from_opencv(bm.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")))
+        return _from_opencv(
+            bm.compute(_opencv_8bit(la, "left", True), _opencv_8bit(ra, "right", True))
+        )
     _refuse_sgbm_range(num, la.shape[1], 3)
     sg = cv2.StereoSGBM.create(
         minDisparity=0,
@@ -460,7 +476,9 @@ def stereovision_1_0(
         speckleRange=32,
         mode=cv2.STEREO_SGBM_MODE_SGBM,
     )
-    return _from_opencv(sg.compute(as_bgr_uint8(la, "left"), as_bgr_uint8(ra, "right")))
+    return _from_opencv(
+        sg.compute(_opencv_8bit(la, "left", False), _opencv_8bit(ra, "right", False))
+    )
 
 
 @renamed_keyword("disp", "disparity")
