@@ -1837,9 +1837,19 @@ def test_load_scene_keeps_gt_zero_and_large_values_as_disparities(tmp_path: Path
         s.gt, np.array([[0.0, 65504.0, np.nan, np.nan], [np.nan, 1.5, 0.0, 2.0]], np.float32)
     )
     assert s.max_disparity == 72064  # round_up16(1.1 * 65504 = 72054.4)
+    # the range its GT sets is said so, with that GT's largest value: a GT left in KITTI's
+    # 256 x scale was said only to need images 72065 px wide
     assert scene_too_narrow(s) == (
-        "images 4 px wide, not wider than the scene's disparity range (72064 px, "
-        "evaluation.md's rule: 16 at least): a scene needs images at least 72065 px wide"
+        "images 4 px wide, not wider than the scene's disparity range (72064 px: 1.1 x its "
+        "largest GT disparity, 65504 px, rounded up to a multiple of 16): a scene needs images "
+        "at least 72065 px wide, or its gt_disp.pfm is not in pixels (KITTI's PNGs hold 256 x "
+        "the disparity)"
+    )
+    # a range at evaluation.md's 16 px floor (a GT of 2 px) is said as before
+    write_pfm(d / "gt_disp.pfm", np.full((2, 4), 2.0, np.float32))
+    assert scene_too_narrow(load_scene(d)) == (
+        "images 4 px wide, not wider than the scene's disparity range (16 px, evaluation.md's "
+        "rule: 16 at least): a scene needs images at least 17 px wide"
     )
 
 

@@ -1858,14 +1858,30 @@ def scene_too_narrow(scene: Scene) -> str | None:
     Returns
     -------
     str or None
-        The reason, naming the images' width, the scene's range and the width it needs.
+        The reason, naming the images' width, the scene's range and the width it needs; for a
+        range its GT sets (above 16 px), the GT's largest disparity and that the GT may not
+        be in pixels (KITTI's PNGs hold 256 x the disparity).
     """
+    from stereovision._validate import figure_shown
+
     md, width = scene.max_disparity, scene.left.shape[1]
     if md < width:
         return None
+    needs = f"a scene needs images at least {md + 1} px wide"
+    gt = scene.gt
+    top = float(np.nanmax(gt, initial=-np.inf, where=np.isfinite(gt))) if gt is not None else 0.0
+    if top > 0 and 16 < md == scene_max_disparity(gt, width):
+        # a GT kept in KITTI's 256 x scale (4466 px on a 300 px crop) was said to need images
+        # 4913 px wide and nothing more: the rule's number, not the GT that set it
+        return (
+            f"images {width} px wide, not wider than the scene's disparity range ({md} px: 1.1 "
+            f"x its largest GT disparity, {figure_shown(top)} px, rounded up to a multiple of "
+            f"16): {needs}, or its gt_disp.pfm is not in pixels (KITTI's PNGs hold 256 x the "
+            "disparity)"
+        )
     return (
         f"images {width} px wide, not wider than the scene's disparity range ({md} px, "
-        f"evaluation.md's rule: 16 at least): a scene needs images at least {md + 1} px wide"
+        f"evaluation.md's rule: 16 at least): {needs}"
     )
 
 
