@@ -246,6 +246,31 @@ def test_eval_writes_each_scene_s_line_out_before_the_next_scene(
     assert written[1].count("a/tiny") == 1 and "b/tiny" not in written[1]
 
 
+def test_eval_table_keeps_its_columns_under_a_long_scene_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """The scene column was 38 characters whatever the names: a longer one
+    (outdoor_session_2026_12_01_rectified/tiny, 41) pushed its row's figures out from under
+    their labels. The column is as wide as the longest name."""
+    from stereovision import cli
+
+    folder = tmp_path / "outdoor_session_2026_12_01_rectified"
+    folder.mkdir()
+    syn.narrow_scene(folder, 4, 24)
+    dense = {"bad_2.0": 1.0, "bad_1.0": 2.0, "density": 100.0}
+
+    def fake(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> dict[str, Any]:
+        return {"scene": scene.name, "max_disparity": 16, "ours": dense, "ours+fill": dense}
+
+    monkeypatch.setattr(cli, "_eval_scene", fake)
+    proc = _eval(capfd, str(folder / "tiny"), "--no-opencv")
+    assert proc.returncode == 0, proc.stderr
+    header, sub, row = proc.stdout.splitlines()[:3]
+    assert row.startswith("outdoor_session_2026_12_01_rectified/tiny ")
+    bars = [[i for i, c in enumerate(line) if c == "|"] for line in (header, sub, row)]
+    assert bars[0] == bars[1] == bars[2], proc.stdout
+
+
 def test_eval_of_a_scene_where_ours_has_no_gt_depth(
     terrace: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

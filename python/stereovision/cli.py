@@ -1882,13 +1882,16 @@ def cmd_eval(args: argparse.Namespace) -> int:
     # table, the JSON lines and the depth lines: each is named by as many parents as needed
     names = dict(zip(dirs, scene_names(dirs), strict=True))
     rows = []
+    # the scene column as wide as the longest name (38 at least): a longer one pushed its row's
+    # figures out from under their labels
+    col = max([38] + [len(escaped(n)) for n in names.values()])
     header = (
-        f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
+        f"{'scene':{col}s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
         f" {'StereoBM':^20s} | {'SGBM-3WAY':^20s} | {'SGBM+fill':^20s}"
     )
     # each column's three labels over its three numbers (_fmt_dense: 6 characters each)
     labels = f"{'bad-2':>6s} {'bad-1':>6s} {'dens':>6s}"
-    sub = f"{'':38s} {'':>4s} | " + " | ".join([labels] * 5)
+    sub = f"{'':{col}s} {'':>4s} | " + " | ".join([labels] * 5)
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     failed: list[str] = []
     skipped = 0
@@ -1945,7 +1948,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             for key in ("bm", "sgbm", "sgbm+fill"):
                 cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
             name = escaped(row["scene"])  # one line, as the other lines name it
-            tqdm.write(f"{name:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+            tqdm.write(f"{name:{col}s} {row['max_disparity']:4d} | " + " | ".join(cells))
             sys.stdout.flush()
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (Terminated): the scenes evaluated are kept
         # the mean, time and depth lines come after the loop: the medians of the scenes timed
