@@ -296,6 +296,22 @@ def test_bench_names_two_scenes_of_one_name_by_their_parents(
     assert [r["scene"] for r in rows] == ["day1/cam/tiny", "day2/cam/tiny"]
 
 
+def test_bench_table_keeps_its_columns_under_a_long_scene_name() -> None:
+    """The scene column was 34 characters whatever the names: a longer one
+    (outdoor_session_2026_12_01/rectified_pair_000123, 48) pushed its rows' figures out from
+    under their labels. The column is as wide as the longest name."""
+    long = "outdoor_session_2026_12_01/rectified_pair_000123"
+    cases = [
+        BenchCase(scene, case, "opencv", 60, 40, 16, 5, 2.0, 1.0, {"bad_2.0": 3.0})
+        for scene in (long, "middlebury2001/tsukuba")
+        for case in ("StereoBM", "SGBM-3WAY")
+    ]
+    lines = format_table(cases).splitlines()
+    assert lines[1].startswith(f"{long}   60x40 ")
+    ends = {line.index(" 2.0 ") for line in lines[1:]}  # the ms column, in every row
+    assert len(ends) == 1 and lines[0].index("      ms") + 4 == ends.pop(), lines
+
+
 def test_bench_of_a_scene_no_higher_than_stereobms_block_times_the_others(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -312,16 +312,19 @@ def format_table(cases: Sequence[BenchCase]) -> str:
         A header line, then one line per case (the scene, size and range on its first case
         only; ``-`` for a figure without a value).
     """
+    # the scene column as wide as the longest name (34 at least): a longer one pushed its rows'
+    # figures out from under their labels
+    col = max([34] + [len(escaped(c.scene)) for c in cases])
     lines = [
-        f"{'scene':34s} {'size':>9s} {'D':>4s} {'case':12s} {'ms':>8s} {'x SGBM':>7s}"
+        f"{'scene':{col}s} {'size':>9s} {'D':>4s} {'case':12s} {'ms':>8s} {'x SGBM':>7s}"
         f" {'bad-2':>6s} {'+fill':>6s} {'dens':>6s} {'p@1':>6s} {'count':>6s}"
     ]
     last = None
     for c in cases:
         head = (
-            f"{escaped(c.scene):34s} {c.width:4d}x{c.height:<4d} {c.max_disparity:4d}"
+            f"{escaped(c.scene):{col}s} {c.width:4d}x{c.height:<4d} {c.max_disparity:4d}"
             if c.scene != last
-            else " " * 49
+            else " " * (col + 15)
         )
         last = c.scene
         a = c.accuracy
