@@ -1871,7 +1871,7 @@ def scene_too_narrow(scene: Scene) -> str | None:
     gt = scene.gt
     top = float(np.nanmax(gt, initial=-np.inf, where=np.isfinite(gt))) if gt is not None else 0.0
     if top > 0 and 16 < md == scene_max_disparity(gt, width):
-        # a GT kept in KITTI's 256 x scale (4466 px on a 300 px crop) was said to need images
+        # a GT kept in KITTI's 256 x scale (4458 px on a 300 px crop) was said to need images
         # 4913 px wide and nothing more: the rule's number, not the GT that set it
         return (
             f"images {width} px wide, not wider than the scene's disparity range ({md} px: 1.1 "
@@ -1904,8 +1904,8 @@ def scene_max_disparity(
     Returns
     -------
     int
-        ``round_up16(1.1 * max finite GT)``; without usable GT ``round_up16(ndisp)`` when it is
-        below ``width``, else ``round_up16(width // 4)`` (an ``ndisp`` the images have no room
+        ``round_up16(1.1 * max finite GT)``; without usable GT ``round_up16(ndisp)`` when that
+        is below ``width``, else ``round_up16(width // 4)`` (an ``ndisp`` the images have no room
         for bounds nothing: ETH3D's calib.txt gives the width).
 
     Raises
