@@ -28,7 +28,7 @@ from stereovision.matching.fusion import (
     fused_dense,
     remeasure,
 )
-from stereovision.matching.gabor import gabor_disparity
+from stereovision.matching.gabor import GaborResult, gabor_disparity
 from stereovision.matching.hopfield import hopfield_match
 from tests.reference import edges_ref
 
@@ -60,6 +60,23 @@ def test_vote_keeps_agreeing_pairs_and_averages() -> None:
     np.testing.assert_array_equal(res.sources, [1 | 4, 1 | 4])
     assert res.sources_map[5, 5] == 5 and res.count_map[7, 12] == 0
     assert np.isnan(res.dispx[7, 12]) and res.dispx[5, 8] == pytest.approx((5 + 10.6) / 1.5)
+
+
+def test_fuse_takes_a_gabor_result_and_names_what_is_no_channel() -> None:
+    """gabor_disparity's own result is the dense channel (it was "'GaborResult' object is not
+    subscriptable"); the disparity map alone, or a sparse channel's to_array(), is a TypeError
+    naming the argument (they failed on a row of the map, on a missing attribute)."""
+    hop = _m([(5, 5, 10.4), (8, 5, 10.6), (12, 7, 14.0)])
+    d, c = _dense(10.0, 0.5)
+    want = fuse((d, c), {"hopfield": hop})
+    got = fuse(GaborResult(disparity=d, confidence=c), {"hopfield": hop})
+    np.testing.assert_array_equal(got.matches.to_array(), want.matches.to_array())
+    np.testing.assert_array_equal(got.sources, want.sources)
+    assert len(fuse(np.stack([d, c]), {"hopfield": hop})) == len(want)  # a stacked pair, as before
+    with pytest.raises(TypeError, match=r"gabor: expected the \(dispx, conf\) maps or a Gabor"):
+        fuse(d, {"hopfield": hop})  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"sparse\['hopfield'\]: expected a stereovision.Matches"):
+        fuse(None, {"hopfield": hop.to_array()})  # type: ignore[dict-item]
 
 
 def test_sparse_channels_meet_within_radius() -> None:

@@ -308,7 +308,7 @@ def _check_agree(mode: str, min_agree: int, channels: Iterable[str]) -> None:
 
 
 def fuse(
-    gabor: tuple[npt.ArrayLike, npt.ArrayLike] | None,
+    gabor: tuple[npt.ArrayLike, npt.ArrayLike] | GaborResult | None,
     sparse: Mapping[str, Matches],
     *,
     mode: str = "vote",
@@ -322,9 +322,10 @@ def fuse(
 
     Parameters
     ----------
-    gabor : (dispx, conf) or None
-        The dense channel: ``(H, W)`` float32 disparity (NaN = none) and confidence in ``[0, 1]``.
-        Its vertical disparity is taken as 0 (rectified pairs).
+    gabor : (dispx, conf), GaborResult or None
+        The dense channel: ``(H, W)`` float32 disparity (NaN = none) and confidence in ``[0, 1]``,
+        or :func:`~stereovision.matching.gabor.gabor_disparity`'s result holding them. Its
+        vertical disparity is taken as 0 (rectified pairs).
     sparse : mapping of str to Matches
         The sparse channels by name (``"mcgm"``, ``"hopfield"``), each on the same image size.
     mode : {"vote", "intersection"}
@@ -352,7 +353,22 @@ def fuse(
         ``a_conf_min`` that is not a number in ``[0, 1]`` or a
         ``min_agree`` that is not a whole number of at least 2 or, in vote mode, is more than
         the channels given.
+    TypeError
+        A ``gabor`` that is neither a ``(dispx, conf)`` pair nor a
+        :class:`~stereovision.matching.gabor.GaborResult` (one map alone), or a sparse
+        channel that is no :class:`~stereovision.Matches` (its ``to_array()``).
     """
+    if isinstance(gabor, GaborResult):
+        # gabor_disparity's own result (FusionResult.channel_outputs["gabor"]) was Python's
+        # "'GaborResult' object is not subscriptable"
+        gabor = (gabor.disparity, gabor.confidence)
+    elif gabor is not None:
+        pair = isinstance(gabor, (tuple, list)) and len(gabor) == 2
+        stacked = isinstance(gabor, np.ndarray) and gabor.ndim == 3 and len(gabor) == 2
+        if not (pair or stacked):
+            # the disparity map alone: its first row was said to be no (H, W) map
+            got = _shown(gabor) if isinstance(gabor, np.ndarray) else type(gabor).__name__
+            raise TypeError(f"gabor: expected the (dispx, conf) maps or a GaborResult, got {got}")
     if mode not in ("vote", "intersection"):
         raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
     if not sparse:
@@ -360,6 +376,12 @@ def fuse(
     for name in sparse:
         if name not in CHANNEL_BITS or name == "gabor":
             raise ValueError(f"unknown sparse channel {name!r}: expected mcgm or hopfield")
+        if not isinstance(sparse[name], Matches):
+            # an (N, 4) to_array() was "'numpy.ndarray' object has no attribute 'image_shape'"
+            raise TypeError(
+                f"sparse[{name!r}]: expected a stereovision.Matches, got "
+                f"{type(sparse[name]).__name__}"
+            )
     # the checked values, not the raw ones: np.array([1.5]) passed the check and failed below
     mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree = _fuse_options(
         mode, r_spatial, tau_dx, tau_dy, a_conf_min, min_agree
