@@ -649,3 +649,23 @@ def test_gabor_responses_name_a_parameter_that_is_no_number(name: str, value: ob
     want = gabor_responses(img, freq=0.25, aspect=0.5)
     np.testing.assert_array_equal(gabor_responses(img, freq=Fraction(1, 4), aspect=0.5), want)
     np.testing.assert_array_equal(gabor_responses(img, freq=0.25, aspect=Decimal("0.5")), want)
+
+
+def test_every_parameter_is_documented() -> None:
+    """Each of DEFAULTS' keys is named in gabor_disparity's docstring and said in a comment
+    beside its default (as the Hopfield, MCGM and census DEFAULTS are): seven of them
+    (``lr_light``, ``fine_levels``, ...) were in neither, so only the Rust source told what
+    they do."""
+    import inspect
+
+    from stereovision.matching import gabor
+
+    doc = gabor_disparity.__doc__ or ""
+    params = doc[doc.index("**params") : doc.index("Returns")]
+    assert [k for k in DEFAULTS if f"``{k}``" not in params] == []
+    src = inspect.getsource(gabor)
+    block = src[src.index("DEFAULTS: dict") : src.index("\n}\n")]
+    for key in DEFAULTS:
+        line = next(ln for ln in block.splitlines() if f'"{key}":' in ln)
+        above = block.splitlines()[block.splitlines().index(line) - 1].strip()
+        assert "#" in line or above.startswith("#"), key

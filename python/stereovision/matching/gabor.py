@@ -36,30 +36,34 @@ from stereovision._validate import (
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 
-#: Default parameters of :func:`gabor_disparity` (mirrors ``GaborParams::default`` in Rust).
+#: Default parameters of :func:`gabor_disparity` (mirrors ``GaborParams::default`` in Rust,
+#: whose comments say how each was chosen).
 DEFAULTS: dict[str, object] = {
-    "freq": 0.25,
+    "freq": 0.25,  # carrier frequency at every pyramid level (cycles/px)
+    # orientations of the frequency vector from the x-axis (degrees, each in (-90, 90), <= 8)
     "orientations_deg": (0.0, 60.0, -60.0),
-    "bandwidth_oct": 1.5,
-    "aspect": 1.0,
-    "n_levels": None,
-    "iters_per_level": 1,
-    "amp_rel_thresh": 0.02,
-    "stability_tau": 1.25,
-    "smooth_sigma": None,
-    "conf_min": 0.15,
+    "bandwidth_oct": 1.5,  # radial bandwidth (octaves): sets the envelope's sigma
+    "aspect": 1.0,  # envelope aspect ratio sigma_x / sigma_y
+    "n_levels": None,  # pyramid depth; None = automatic (algorithms.md A.3)
+    "iters_per_level": 1,  # Newton steps per level above full resolution (<= 20)
+    "amp_rel_thresh": 0.02,  # amplitude threshold, fraction of the channel's 95th percentile
+    "stability_tau": 1.25,  # Fleet-Jepson stability threshold (units of 1 / sigma_x)
+    "smooth_sigma": None,  # normalised-convolution smoothing (px); None = the envelope's sigma
+    "conf_min": 0.15,  # smoothed confidence a pixel needs to be updated and reported (0..1)
+    # position-shift re-search at each level below the top (px at that level, <= 16)
     "research_radius": 3,
-    "search_pool_radius": 0,
-    "lr_check": True,
-    "lr_tol": 1.5,
+    "search_pool_radius": 0,  # half-size of the box pooling the search energy (px, <= 16)
+    "lr_check": True,  # left-right consistency check
+    "lr_tol": 1.5,  # ... its tolerance (px)
+    # the check's right-reference run stops this many levels above full resolution (<= 4)
     "lr_coarse_levels": 1,
-    "iters_finest": 1,
-    "research_finest": True,
-    "orientations_finest": 1,
-    "fine_levels": 1,
-    "lr_light": False,
-    "speckle_size": 100,
-    "speckle_range": 1.0,
+    "iters_finest": 1,  # Newton steps at full resolution (<= 20)
+    "research_finest": True,  # the re-search at full resolution too
+    "orientations_finest": 1,  # orientations (the first of orientations_deg, >= 1) at the ...
+    "fine_levels": 1,  # ... this many finest levels
+    "lr_light": False,  # a light right-reference run (<= 3 orientations, one step, no re-search)
+    "speckle_size": 100,  # speckle removal: regions of fewer pixels are dropped (0 = off) ...
+    "speckle_range": 1.0,  # ... neighbours within this many px are one region
 }
 
 
@@ -133,11 +137,14 @@ def gabor_disparity(
     min_disparity : float, optional
         Smallest disparity searched, in pixels (default 0).
     **params
-        Overrides of :data:`DEFAULTS`: ``freq`` (cycles/px), ``orientations_deg`` (degrees),
-        ``bandwidth_oct`` (octaves), ``aspect`` (sigma_x / sigma_y), ``n_levels`` (``None`` =
-        automatic), ``iters_per_level``, ``amp_rel_thresh`` (fraction of the 95th percentile),
-        ``stability_tau`` (1/sigma_x units), ``conf_min`` (0..1), ``research_radius`` (px),
-        ``search_pool_radius`` (px), ``lr_check`` (bool), ``lr_tol`` (px), ``speckle_size``
+        Overrides of :data:`DEFAULTS` (each documented there): ``freq`` (cycles/px),
+        ``orientations_deg`` (degrees), ``bandwidth_oct`` (octaves), ``aspect`` (sigma_x /
+        sigma_y), ``n_levels`` (``None`` = automatic), ``iters_per_level``, ``amp_rel_thresh``
+        (fraction of the 95th percentile), ``stability_tau`` (1/sigma_x units),
+        ``smooth_sigma`` (px, ``None`` = the envelope's sigma), ``conf_min`` (0..1),
+        ``research_radius`` (px), ``search_pool_radius`` (px), ``lr_check`` (bool), ``lr_tol``
+        (px), ``lr_coarse_levels``, ``iters_finest``, ``research_finest`` (bool),
+        ``orientations_finest``, ``fine_levels``, ``lr_light`` (bool), ``speckle_size``
         (pixels, 0 = off), ``speckle_range`` (px).
 
     Returns
