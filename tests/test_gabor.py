@@ -413,7 +413,8 @@ def test_the_widest_range_is_searched() -> None:
 
 def test_the_wrappers_own_checks_name_the_argument() -> None:
     """Checks the wrapper makes before the kernel, each in the caller's words: a range 8192.5 px
-    wide, a search_pool_radius of 17, a count of None (only n_levels means automatic), a uint8
+    wide, a search_pool_radius of 17, 21 Newton steps (iters_finest's named as its own), a
+    count of None (only n_levels means automatic), a uint8
     image, images differing only in width, a switch that is not a bool (TypeError)."""
     img = np.random.default_rng(0).random((24, 40)).astype(np.float32)
     cases: list[tuple[dict[str, object], str]] = [
@@ -424,6 +425,9 @@ def test_the_wrappers_own_checks_name_the_argument() -> None:
         ),
         ({"search_pool_radius": 17}, "search_pool_radius must be at most 16 px, got 17"),
         ({"iters_per_level": None}, "iters_per_level must be a non-negative integer, got None"),
+        # the kernel named iters_per_level for either ("iterations must be <= 20")
+        ({"iters_finest": 21}, "iters_finest must be at most 20, got 21"),
+        ({"iters_per_level": 21}, "iters_per_level must be at most 20, got 21"),
     ]
     for kw, says in cases:
         with pytest.raises(ValueError, match="^" + says):

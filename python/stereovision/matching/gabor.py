@@ -86,6 +86,8 @@ class GaborResult:
 
 #: Widest search range ``max_disparity - min_disparity`` (px) of the kernel.
 MAX_RANGE = 8192
+#: Most Newton steps per level (``iters_per_level``, ``iters_finest``) the kernel takes.
+_MAX_ITERS = 20
 
 # Parameters the kernel takes as counts (usize): a negative or fractional value is a ValueError
 # naming the key here, not an OverflowError from the binding.
@@ -222,6 +224,11 @@ def gabor_disparity(
         raise ValueError(
             f"search_pool_radius must be at most 16 px, got {kw['search_pool_radius']!r}"
         )
+    # The kernel checks both step counts in one test and names iters_per_level for either:
+    # iters_finest=21 was "invalid parameter `iters_per_level`: iterations must be <= 20".
+    for name in ("iters_per_level", "iters_finest"):
+        if kw[name] > _MAX_ITERS:
+            raise ValueError(f"{name} must be at most {_MAX_ITERS}, got {kw[name]!r}")
     orient = kw["orientations_deg"]
     # a string or a None in the sequence reached float(): its message named no parameter
     if (
