@@ -516,6 +516,21 @@ def test_plane_fill_min_pixels_lo_and_defaults() -> None:
         plane_fill(fifty, lab, min_pixels=True)
 
 
+@pytest.mark.parametrize("count", [49.0, np.array([49]), np.float32(49)])
+def test_plane_fill_reads_min_pixels_as_the_librarys_count(count: object) -> None:
+    """A whole number given as a float or read from an array is its count (whole_value), as
+    fill_planes' passes and segments' min_size read it: 49.0 was 'expected a whole number'."""
+    yy, xx = np.mgrid[0:10, 0:10]
+    d = (2 + 0.5 * xx + 0.25 * yy).astype(np.float32)
+    d.flat[49:] = np.nan
+    lab = np.zeros((10, 10), np.uint32)
+    want = plane_fill(d, lab, min_pixels=49)
+    assert want[9, 9] == pytest.approx(8.75, abs=1e-4)
+    np.testing.assert_array_equal(plane_fill(d, lab, min_pixels=count), want)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"min_pixels: expected a whole number, got 49\.5"):
+        plane_fill(d, lab, min_pixels=49.5)  # type: ignore[arg-type]
+
+
 def test_fill_planes_takes_a_zero_residual_and_a_zero_count() -> None:
     """``max_residual`` 0 and a pass's ``min_pixels`` 0 are in range (non-negative)."""
     c = np.full((10, 10), 5.0, np.float32)

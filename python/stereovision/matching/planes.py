@@ -31,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
-    NOT_NUMBERS,
+    _shown,
     check_index_range,
     finite_number,
     float_sized,
@@ -39,6 +39,7 @@ from stereovision._validate import (
     real_number,
     renamed_keyword,
     user_stacklevel,
+    whole_value,
 )
 
 __all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
@@ -317,13 +318,16 @@ def plane_fill(
             f" numbers them, got {int(raw.min())} .. {int(raw.max())}"
         )
     lab = np.ascontiguousarray(raw, dtype=np.uint32)
-    if not isinstance(min_pixels, (int, np.integer)) or isinstance(min_pixels, NOT_NUMBERS):
-        raise ValueError(f"min_pixels: expected a whole number, got {min_pixels!r}")
-    if not 0 <= min_pixels <= _MAX_COUNT:
-        raise ValueError(f"min_pixels: expected a non-negative count, got {min_pixels}")
+    # the library's one rule of a count (whole_value): 50.0 or np.array([50]) was refused here
+    # and taken by fill_planes' passes and segments' min_size
+    count = whole_value(min_pixels)
+    if count is None:
+        raise ValueError(f"min_pixels: expected a whole number, got {_shown(min_pixels)}")
+    if not 0 <= count <= _MAX_COUNT:
+        raise ValueError(f"min_pixels: expected a non-negative count, got {_shown(min_pixels)}")
     for name, v in (("max_residual", max_residual), ("lo", lo), ("hi", hi)):
         _real(v, name)
-    out, _, _ = _core.plane_fill(d, lab, int(min_pixels), float(max_residual), lo, hi)
+    out, _, _ = _core.plane_fill(d, lab, count, float(max_residual), lo, hi)
     return out
 
 
