@@ -1847,6 +1847,18 @@ def test_census_clear_refuses_a_negative_jump(jump: float) -> None:
     assert len(census_clear(res, np.full((H, W), 10.0, np.float32), jump=0.0)) == 1
 
 
+@pytest.mark.parametrize("jump", ["1.5", None, True, np.nan])
+def test_census_clear_names_a_jump_that_is_no_number(jump: object) -> None:
+    """A string or None failed in the comparison as Python's "'>=' not supported between
+    instances of 'str' and 'int'", naming nothing; True was a jump of 1 px. A size-1 array is
+    its number."""
+    res = fuse(_dense(10.0), {"hopfield": _m([(5, 5, 10.0)])})
+    census = np.full((H, W), 10.0, np.float32)
+    with pytest.raises(ValueError, match=r"^jump must be >= 0, got "):
+        census_clear(res, census, jump=jump)  # type: ignore[arg-type]
+    assert len(census_clear(res, census, jump=np.array([1.5]))) == 1  # type: ignore[arg-type]
+
+
 def test_fused_dense_edge_step_runs_from_a_one_pixel_radius() -> None:
     """Step 7 runs from ``edge_radius`` 1 (only 0 turns it off): a square drawn 1 px too wide
     on every side loses that 1 px ring, which a 1 px look reaches."""

@@ -34,6 +34,7 @@ from stereovision._validate import (
     _shown,
     finite_number,
     float32_reach,
+    real_number,
     refuse_unknown,
     whole_value,
 )
@@ -774,7 +775,8 @@ def census_clear(
     Raises
     ------
     ValueError
-        A census map of another shape, a negative radius or jump.
+        A census map of another shape, a negative radius or jump, or a jump that is no number
+        (a string, None, a bool).
     """
     import cv2
 
@@ -783,8 +785,11 @@ def census_clear(
         raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
     if radius < 0:
         raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
-    if not jump >= 0:
-        raise ValueError(f"jump must be >= 0, got {jump!r}")
+    # a string or None failed in the comparison as Python's "'>=' not supported", naming
+    # nothing, and True was a jump of 1 px; a size-1 array or a Fraction is its number
+    jump = _plain_option(jump)
+    if not real_number(jump) or not jump >= 0:
+        raise ValueError(f"jump must be >= 0, got {_shown(jump)}")
     # A window wider than the map is the whole map (the border is replicated): 2**70 was NumPy's
     # "Maximum allowed dimension exceeded", 10**5 a 40 GB kernel.
     r = min(int(radius), max(c.shape))
