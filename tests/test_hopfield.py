@@ -13,6 +13,7 @@ import csv
 import re
 from collections.abc import Callable
 from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
 
 import cv2
@@ -674,6 +675,23 @@ def test_interest_thresholds_of_another_type_are_named(value: object) -> None:
     for name in ("rel_threshold", "floor_rel"):
         with pytest.raises(ValueError, match=rf"^{name} must lie in \[0, 1\], got "):
             hp.interest_points(img, **{name: value})
+
+
+@pytest.mark.parametrize(
+    "value", [np.array([0.05]), np.array(0.05), Fraction(1, 20), Decimal("0.05")]
+)
+def test_interest_thresholds_read_as_hopfield_match_reads_them(value: object) -> None:
+    """A size-1 array, a Fraction or a Decimal is its number, as hopfield_match takes it for the
+    same keys: interest_points refused each as 'rel_threshold must lie in [0, 1], got
+    array([0.05])', a value within [0, 1]."""
+    img = np.random.default_rng(0).random((30, 40), dtype=np.float32)
+    for name in ("rel_threshold", "floor_rel"):
+        want = hp.interest_points(img, **{name: 0.05})
+        got = hp.interest_points(img, **{name: value})
+        np.testing.assert_array_equal(got.xy, want.xy)
+        assert len(want) > 0
+    with pytest.raises(ValueError, match=r"^rel_threshold must lie in \[0, 1\], got array"):
+        hp.interest_points(img, rel_threshold=np.array([1.5]))
 
 
 @pytest.mark.parametrize(

@@ -24,6 +24,7 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    _plain_option,
     _shown,
     as_gray_float,
     check_pair,
@@ -152,17 +153,20 @@ def interest_points(
         Bad image (shape, dtype, empty, NaN) or parameters out of range.
     """
     img = as_gray_float(image, "image")
+    fractions: list[float] = []
     for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
+        # as hopfield_match reads them: a size-1 array, a Fraction or a Decimal is its number
+        # (np.array([0.001]) was "must lie in [0, 1], got array([0.001])")
+        value = _plain_option(v)
         # a string or None reached float(): its message named no parameter
-        number = real_number(float_sized(v, name))  # True was 1.0, 0 ns was 0.0
-        if not (number and 0.0 <= float(v) <= 1.0):  # type: ignore[arg-type]
-            raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
+        number = real_number(float_sized(value, name))  # True was 1.0, 0 ns was 0.0
+        if not (number and 0.0 <= float(value) <= 1.0):
+            raise ValueError(f"{name} must lie in [0, 1], got {_shown(v)}")
+        fractions.append(float(value))
     # Sizes beyond the image act as the image: the cap keeps them within the kernel's integers.
     nms = int_in_range(nms_half, "nms_half", 1, 2**31 - 1)
     tiles = int_in_range(tile, "tile", 0, 2**31 - 1)
-    resp, xy, vals = _core.hopfield_interest(
-        img, float(rel_threshold), nms, tiles, float(floor_rel)
-    )
+    resp, xy, vals = _core.hopfield_interest(img, fractions[0], nms, tiles, fractions[1])
     return InterestPoints(xy=xy.astype(np.float32), values=vals, response=resp)
 
 
