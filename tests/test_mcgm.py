@@ -711,6 +711,20 @@ def test_matches_arrays_are_checked_and_kept_as_given() -> None:
         sv.Matches(xl=a, yl=a, xr=a[:2], yr=a, score=a, image_shape=(4, 4))
 
 
+def test_matches_name_values_float32_cannot_hold() -> None:
+    """A finite 1e40 became inf with only NumPy's "overflow encountered in cast" (from_csv
+    refuses it in a file), and a text energy trace was "could not convert string to float",
+    naming nothing."""
+    a = np.zeros(2)
+    big = np.array([1.0, -1e40])
+    with pytest.raises(ValueError, match=r"^xr: 1 finite value\(s\) beyond float32's range"):
+        sv.Matches(xl=a, yl=a, xr=big, yr=a, score=a, image_shape=(4, 4))
+    with pytest.raises(ValueError, match=r"^energy_trace: expected real values, got dtype <U3"):
+        sv.Matches(a, a, a, a, a, (4, 4), energy_trace="abc")  # type: ignore[arg-type]
+    m = sv.Matches(a, a, np.array([np.inf, 3.4e38]), a, a, (4, 4), energy_trace=[1, 2])
+    assert m.xr.tolist() == [np.inf, np.float32(3.4e38)] and m.energy_trace.tolist() == [1, 2]
+
+
 def test_matches_are_no_array_for_numpy() -> None:
     """A Matches is a sequence of one-match Matches: np.asarray(m) (as triangulate(m, m, calib)
     does) nested them 64 deep, 36 s for tsukuba's 4,877 MCGM matches, then "setting an array

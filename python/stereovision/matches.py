@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path, user_stacklevel
+from stereovision._validate import NOT_NUMBERS, as_path, refuse_beyond_float32, user_stacklevel
 from stereovision.calibration import Calibration
 from stereovision.io import atomic_write
 
@@ -40,6 +40,9 @@ def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
     # The float32 cast dropped a complex array's imaginary part with only NumPy's warning.
     if raw.dtype.kind not in "biuf":
         raise ValueError(f"{name}: expected real values, got dtype {raw.dtype}")
+    # a finite 1e40 became inf with only NumPy's "overflow encountered in cast" (from_csv
+    # refuses it in a file)
+    refuse_beyond_float32(raw, name, "would be read as inf (the matches are float32)")
     arr = np.ascontiguousarray(raw, dtype=np.float32)
     if arr.ndim != 1:
         raise ValueError(f"{name}: expected a 1-D array, got shape {arr.shape}")
@@ -114,8 +117,11 @@ class Matches:
         object.__setattr__(self, "image_shape", (h, w))
         # None is no trace and no stats: np.asarray(None, float) made a trace of one NaN
         # energy, and None as the stats an AttributeError at the first selection (m[:5])
-        trace = np.zeros(0) if self.energy_trace is None else self.energy_trace
-        object.__setattr__(self, "energy_trace", np.asarray(trace, dtype=np.float64).reshape(-1))
+        trace = np.asarray(np.zeros(0) if self.energy_trace is None else self.energy_trace)
+        # text was NumPy's "could not convert string to float", naming nothing
+        if trace.dtype.kind not in "biuf":
+            raise ValueError(f"energy_trace: expected real values, got dtype {trace.dtype}")
+        object.__setattr__(self, "energy_trace", trace.astype(np.float64).reshape(-1))
         if self.stats is None:
             object.__setattr__(self, "stats", {})
         elif not isinstance(self.stats, dict):
