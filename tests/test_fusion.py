@@ -1490,6 +1490,32 @@ def test_fuse_pair_without_a_sparse_channel_is_refused_before_the_matching(
         sv_match(img, img, method="fused", max_disparity=8, channels=channels)
 
 
+@pytest.mark.parametrize(
+    ("channels", "says"),
+    [
+        (("gabor", "mcgm", "hopfield"), "the mcgm and hopfield channels search from 0 px"),
+        (("gabor", "hopfield"), "the hopfield channel searches from 0 px"),
+    ],
+)
+def test_fuse_pair_refuses_a_negative_range_before_the_matching(
+    channels: tuple[str, ...], says: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The sparse channels' own refusal of min_disparity=-2 came after the Gabor channel and
+    the census map, which take a negative range, had run on the whole pair (0.46 s on cones)."""
+    import stereovision.matching.gabor as gabor_mod
+    import stereovision.matching.sgm as sgm_mod
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    monkeypatch.setattr(gabor_mod, "gabor_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    said = r"^min_disparity must be a non-negative number of pixels, got -2: " + says
+    with pytest.raises(ValueError, match=said):
+        fuse_pair(img, img, max_disparity=8, min_disparity=-2, channels=channels)
+
+
 def test_fuse_pair_reads_channels_given_as_a_generator() -> None:
     """886da87 read channels three times: a generator was used up by the unknown-name check
     and then said to hold "no sparse channel" (before it, it ran the census map alone and
