@@ -673,3 +673,15 @@ def test_every_parameter_is_documented() -> None:
         line = next(ln for ln in block.splitlines() if f'"{key}":' in ln)
         above = block.splitlines()[block.splitlines().index(line) - 1].strip()
         assert "#" in line or above.startswith("#"), key
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_gabor_responses_name_a_non_finite_image_by_its_keyword(bad: float) -> None:
+    """The kernel named its own argument, ``img``, the keyword renamed ``image`` (whose use
+    is deprecated): "img: image contains non-finite values (NaN or inf) at 1 pixels"."""
+    img = np.full((12, 16), 0.5, np.float32)
+    img[3, 4] = bad
+    with pytest.raises(
+        ValueError, match=r"^image: image contains non-finite values \(NaN or inf\) at 1 pix"
+    ):
+        gabor_responses(img)

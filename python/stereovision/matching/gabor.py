@@ -297,5 +297,11 @@ def gabor_responses(
         if isinstance(v, NOT_NUMBERS) or not isinstance(v, (numbers.Real, decimal.Decimal)):
             raise ValueError(f"{name}: expected a number, got {v!r}")
         values.append(float_sized(v, name))  # 10**400: the binding's bare OverflowError
-    re, im = _core.gabor_responses(_as_grey(image, "image"), *values)
+    img = _as_grey(image, "image")
+    # the kernel names its own argument: "img: image contains non-finite values ..." for the
+    # parameter renamed image (as gabor_disparity's kernel says it of "left")
+    bad = int(np.count_nonzero(~np.isfinite(img)))
+    if bad:
+        raise ValueError(f"image: image contains non-finite values (NaN or inf) at {bad} pixels")
+    re, im = _core.gabor_responses(img, *values)
     return (re + 1j * im).astype(np.complex64)
