@@ -1510,6 +1510,24 @@ def test_sigmas_not_coarse_to_fine_are_named(sigmas: object) -> None:
     assert len(mcgm.curves(ok, sigmas=[1.0])) == 1
 
 
+@pytest.mark.parametrize("kw", [{"sigmas": [4.0]}, {"sigmas": [8.0, 4.0]}, {"half_res_sigma": 1.0}])
+def test_channels_that_are_all_priors_are_named(kw: dict[str, object]) -> None:
+    """Every channel at or above half_res_sigma runs at half resolution as a prior only: the
+    run gave 0 matches without a word (cones crop: sigmas=[4.0] 0 matches of 14 segment pairs,
+    [3.9] 136). A ValueError names both; one finer channel (or a larger half_res_sigma) runs,
+    and curves() still shows the half-resolution channels."""
+    left, right = _sine_pair()
+    said = r"^sigmas: every channel \(.*\) is at or above half_res_sigma \(.*\), so each runs"
+    with pytest.raises(ValueError, match=said):
+        mcgm.mcgm_match(left, right, max_disparity=8, **kw)
+    with pytest.raises(ValueError, match=said):
+        mcgm.zncc_reference(left, right, max_disparity=8, **kw)
+    with pytest.raises(ValueError, match=said):
+        sv.match(left, right, method="mcgm", max_disparity=8, **kw)
+    assert all(c.scale == 2 for c in mcgm.curves(left, **kw))
+    assert len(mcgm.mcgm_match(left, right, max_disparity=8, sigmas=[4.0], half_res_sigma=8.0))
+
+
 def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> None:
     """zncc_reference reshaped ``pixels`` to (-1, 2) and cast it to int64: a (2, N) array
     (np.nonzero's rows, or x over y) was paired into other pixels, and (10.7, 20.2) truncated

@@ -55,7 +55,8 @@ __all__ = [
 #: Default parameters (mirror ``McgmParams::default`` in Rust; algorithms.md B.2 + B.8).
 DEFAULTS: dict[str, Any] = {
     "sigmas": [4.0, 2.0, 1.0],  # LoG channels, coarse to fine (px, B.2)
-    "half_res_sigma": 4.0,  # channels this coarse run on the 2x-decimated image, prior only
+    # channels this coarse run on the 2x-decimated image, prior only (one must be finer)
+    "half_res_sigma": 4.0,
     "high_quantile": 0.5,  # t_high = this quantile of crossing strengths (B.8: 50th percentile)
     "low_ratio": 0.4,  # t_low = 0.4 t_high (B.2)
     "max_turn_deg": 60.0,  # normal change allowed between curve pixels (B.8: 60, paper 18)
@@ -252,6 +253,23 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     return kw
 
 
+def _refuse_priors_only(kw: dict[str, Any]) -> None:
+    """A ``ValueError`` naming ``sigmas`` and ``half_res_sigma`` when every channel is at or
+    above ``half_res_sigma``: each then runs at half resolution as a prior only, and the run
+    gave 0 matches without a word (cones crop: ``sigmas=[4.0]`` 0 matches of 14 pairs, where
+    ``[3.9]`` gave 136; ``half_res_sigma=1.0`` 0 instead of 1430). A half_res_sigma that is
+    no number >= 0 is left to the kernel, which names it."""
+    half = kw["half_res_sigma"]
+    if not real_number(half) or not 0 <= half < math.inf:
+        return
+    if all(s >= half for s in kw["sigmas"]):
+        raise ValueError(
+            f"sigmas: every channel ({reprlib.repr(kw['sigmas'])}) is at or above "
+            f"half_res_sigma ({half}), so each runs at half resolution as a prior only and "
+            "none gives a match: add a finer sigma or raise half_res_sigma"
+        )
+
+
 def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
     """Separable zero-mean scale-normalised LoG ``sigma^2 lap(G)`` (B.3), ``(H, W)`` float32.
 
@@ -364,8 +382,9 @@ def mcgm_match(
     ------
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter, a value
-        out of range, ``sigmas`` not coarse to fine, a ``debug`` that is not True or False, or a
-        ``min_disparity`` not below the image width (as :func:`stereovision.match`: no pixel
+        out of range, ``sigmas`` not coarse to fine or all at or above ``half_res_sigma``
+        (priors only: no channel could give a match), a ``debug`` that is not True or False, or
+        a ``min_disparity`` not below the image width (as :func:`stereovision.match`: no pixel
         has a match that far).
     MemoryError
         When an image-sized buffer of the kernel cannot be allocated (the message names it and
@@ -387,6 +406,7 @@ def mcgm_match(
         raise ValueError(f"debug: expected True or False, got {debug!r}")
     gl, gr = check_pair(left, right)
     kw = _params(max_disparity, min_disparity, params)
+    _refuse_priors_only(kw)
     refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
     m, stats, chans = _core.mcgm_match(gl, gr, kw)
     st: dict[str, Any] = dict(stats)
@@ -561,6 +581,7 @@ def zncc_reference(
     h, w = gl.shape
     refuse_unreachable_range(min_disparity, max_disparity, w)
     if pixels is None:
+        _refuse_priors_only(kw)  # no full-resolution channel: no pixel to match
         mask = np.zeros((h, w), dtype=bool)
         min_cos = np.sin(np.deg2rad(kw["horiz_skip_deg"]))
         for c in curves(gl, **params):
