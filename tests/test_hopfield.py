@@ -833,3 +833,31 @@ def test_a_bool_or_a_time_in_a_size_1_array_is_no_number(name: str, value: objec
     with pytest.raises(ValueError) as exc:
         hp.hopfield_match(left, left, max_disparity=8, **{name: value})
     assert str(exc.value) == f"{name}: expected a number, got {value!r}"
+
+
+@pytest.mark.parametrize("method", ["hopfield", "best", "mcgm", "gabor", "fused"])
+def test_a_float16_range_gives_the_floats_matches_without_a_warning(method: str) -> None:
+    """A range given as np.float16 (read from a half-precision map) was clipped against
+    2**31 - 1 cast to float16: NumPy's "overflow encountered in cast", up to four times per
+    call (match's range filter, the Hopfield and MCGM wrappers, the census map's check), for
+    the same matches as the float's."""
+    import warnings
+
+    from stereovision.matching.sgm import sgm_disparity
+
+    rng = np.random.default_rng(2)
+    right = rng.random((40, 64)).astype(np.float32)
+    left = np.roll(right, 5, axis=1)
+    want = sv.match(left, right, method=method, max_disparity=12.5, min_disparity=2.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = sv.match(
+            left,
+            right,
+            method=method,
+            max_disparity=np.float16(12.5),
+            min_disparity=np.float16(2.5),
+        )
+        sgm = sgm_disparity(left, right, max_disparity=np.float16(12.5))
+    np.testing.assert_array_equal(got.to_array(), want.to_array())
+    np.testing.assert_array_equal(sgm, sgm_disparity(left, right, max_disparity=12.5))

@@ -293,8 +293,12 @@ def _in_range(m: Matches, lo: float, hi: float) -> npt.NDArray[np.bool_]:
     # NumPy's bare TypeError, np.array([[4.05]]) a 2-D mask)
     lo, hi = (v.reshape(())[()] if isinstance(v, np.ndarray) else v for v in (lo, hi))
     # lo as a Python float, as before (a NumPy float64 would compare in float64)
+    lo = lo.item() if isinstance(lo, np.generic) else lo  # its float, without float16's cast
     lo = float(min(max(lo, -_BOUND_CLIP), _BOUND_CLIP))
-    hi = min(max(hi, -_BOUND_CLIP), _BOUND_CLIP)
+    # a NumPy float within the clip is kept as it is (and compared as before): the clip cast
+    # 2**31 - 1 to a float16 bound, NumPy's "overflow encountered in cast"
+    inside = isinstance(hi, np.floating) and abs(float(hi)) <= _BOUND_CLIP
+    hi = hi if inside else min(max(hi, -_BOUND_CLIP), _BOUND_CLIP)
     return (d >= lo) & (d <= hi)
 
 

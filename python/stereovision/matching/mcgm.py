@@ -239,8 +239,13 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     # The kernel clips the range to the image; the clip here keeps it within its integers
     # (without a float of an int beyond a float's range: 2**1100 was an OverflowError).
     big = 2**31 - 1
-    lo = math.floor(min(min_disparity, big))
-    hi = math.ceil(min(max_disparity, big))
+    # a NumPy scalar as its Python number: min() cast 2**31 - 1 to a float16 range bound
+    # (NumPy's "overflow encountered in cast"); the same whole bounds
+    lo_v, hi_v = (
+        v.item() if isinstance(v, np.generic) else v for v in (min_disparity, max_disparity)
+    )
+    lo = math.floor(min(lo_v, big))
+    hi = math.ceil(min(hi_v, big))
     # the range as given, not as rounded and clipped: min_disparity 32.5 over a max_disparity of 32
     # (lo 32 <= hi 32) gave no match without a word, and 1e300 was shown as its clip 2147483647
     if max_disparity < min_disparity:

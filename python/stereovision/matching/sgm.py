@@ -191,7 +191,8 @@ def sgm_disparity(
         # The kernel takes i32 levels (and at most 2048 of them); 1e300 is finite, only too big.
         if not math.isfinite(float_sized(v, name)):
             raise ValueError(f"{name}: expected a finite number of pixels, got {v}")
-        if abs(v) >= _I32_LIMIT:
+        # its Python number: a float16 bound cast the limit to float16 (NumPy's overflow warning)
+        if abs(v.item() if isinstance(v, np.generic) else v) >= _I32_LIMIT:
             raise ValueError(
                 f"{name}: {v} is outside the census kernel's 32-bit integer levels "
                 f"(|{name}| must be below {_I32_LIMIT})"
