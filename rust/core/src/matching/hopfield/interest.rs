@@ -646,20 +646,17 @@ mod tests {
         }
     }
 
-    /// The selection rule of [`interest_points`] by brute force: threshold from the pixel's
-    /// tile maximum and the floor from the map's maximum, strict against earlier neighbours,
-    /// at least as large as later ones, raster order.
-    fn select_brute(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<(u32, u32, f32)> {
-        let tile = if p.tile == 0 {
+    /// Each pixel's tile maximum by brute force (`tile` 0: one tile over the map), the
+    /// threshold's base in [`select_brute`].
+    fn tile_max_brute(m: &[f32], w: usize, h: usize, tile: usize) -> Vec<f32> {
+        let tile = if tile == 0 {
             w.max(h)
         } else {
-            p.tile.min(w.max(h))
+            tile.min(w.max(h))
         };
-        let max = m.iter().copied().fold(0.0f32, f32::max);
-        let r = p.nms_half as isize;
-        let mut out = Vec::new();
-        for y in BORDER..h.saturating_sub(BORDER) {
-            for x in BORDER..w.saturating_sub(BORDER) {
+        let mut out = vec![0.0f32; w * h];
+        for y in 0..h {
+            for x in 0..w {
                 let (tx, ty) = (x / tile * tile, y / tile * tile);
                 let mut tmax = 0.0f32;
                 for yy in ty..(ty + tile).min(h) {
@@ -667,9 +664,21 @@ mod tests {
                         tmax = tmax.max(m[yy * w + xx]);
                     }
                 }
+                out[y * w + x] = tmax;
+            }
+        }
+        out
+    }
+
+    /// Each pixel's window rule by brute force: strict against earlier neighbours within
+    /// `nms_half`, at least as large as later ones (the part of [`select_brute`] that does
+    /// not depend on the tile or the thresholds: computed once for all of them).
+    fn nms_brute(m: &[f32], w: usize, h: usize, nms_half: usize) -> Vec<bool> {
+        let r = nms_half as isize;
+        let mut out = vec![true; w * h];
+        for y in 0..h {
+            for x in 0..w {
                 let v = m[y * w + x];
-                let thr = (tmax * p.rel_threshold).max(max * p.floor_rel);
-                let mut peak = v > 0.0 && v >= thr;
                 // Offsets of the window inside the image only: the others were skipped one by
                 // one (14641 of them a pixel at nms_half 60, most of the test's time).
                 let (x0, y0) = (x as isize, y as isize);
@@ -682,11 +691,34 @@ mod tests {
                         let n = m[yy as usize * w + xx as usize];
                         let earlier = dy < 0 || (dy == 0 && dx < 0);
                         if n > v || (earlier && n == v) {
-                            peak = false;
+                            out[y * w + x] = false;
                         }
                     }
                 }
-                if peak {
+            }
+        }
+        out
+    }
+
+    /// The selection rule of [`interest_points`] by brute force: threshold from the pixel's
+    /// tile maximum (`tmax`: [`tile_max_brute`] of `p.tile`) and the floor from the map's
+    /// maximum, strict against earlier neighbours, at least as large as later ones (`nms`:
+    /// [`nms_brute`] of `p.nms_half`), raster order.
+    fn select_brute(
+        m: &[f32],
+        w: usize,
+        h: usize,
+        p: &InterestParams,
+        tmax: &[f32],
+        nms: &[bool],
+    ) -> Vec<(u32, u32, f32)> {
+        let max = m.iter().copied().fold(0.0f32, f32::max);
+        let mut out = Vec::new();
+        for y in BORDER..h.saturating_sub(BORDER) {
+            for x in BORDER..w.saturating_sub(BORDER) {
+                let v = m[y * w + x];
+                let thr = (tmax[y * w + x] * p.rel_threshold).max(max * p.floor_rel);
+                if v > 0.0 && v >= thr && nms[y * w + x] {
                     out.push((x as u32, y as u32, v));
                 }
             }
@@ -748,8 +780,12 @@ mod tests {
                     k as f32 / 8.0 * scale
                 })
                 .collect();
+            let tiles = [0, 5, 16, 64];
+            let tmaxes: Vec<Vec<f32>> =
+                tiles.iter().map(|&t| tile_max_brute(&m, w, h, t)).collect();
             for nms_half in [1, 2, 3, 7, 20, 60] {
-                for tile in [0, 5, 16, 64] {
+                let nms = nms_brute(&m, w, h, nms_half);
+                for (&tile, tmax) in tiles.iter().zip(&tmaxes) {
                     for (rel_threshold, floor_rel) in [(0.5, 0.0), (0.25, 0.5), (1e-3, 1e-4)] {
                         let p = InterestParams {
                             rel_threshold,
@@ -762,7 +798,7 @@ mod tests {
                             .iter()
                             .map(|q| (q.x, q.y, q.value))
                             .collect();
-                        assert_eq!(got, select_brute(&m, w, h, &p), "{w}x{h} {p:?}");
+                        assert_eq!(got, select_brute(&m, w, h, &p, tmax, &nms), "{w}x{h} {p:?}");
                     }
                 }
             }
