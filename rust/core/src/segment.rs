@@ -694,6 +694,39 @@ pub(crate) mod tests {
         stdout
     }
 
+    /// Runs `f` in a forked copy of this process and waits for it: the variants of one child
+    /// test (several memory limits) share what it computed before the forks, each limit in a
+    /// process of its own. Fails when the fork does not exit 0 (an abort on a failed
+    /// allocation, a panic). The global rayon pool must not have started before the fork (a
+    /// forked process has the forking thread only): the fork starts its own.
+    #[cfg(target_os = "linux")]
+    pub(crate) fn in_a_fork(f: impl FnOnce()) {
+        use std::io::Write;
+        extern "C" {
+            fn fork() -> i32;
+            fn waitpid(pid: i32, status: *mut i32, options: i32) -> i32;
+            fn _exit(status: i32) -> !;
+        }
+        std::io::stdout().flush().unwrap(); // not printed twice by the fork
+                                            // SAFETY: plain fork; the fork runs `f` and leaves by `_exit`, never returning here.
+        let pid = unsafe { fork() };
+        assert!(pid >= 0, "fork failed");
+        if pid == 0 {
+            let ok = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).is_ok();
+            let flushed = std::io::stdout().flush().is_ok();
+            // SAFETY: ends the forked process without running the test harness on.
+            unsafe { _exit(if ok && flushed { 0 } else { 101 }) }
+        }
+        let mut status = 0i32;
+        // SAFETY: a valid pointer to an int for the wait status.
+        assert_eq!(
+            unsafe { waitpid(pid, &mut status, 0) },
+            pid,
+            "waitpid failed"
+        );
+        assert_eq!(status, 0, "the fork failed (wait status {status:#x})");
+    }
+
     /// This process's mapped address space (`VmSize`), in bytes.
     #[cfg(target_os = "linux")]
     pub(crate) fn vm_size() -> usize {

@@ -1183,35 +1183,46 @@ fn network_orders_too_large_to_allocate_are_an_error() {
 
 /// Run by [`final_stages_too_large_to_allocate_are_an_error`] in a child process: the final
 /// selection and the depth-edge filters of 2^18 lone neurons (256 rows of 1024: building
-/// their network in debug code is most of the child's time), all on (the network built
-/// before), under an address-space limit of `SV_OOM_MIB` MiB more than is mapped. Measured:
-/// the selection fails at 0.25 to 4 MiB, the point grid at 6, the filters at 8 to 14.
+/// their network in debug code is most of the child's time, done once, on a pool of its own,
+/// before a fork per limit), all on (the network built before), under an address-space limit
+/// of each of the comma-separated `SV_OOM_MIB` MiB more than is mapped. Measured in the
+/// forks (half-MiB steps): the selection fails at 0.25 to 5.5 MiB, the point grid at 6 to
+/// 7.5, the filters at 8 to 15 (one process a limit: 0.25 to 4, 6, 8 to 14).
 #[cfg(target_os = "linux")]
 #[test]
 #[ignore = "a child of final_stages_too_large_to_allocate_are_an_error"]
 fn final_stages_under_a_memory_limit() {
-    let Some(mib) = std::env::var_os("SV_OOM_MIB") else {
+    let Some(mibs) = std::env::var_os("SV_OOM_MIB") else {
         return;
     };
-    let mib: f64 = mib.to_str().unwrap().parse().unwrap();
     let neurons = lone_neurons_in(256);
     let p = HopfieldParams::default();
-    let net = Network::new(&neurons, &p.weights).unwrap();
+    // Not on the global pool: a fork would wait on its thread, which the fork has not.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let net = pool.install(|| Network::new(&neurons, &p.weights)).unwrap();
     let state = vec![1u8; neurons.len()];
     let img = vec![0.0f32; 4];
     let v = ImageView::new(2, 2, &img).unwrap();
-    rayon::join(|| (), || ()); // the pool's thread started before the limit
-    crate::segment::tests::limit_address_space(
-        crate::segment::tests::vm_size() + (mib * f64::from(1 << 20)) as usize,
-    );
-    let run = || -> Result<usize> {
-        let selected = fallback(&neurons, &net, &state, &p)?;
-        let chosen = disambiguate(&neurons, &net, &selected, &p)?;
-        Ok(finish(&v, &v, &neurons, &chosen, &p)?.len())
-    };
-    match run() {
-        Ok(n) => println!("child: {n} matches"),
-        Err(e) => println!("child: error: {e}"),
+    for mib in mibs.to_str().unwrap().split(',') {
+        crate::segment::tests::in_a_fork(|| {
+            let limit: f64 = mib.parse().unwrap();
+            rayon::join(|| (), || ()); // the pool's thread started before the limit
+            crate::segment::tests::limit_address_space(
+                crate::segment::tests::vm_size() + (limit * f64::from(1 << 20)) as usize,
+            );
+            let run = || -> Result<usize> {
+                let selected = fallback(&neurons, &net, &state, &p)?;
+                let chosen = disambiguate(&neurons, &net, &selected, &p)?;
+                Ok(finish(&v, &v, &neurons, &chosen, &p)?.len())
+            };
+            match run() {
+                Ok(n) => println!("child: {mib} MiB: {n} matches"),
+                Err(e) => println!("child: {mib} MiB: error: {e}"),
+            }
+        });
     }
 }
 
@@ -1222,17 +1233,17 @@ fn final_stages_too_large_to_allocate_are_an_error() {
     // agreement) built their per-neuron, per-point and per-match lists and their point grids
     // (PointGrid::new) with collect/vec!/push: a failed allocation aborted the process
     // (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child_with(
+        "matching::hopfield::tests::final_stages_under_a_memory_limit",
+        Some(("SV_OOM_MIB", "0.25,6,10")),
+    );
     for (mib, want) in [
         ("0.25", "the Hopfield matcher's final selection needs "),
         ("6", "the Hopfield matcher's point grid needs "),
         ("10", "the Hopfield matcher's depth-edge filters needs "),
     ] {
-        let stdout = crate::segment::tests::run_oom_child_with(
-            "matching::hopfield::tests::final_stages_under_a_memory_limit",
-            Some(("SV_OOM_MIB", mib)),
-        );
-        let want = format!("child: error: out of memory: {want}");
-        assert!(stdout.contains(&want), "{mib} MiB: {want} not in {stdout}");
+        let want = format!("child: {mib} MiB: error: out of memory: {want}");
+        assert!(stdout.contains(&want), "{want} not in {stdout}");
     }
 }
 
