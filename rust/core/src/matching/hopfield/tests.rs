@@ -1346,7 +1346,7 @@ fn right_rows_too_large_to_allocate_are_an_error() {
 /// match at all for `edge_tol` or `dy_window` = 2^64 - 1, values the binding accepts.
 #[test]
 fn windows_wider_than_the_image_cover_it_up_to_usize_max() {
-    let (l, r) = shifted_pair(120, 90, 7);
+    let (l, r) = shifted_pair(120, 45, 7);
     let pts = |nms_half: usize| {
         let p = InterestParams {
             nms_half,
