@@ -707,8 +707,9 @@ pub(crate) mod tests {
             fn waitpid(pid: i32, status: *mut i32, options: i32) -> i32;
             fn _exit(status: i32) -> !;
         }
-        std::io::stdout().flush().unwrap(); // not printed twice by the fork
-                                            // SAFETY: plain fork; the fork runs `f` and leaves by `_exit`, never returning here.
+        // flushed first, so nothing buffered is printed twice (by the fork too)
+        std::io::stdout().flush().unwrap();
+        // SAFETY: plain fork; the fork runs `f` and leaves by `_exit`, never returning here.
         let pid = unsafe { fork() };
         assert!(pid >= 0, "fork failed");
         if pid == 0 {
