@@ -1356,6 +1356,20 @@ def test_pcd_header_incomplete_or_not_terminated(tmp_path):
         export.read_pcd(path)
 
 
+def test_pcd_without_height_is_unorganised_as_pcl_reads_it(tmp_path):
+    """PCL's reader takes a file without HEIGHT (PCD before 0.7) as unorganised, HEIGHT 1, and
+    WIDTH as its POINTS when not given either: both were refused as an incomplete header."""
+    path = _xyz_pcd(tmp_path / "h.pcd")
+    path.write_text(path.read_text().replace("HEIGHT 1\n", ""))
+    assert export.read_pcd(path)[0].tolist() == [[[1, 2, 3], [4, 5, 6]]]
+    path.write_text(path.read_text().replace("WIDTH 2\n", ""))
+    assert export.read_pcd(path)[0].tolist() == [[[1, 2, 3], [4, 5, 6]]]
+    # nor WIDTH, HEIGHT nor POINTS: incomplete still
+    path.write_text(path.read_text().replace("POINTS 2\n", ""))
+    with pytest.raises(ValueError, match=r"^PCD file .*h\.pcd: incomplete header$"):
+        export.read_pcd(path)
+
+
 def test_read_npz_of_a_npy_file_is_named(tmp_path):
     """np.load gives a .npy file's array, not a bundle: read_npz failed with "'numpy.ndarray'
     object does not support the context manager protocol"."""

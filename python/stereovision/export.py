@@ -414,7 +414,14 @@ def read_pcd(
         sizes = [int(s) for s in meta["SIZE"]]
         types = meta["TYPE"]
         counts = [int(c) for c in meta.get("COUNT", ["1"] * len(names))]
-        width, height = int(meta["WIDTH"][0]), int(meta["HEIGHT"][0])
+        # PCL's reader: a file without HEIGHT (PCD before 0.7) is unorganised, HEIGHT 1, and
+        # WIDTH is its POINTS when not given either ("incomplete header" refused such files)
+        points = int(meta["POINTS"][0]) if "POINTS" in meta else None
+        if "HEIGHT" in meta or points is None:
+            width, height = int(meta["WIDTH"][0]), int(meta["HEIGHT"][0])
+        else:
+            width = int(meta["WIDTH"][0]) if "WIDTH" in meta else points
+            height = 1
         mode = meta["DATA"][0]
     except (KeyError, IndexError, ValueError):
         raise ValueError(f"PCD file {p}: incomplete header") from None
