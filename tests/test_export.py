@@ -1018,8 +1018,11 @@ def test_read_pcd_names_what_is_wrong(tmp_path):
     # PCL's binary_compressed (LZF, fields one after the other) is not read as binary records
     packed = _xyz_pcd(tmp_path / "lzf.pcd", "", mode="binary_compressed")
     packed.write_bytes(packed.read_bytes() + b"\0" * 64)
-    with pytest.raises(ValueError, match=r"unsupported DATA 'binary_compressed' \(ascii or b"):
+    with pytest.raises(ValueError, match=r"lzf\.pcd: 0 bytes of compressed points, expected 24"):
         export.read_pcd(packed)
+    other = _xyz_pcd(tmp_path / "lzf.pcd", "", mode="binary_zstd")
+    with pytest.raises(ValueError, match=r"unsupported DATA 'binary_zstd' \(ascii, binary or b"):
+        export.read_pcd(other)
     quad = tmp_path / "u1.pcd"
     quad.write_text(
         "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 1\nTYPE F F F U\n"
@@ -1368,6 +1371,77 @@ def test_pcd_without_height_is_unorganised_as_pcl_reads_it(tmp_path):
     path.write_text(path.read_text().replace("POINTS 2\n", ""))
     with pytest.raises(ValueError, match=r"^PCD file .*h\.pcd: incomplete header$"):
         export.read_pcd(path)
+
+
+def _lzf(data):
+    """LZF as liblzf's lzf_compress writes it (greedy, for the tests' few bytes): literal runs
+    of 1-32 bytes (control 0-31), back references of 3-264 bytes (LZF's reach: 8192 back)."""
+    out, lit, i = bytearray(), bytearray(), 0
+
+    def flush():
+        while lit:
+            out.append(len(lit[:32]) - 1)
+            out.extend(lit[:32])
+            del lit[:32]
+
+    while i < len(data):
+        best, back = 0, 0
+        for start in range(max(0, i - 300), i):  # 300, not 8192 back: a fast test
+            k = 0
+            while i + k < len(data) and k < 264 and data[start + k] == data[i + k]:
+                k += 1
+            if k > best:
+                best, back = k, i - start - 1
+        if best < 3:
+            lit.append(data[i])
+            i += 1
+            continue
+        flush()
+        n = best - 2
+        out += bytes([7 << 5 | back >> 8, n - 7]) if n >= 7 else bytes([n << 5 | back >> 8])
+        out.append(back & 0xFF)
+        i += best
+    flush()
+    return bytes(out)
+
+
+def test_pcd_binary_compressed_as_pcl_writes_it(tmp_path):
+    """PCL's savePCDFileBinaryCompressed (DATA binary_compressed: sizes, then LZF of each
+    field's values in turn) was refused, 'unsupported DATA'; it reads as the binary file."""
+    n = 120  # repeated values: back references, long and overlapping ones
+    pts = np.zeros((n, 3), np.float32)
+    pts[:, 0] = np.arange(n) % 7
+    pts[::5, 1] = np.nan
+    pts[:, 2] = 2.5
+    rgb = np.full(n, 0xFF0A141E, np.uint32)
+    rgb[1::2] = 0xFFFF0000
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z _ rgb\nSIZE 4 4 4 1 4\nTYPE F F F U U\n"
+        f"COUNT 1 1 1 3 1\nWIDTH {n // 2}\nHEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\n"
+    )
+    planes = b"".join(
+        [pts[:, 0].tobytes(), pts[:, 1].tobytes(), pts[:, 2].tobytes(), bytes(3 * n), rgb.tobytes()]
+    )
+    lzf = _lzf(planes)
+    assert len(lzf) < len(planes) // 4  # it did compress
+    path = tmp_path / "c.pcd"
+    body = np.array([len(lzf), len(planes)], "<u4").tobytes() + lzf
+    path.write_bytes((head + "DATA binary_compressed\n").encode() + body)
+    got, cols = export.read_pcd(path)
+    np.testing.assert_array_equal(got, pts.reshape(2, n // 2, 3))
+    assert cols.reshape(-1, 3)[:2].tolist() == [[10, 20, 30], [255, 0, 0]]
+    assert export.load_cloud(path)[0].shape == (n - n // 5, 3)
+    # a literal 'A' and 12 more from one byte back (the overlapping copy of liblzf)
+    assert export._lzf_decompress(b"\x00A\xe0\x03\x00", 13, path) == b"A" * 13
+    sizes = np.array([2, len(planes)], "<u4").tobytes()
+    for cut, word in (
+        (body[:-1], "truncated"),
+        (sizes + b"\x20\x05", "damaged"),  # a reference before the start
+        (sizes + b"\x00A", "damaged"),  # 1 byte of 2280
+    ):
+        path.write_bytes((head + "DATA binary_compressed\n").encode() + cut)
+        with pytest.raises(ValueError, match=rf"^{word} PCD file .*c\.pcd"):
+            export.read_pcd(path)
 
 
 def test_read_npz_of_a_npy_file_is_named(tmp_path):

@@ -362,7 +362,8 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
 def read_pcd(
     path: PathLike,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
-    """Read a PCD file with ``x y z`` (float) and optional packed ``rgb`` (ascii or binary data).
+    """Read a PCD file with ``x y z`` (float) and optional packed ``rgb`` (ascii, binary or
+    PCL's LZF ``binary_compressed`` data).
 
     The colour is PCL's packed ``0xAARRGGBB`` (alpha unread) in a 4-byte ``rgb`` (or ``rgba``)
     field, read as bits whether the header types it ``F`` (``pcl::PointXYZRGB``), ``U`` or
@@ -478,12 +479,83 @@ def read_pcd(
                 rec[name] = bits.astype("<u4").view(dtype[name])
             else:
                 rec[name] = col
+    elif mode == "binary_compressed":
+        rec = _compressed_pcd_records(raw[pos:], dtype, n, p)
     else:
-        raise ValueError(f"PCD file {p}: unsupported DATA {mode!r} (ascii or binary)")
+        raise ValueError(
+            f"PCD file {p}: unsupported DATA {mode!r} (ascii, binary or binary_compressed)"
+        )
     pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=-1).astype(np.float32)
     cols = None if colour is None else _unpack_rgb(np.asarray(rec[colour]))
     shape = (height, width)
     return pts.reshape(*shape, 3), None if cols is None else cols.reshape(*shape, 3)
+
+
+def _lzf_decompress(data: bytes, size: int, path: Path) -> bytes:
+    """LZF (liblzf's ``lzf_decompress``, which PCL's ``binary_compressed`` data is) of
+    ``data`` into ``size`` bytes; a damaged stream is a ValueError naming ``path``."""
+    out = bytearray()
+    i, n = 0, len(data)
+    damaged = f"damaged PCD file {path}: its compressed data does not decompress"
+    try:
+        while i < n:
+            ctrl = data[i]
+            i += 1
+            if ctrl < 32:  # a literal run of ctrl + 1 bytes
+                run = data[i : i + ctrl + 1]
+                if len(run) != ctrl + 1:
+                    raise ValueError(damaged)
+                out += run
+                i += ctrl + 1
+                continue
+            length = ctrl >> 5  # a back reference: length + 2 bytes from back there
+            if length == 7:
+                length += data[i]
+                i += 1
+            start = len(out) - ((ctrl & 0x1F) << 8) - data[i] - 1
+            i += 1
+            length += 2
+            if start < 0:
+                raise ValueError(damaged)
+            chunk = out[start : start + length]
+            if len(chunk) < length:  # overlapping its own output: the bytes repeat
+                chunk = (chunk * (length // len(chunk) + 1))[:length]
+            out += chunk
+            if len(out) > size:
+                raise ValueError(damaged)
+    except IndexError:  # a back reference cut short
+        raise ValueError(damaged) from None
+    if len(out) != size:
+        raise ValueError(damaged)
+    return bytes(out)
+
+
+def _compressed_pcd_records(
+    body: bytes, dtype: np.dtype[Any], n: int, path: Path
+) -> npt.NDArray[Any]:
+    """The ``n`` records of a PCD's ``binary_compressed`` data (``pcl::io::
+    savePCDFileBinaryCompressed``): the compressed and the plain size (uint32), then LZF of
+    each field's values for all points in turn (all x, then all y..., to aid the compression)."""
+    if len(body) < 8:
+        raise ValueError(f"truncated PCD file {path}: expected {n} points")
+    packed, size = (int(v) for v in np.frombuffer(body, "<u4", count=2))
+    if len(body) - 8 < packed:
+        raise ValueError(f"truncated PCD file {path}: expected {n} points")
+    if size != n * dtype.itemsize:
+        raise ValueError(
+            f"damaged PCD file {path}: {size} bytes of compressed points, expected "
+            f"{n * dtype.itemsize} for {n} points"
+        )
+    plain = _lzf_decompress(body[8 : 8 + packed], size, path) if size else b""
+    rec = np.empty(n, dtype=dtype)
+    offset = 0
+    for name in dtype.names or ():
+        field = dtype[name]  # (COUNT,) values for a field of COUNT > 1
+        count = n * field.itemsize // field.base.itemsize
+        values = np.frombuffer(plain, field.base, count=count, offset=offset)
+        rec[name] = values.reshape((n, *field.shape))
+        offset += n * field.itemsize
+    return rec
 
 
 # ----------------------------------------------------------------------------- NPZ
