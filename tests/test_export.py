@@ -1373,6 +1373,22 @@ def test_pcd_without_height_is_unorganised_as_pcl_reads_it(tmp_path):
         export.read_pcd(path)
 
 
+def test_pcd_whose_points_are_not_width_by_height_is_refused(tmp_path):
+    """POINTS 2 with WIDTH 3 (a cloud cropped, its WIDTH left): the third point was read from
+    the bytes after the data (PCL pads its files to a page), a point (0, 0, 0) at the camera;
+    PCL's reader refuses such a file, and so does read_pcd now, naming both counts."""
+    path = _xyz_pcd(tmp_path / "m.pcd", "", w=3, mode="binary")
+    path.write_bytes(
+        path.read_bytes().replace(b"POINTS 3", b"POINTS 2")
+        + np.array([[1, 2, 3], [4, 5, 6]], "<f4").tobytes()
+        + bytes(4096)
+    )
+    with pytest.raises(
+        ValueError, match=r"m\.pcd: WIDTH x HEIGHT is 3 x 1 = 3 points, POINTS says 2$"
+    ):
+        export.read_pcd(path)
+
+
 def _lzf(data):
     """LZF as liblzf's lzf_compress writes it (greedy, for the tests' few bytes): literal runs
     of 1-32 bytes (control 0-31), back references of 3-264 bytes (LZF's reach: 8192 back)."""

@@ -386,7 +386,8 @@ def read_pcd(
     FileNotFoundError
         Missing file.
     ValueError
-        Not a PCD file, unsupported fields / compression, truncated data, or a folder.
+        Not a PCD file, unsupported fields / compression, truncated data, ``WIDTH`` x
+        ``HEIGHT`` other than ``POINTS``, or a folder.
     """
     p = as_path(path, file=True)
     if not p.exists():
@@ -446,6 +447,13 @@ def read_pcd(
         ) from None
     if width < 0 or height < 0:
         raise ValueError(f"PCD file {p}: negative WIDTH or HEIGHT ({width} x {height})")
+    if points is not None and points != width * height:
+        # as PCL's reader refuses it: a POINTS 2 file of WIDTH 3 (a cloud cropped, its WIDTH
+        # left) read a third point from the bytes after the data (PCL pads a file to a page)
+        raise ValueError(
+            f"PCD file {p}: WIDTH x HEIGHT is {width} x {height} = {width * height} points, "
+            f"POINTS says {points}"
+        )
     # The packed colour: "rgb" (PCL's PointXYZRGB, TYPE F) or "rgba" (PointXYZRGBA, TYPE U).
     colour = next((c for c in ("rgb", "rgba") if c in names), None)
     if colour is not None and (dtype[colour].shape != () or dtype[colour].itemsize != 4):
