@@ -271,6 +271,39 @@ def test_eval_table_keeps_its_columns_under_a_long_scene_name(
     assert bars[0] == bars[1] == bars[2], proc.stdout
 
 
+def test_eval_no_opencv_table_has_no_opencv_columns(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """`eval --no-opencv` printed the StereoBM, SGBM-3WAY and SGBM+fill column names over three
+    blank columns on every row, as if OpenCV had failed on every scene; the table has ours and
+    ours+fill alone (with OpenCV, the five columns as before)."""
+    from stereovision import cli
+
+    syn.narrow_scene(tmp_path, 4, 24)
+    dense = {"bad_2.0": 1.0, "bad_1.0": 2.0, "density": 100.0}
+
+    def fake(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> dict[str, Any]:
+        row = {"scene": scene.name, "max_disparity": 16, "ours": dense, "ours+fill": dense}
+        if with_opencv:
+            row.update({"bm": dense, "sgbm": dense, "sgbm+fill": dense})
+        return row
+
+    monkeypatch.setattr(cli, "_eval_scene", fake)
+    proc = _eval(capfd, str(tmp_path / "tiny"), "--no-opencv")
+    assert proc.returncode == 0, proc.stderr
+    header, sub, row = proc.stdout.splitlines()[:3]
+    assert header.split() == ["scene", "D", "|", "ours", "|", "ours+fill"]
+    assert sub.split() == ["|", "bad-2", "bad-1", "dens", "|", "bad-2", "bad-1", "dens"]
+    assert row.split()[1:] == ["16", "|", "1.0", "2.0", "100.0", "|", "1.0", "2.0", "100.0"]
+    assert proc.stdout.splitlines()[3] == "mean bad-2.0: ours 1.0 %, ours+fill 1.0 %"
+    proc = _eval(capfd, str(tmp_path / "tiny"))
+    header, sub, row = proc.stdout.splitlines()[:3]
+    assert [w for w in header.split() if w != "|"][2:] == [
+        "ours", "ours+fill", "StereoBM", "SGBM-3WAY", "SGBM+fill"
+    ]  # fmt: skip
+    assert row.split().count("100.0") == 5
+
+
 def test_eval_of_a_scene_where_ours_has_no_gt_depth(
     terrace: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

@@ -1885,13 +1885,15 @@ def cmd_eval(args: argparse.Namespace) -> int:
     # the scene column as wide as the longest name (38 at least): a longer one pushed its row's
     # figures out from under their labels
     col = max([38] + [len(escaped(n)) for n in names.values()])
-    header = (
-        f"{'scene':{col}s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
-        f" {'StereoBM':^20s} | {'SGBM-3WAY':^20s} | {'SGBM+fill':^20s}"
+    # --no-opencv: no OpenCV columns (three blank ones under their names read as OpenCV
+    # having failed on every scene)
+    titles = ["ours", "ours+fill"] + (
+        [] if args.no_opencv else ["StereoBM", "SGBM-3WAY", "SGBM+fill"]
     )
+    header = f"{'scene':{col}s} {'D':>4s} | " + " | ".join(f"{t:^20s}" for t in titles)
     # each column's three labels over its three numbers (_fmt_dense: 6 characters each)
     labels = f"{'bad-2':>6s} {'bad-1':>6s} {'dens':>6s}"
-    sub = f"{'':{col}s} {'':>4s} | " + " | ".join([labels] * 5)
+    sub = f"{'':{col}s} {'':>4s} | " + " | ".join([labels] * len(titles))
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     failed: list[str] = []
     skipped = 0
@@ -1945,7 +1947,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 tqdm.write(header)
                 tqdm.write(sub)
             cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
-            for key in ("bm", "sgbm", "sgbm+fill"):
+            for key in () if args.no_opencv else ("bm", "sgbm", "sgbm+fill"):
                 cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
             name = escaped(row["scene"])  # one line, as the other lines name it
             tqdm.write(f"{name:{col}s} {row['max_disparity']:4d} | " + " | ".join(cells))
