@@ -18,6 +18,8 @@ from __future__ import annotations
 import csv
 import dataclasses
 import re
+from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
 
 import cv2
@@ -1526,6 +1528,27 @@ def test_channels_that_are_all_priors_are_named(kw: dict[str, object]) -> None:
         sv.match(left, right, method="mcgm", max_disparity=8, **kw)
     assert all(c.scale == 2 for c in mcgm.curves(left, **kw))
     assert len(mcgm.mcgm_match(left, right, max_disparity=8, sigmas=[4.0], half_res_sigma=8.0))
+
+
+@pytest.mark.parametrize("half", [Fraction(1), Decimal(1)])
+def test_channels_all_priors_of_a_fraction_or_decimal_half_res_sigma_are_named(
+    half: object,
+) -> None:
+    """The check of channels that are all priors read half_res_sigma only as a Python or NumPy
+    number: Fraction(1) or Decimal(1) (a config read with parse_float=Decimal), which the
+    kernel reads as 1.0, still gave 0 matches without a word. It is named as 1.0 is."""
+    left, right = _sine_pair()
+    said = r"^sigmas: every channel \(\[4.0, 2.0, 1.0\]\) is at or above half_res_sigma \(1.0\)"
+    with pytest.raises(ValueError, match=said):
+        mcgm.mcgm_match(left, right, max_disparity=8, half_res_sigma=half)
+
+
+def test_no_channel_at_all_is_said_as_no_channel() -> None:
+    """sigmas=[] was said to be 'every channel ([]) is at or above half_res_sigma' by the
+    priors-only check: it is the kernel's 'needs at least one channel' again."""
+    left, right = _sine_pair()
+    with pytest.raises(ValueError, match=r"`sigmas`: needs at least one channel"):
+        mcgm.mcgm_match(left, right, max_disparity=8, sigmas=[])
 
 
 def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> None:

@@ -29,6 +29,7 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     NOT_NUMBERS,
+    _plain_real,
     _shown,
     as_gray_float,
     check_pair,
@@ -263,11 +264,14 @@ def _refuse_priors_only(kw: dict[str, Any]) -> None:
     above ``half_res_sigma``: each then runs at half resolution as a prior only, and the run
     gave 0 matches without a word (cones crop: ``sigmas=[4.0]`` 0 matches of 14 pairs, where
     ``[3.9]`` gave 136; ``half_res_sigma=1.0`` 0 instead of 1430). A half_res_sigma that is
-    no number >= 0 is left to the kernel, which names it."""
-    half = kw["half_res_sigma"]
+    no number >= 0, or no channel at all, is left to the kernel, which names it."""
+    # a Fraction or a Decimal (a config read with parse_float=Decimal) as its float: the kernel
+    # reads it so, and half_res_sigma=Fraction(1) still gave 0 matches without a word
+    half = _plain_real(kw["half_res_sigma"])
     if not real_number(half) or not 0 <= half < math.inf:
         return
-    if all(s >= half for s in kw["sigmas"]):
+    # no channel is the kernel's "needs at least one channel", not "every channel ([])"
+    if kw["sigmas"] and all(s >= half for s in kw["sigmas"]):
         raise ValueError(
             f"sigmas: every channel ({reprlib.repr(kw['sigmas'])}) is at or above "
             f"half_res_sigma ({half}), so each runs at half resolution as a prior only and "
