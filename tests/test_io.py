@@ -1127,6 +1127,31 @@ def test_scan_scenes_says_a_left_png_that_is_a_folder_is_one(tmp_path: Path) -> 
     assert _no_scene_under(tmp_path / "s", given, half) == f"{given}: {why}"
 
 
+def test_scan_scenes_names_a_pair_named_in_another_case(tmp_path: Path) -> None:
+    """A scene folder of Left.png + Right.png under the root given was left out without a word
+    (eval's mean over one scene fewer), and a tree of only such folders was 'no scene under
+    ROOT' alone (87b6bed's hint was for the folder given only). Each is skipped saying the
+    names are lower case; the folder given itself is said as 87b6bed says it."""
+    from stereovision.io import _no_scene_under
+
+    for name in ("good", "cased"):
+        (tmp_path / name).mkdir()
+    for name in ("good/left.png", "good/right.png", "cased/Left.png", "cased/Right.png"):
+        (tmp_path / name).write_bytes(b"")
+    lower = "a scene's images are named left.png and right.png, in lower case"
+    why = f"holds Left.png, Right.png: {lower}"
+    assert scan_scenes(tmp_path) == ([tmp_path / "good"], [(tmp_path / "cased", why)])
+    (tmp_path / "good/left.png").unlink()
+    (tmp_path / "good/right.png").unlink()
+    root, given = str(tmp_path), str(tmp_path / "cased")
+    assert _no_scene_under(tmp_path, root, scan_scenes(root)[1]) == (
+        f"no scene (left.png + right.png) under {root}; {given} holds Left.png, Right.png: {lower}"
+    )
+    assert _no_scene_under(tmp_path / "cased", given, scan_scenes(given)[1]) == (
+        f"no scene (left.png + right.png) under {given} (Left.png, Right.png found: {lower})"
+    )
+
+
 def test_scan_scenes_finds_a_scene_linked_by_a_hidden_and_a_visible_name(tmp_path: Path) -> None:
     """434f57a's skip of hidden folders dropped a scene linked as ``.cache`` and as ``s``: the
     walk took the hidden link (first in name order) as the folder's one entry, so the visible

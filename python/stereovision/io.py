@@ -2148,6 +2148,9 @@ _MIDDLEBURY_FIX = (
 )
 _MIDDLEBURY_NAMES = f"has Middlebury's im0.png + im1.png: {_MIDDLEBURY_FIX}"
 
+#: Why a folder of ``Left.png`` or ``right.PNG`` is no scene (:func:`scan_scenes`).
+_LOWER_CASE_NAMES = "a scene's images are named left.png and right.png, in lower case"
+
 
 def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     """:func:`find_scenes`'s scenes, and the folders left out as half a scene, each with why.
@@ -2158,7 +2161,8 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     not (a hidden copy of a scene was evaluated twice); ``root`` itself is searched even if
     hidden, as given. A folder of Middlebury's names (``im0.png`` + ``im1.png``, no
     ``left.png`` or ``right.png``) is left out too, saying the names a scene's files take (it
-    was "no scene" without a word on the names expected).
+    was "no scene" without a word on the names expected), and so is a folder of ``Left.png`` or
+    ``right.PNG`` (its scene was left out of a run without a word).
 
     Parameters
     ----------
@@ -2170,8 +2174,8 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     scenes : list of pathlib.Path
         Sorted scene directories.
     skipped : list of (pathlib.Path, str)
-        Sorted folders holding one image of a scene's two, or Middlebury's names, and why
-        they are no scene.
+        Sorted folders holding one image of a scene's two, Middlebury's names or a pair
+        named in another case, and why they are no scene.
 
     Raises
     ------
@@ -2212,6 +2216,10 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
             skipped.append((Path(folder), f"{why} (a scene folder holds both)"))
         elif "im0.png" in files and "im1.png" in files:
             skipped.append((Path(folder), _MIDDLEBURY_NAMES))
+        elif cased := sorted(f for f in files if f.lower() in ("left.png", "right.png")):
+            # a scene of Left.png + Right.png under the root was left out without a word (the
+            # run's mean over one scene fewer), and a tree of them was "no scene" alone
+            skipped.append((Path(folder), f"holds {', '.join(cased)}: {_LOWER_CASE_NAMES}"))
     return sorted(found), sorted(skipped)
 
 
@@ -2238,6 +2246,8 @@ def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] =
         were not named: the line hid why a folder of them gave nothing).
     """
     pair = ("left.png", "right.png")
+    # the folder's own Left.png + Right.png are said below as found in it
+    half = [(f, why) for f, why in half if not (f == folder and why.endswith(_LOWER_CASE_NAMES))]
     # the folder itself half a scene: in scan_scenes' words, which tell a right.png that is a
     # folder ("has left.png but no right.png" here) or a broken link (said as a half scene
     # skipped under the folder) from a missing one
@@ -2249,7 +2259,7 @@ def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] =
     # Left.png or right.PNG is a PNG: "a scene's images are PNG" sent the user looking for
     # another format, where the names are the trouble
     cased = [n for n in others if n.lower() in pair]
-    lower = "named left.png and right.png, in lower case"
+    lower = _LOWER_CASE_NAMES.removeprefix("a scene's images are ")
     own = [why for f, why in half if f == folder]
     have = [n for n in pair if (folder / n).is_file()]
     if own or len(have) == 1:
@@ -2269,6 +2279,15 @@ def _no_scene_under(folder: Path, given: str, half: Sequence[tuple[Path, str]] =
         verb = "holds" if len(middlebury) == 1 else "hold"
         found += f"; {shown}{more} {verb} Middlebury's im0.png + im1.png: {_MIDDLEBURY_FIX}"
         half = [(f, why) for f, why in half if why != _MIDDLEBURY_NAMES]
+    # folders of Left.png + Right.png under it: named with their names, not as half scenes
+    cased_dirs = [(f, why) for f, why in half if why.endswith(_LOWER_CASE_NAMES)]
+    if cased_dirs:
+        shown = ", ".join(
+            f"{f} {why.removesuffix(f': {_LOWER_CASE_NAMES}')}" for f, why in cased_dirs[:3]
+        )
+        more = f" and {len(cased_dirs) - 3} more" if len(cased_dirs) > 3 else ""
+        found += f"; {shown}{more}: {_LOWER_CASE_NAMES}"
+        half = [(f, why) for f, why in half if not why.endswith(_LOWER_CASE_NAMES)]
     # a few named, the rest counted: the line stays one line under a tree of them
     named = [f"{f} {why.removesuffix(' (a scene folder holds both)')}" for f, why in half[:3]]
     if len(half) > 3:
