@@ -630,6 +630,31 @@ def test_load_scene_of_middleburys_names_says_the_names_a_scene_takes(tmp_path: 
     assert str(err.value) == f"image file not found: {tmp_path / 'right.png'}"
 
 
+def test_load_scene_and_view_of_a_pair_named_in_another_case_say_the_names(
+    tmp_path: Path,
+) -> None:
+    """A folder of Left.png + Right.png was 'image file not found: .../left.png' to load_scene
+    and 'no cloud.ply and no scene (left.png + right.png) in this folder' to view, beside the
+    pair: each says what eval says of it (87b6bed3), that the names are lower case."""
+    from stereovision import render
+
+    for name in ("Left.png", "Right.png"):
+        (tmp_path / name).write_bytes(b"")
+    why = (
+        f"{tmp_path} holds Left.png, Right.png: a scene's images are named left.png and "
+        "right.png, in lower case"
+    )
+    with pytest.raises(FileNotFoundError) as err:
+        load_scene(tmp_path)
+    assert str(err.value) == f"image file not found: {tmp_path / 'left.png'}; {why}"
+    with pytest.raises(FileNotFoundError) as err:
+        render.load_view_source(tmp_path)
+    assert str(err.value) == (
+        f"{tmp_path}: no cloud.ply and no scene (left.png + right.png) in this folder; it "
+        + why.removeprefix(f"{tmp_path} ")
+    )
+
+
 @pytest.mark.parametrize("name", ["gt_disp.pfm", "calib.txt", "Q.dat"])
 def test_load_scene_refuses_a_link_to_nothing(tmp_path: Path, name: str) -> None:
     """A scene's GT or calibration that is a link whose target moved (exists() is False) was

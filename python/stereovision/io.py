@@ -1937,6 +1937,23 @@ def scene_max_disparity(
     return round_up16(width // _WIDTH_FRACTION)
 
 
+#: Why a folder of ``Left.png`` or ``right.PNG`` is no scene (:func:`scan_scenes`).
+_LOWER_CASE_NAMES = "a scene's images are named left.png and right.png, in lower case"
+_SCENE_PAIR = ("left.png", "right.png")
+
+
+def _cased_pair(folder: Path) -> str | None:
+    """Why ``folder`` of ``Left.png`` or ``right.PNG`` (neither ``left.png`` nor ``right.png``)
+    is no scene, in :func:`scan_scenes`' words; None for any other folder."""
+    if any(os.path.lexists(folder / n) for n in ("left.png", "right.png")):
+        return None
+    try:
+        cased = sorted(q.name for q in folder.iterdir() if q.name.lower() in _SCENE_PAIR)
+    except OSError:
+        return None
+    return f"holds {', '.join(cased)}: {_LOWER_CASE_NAMES}" if cased else None
+
+
 def _absolute_as_read(path: Path) -> Path:
     """``path`` made absolute with each '..' folded as the OS follows it, links' names kept.
 
@@ -1996,7 +2013,8 @@ def load_scene(directory: PathLike) -> Scene:
     ------
     FileNotFoundError
         If the directory, ``left.png`` or ``right.png`` is missing (for a folder of
-        Middlebury's ``im0.png`` + ``im1.png``, naming the files to rename), or ``gt_disp.pfm``,
+        Middlebury's ``im0.png`` + ``im1.png``, naming the files to rename; of ``Left.png`` +
+        ``Right.png``, saying the names are lower case), or ``gt_disp.pfm``,
         ``calib.txt`` or ``Q.dat`` is a link to a file that does not exist.
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
@@ -2014,6 +2032,9 @@ def load_scene(directory: PathLike) -> Scene:
         # a folder as Middlebury ships it: said as eval and bench say it (scan_scenes), not
         # only "image file not found: .../left.png" with the names to use unsaid
         raise FileNotFoundError(f"image file not found: {d / 'left.png'}; {d} {_MIDDLEBURY_NAMES}")
+    cased = _cased_pair(d)
+    if cased:  # Left.png + Right.png: "image file not found: .../left.png" alone, beside them
+        raise FileNotFoundError(f"image file not found: {d / 'left.png'}; {d} {cased}")
     left = imread(d / "left.png")
     right = imread(d / "right.png")
     if left.shape != right.shape:
@@ -2147,9 +2168,6 @@ _MIDDLEBURY_FIX = (
     "im0.png, im1.png and disp0.pfm or disp0GT.pfm; calib.txt is read as it is)"
 )
 _MIDDLEBURY_NAMES = f"has Middlebury's im0.png + im1.png: {_MIDDLEBURY_FIX}"
-
-#: Why a folder of ``Left.png`` or ``right.PNG`` is no scene (:func:`scan_scenes`).
-_LOWER_CASE_NAMES = "a scene's images are named left.png and right.png, in lower case"
 
 
 def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:

@@ -1551,8 +1551,13 @@ def load_view_source(
                 "--calib: no metric 3-D points without one)"
             )
         else:
+            from stereovision.io import _cased_pair
+
+            # Left.png + Right.png: "no scene (left.png + right.png)" alone, beside them
+            cased = _cased_pair(p)
             raise FileNotFoundError(
                 f"{p}: no cloud.ply and no scene (left.png + right.png) in this folder"
+                + (f"; it {cased}" if cased else "")
             )
     points, colors = load_cloud(p)
     shown, shown_colors = display_subset(points, colors, max_points)
