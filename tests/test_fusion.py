@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -1514,6 +1515,34 @@ def test_fuse_pair_refuses_a_negative_range_before_the_matching(
     said = r"^min_disparity must be a non-negative number of pixels, got -2: " + says
     with pytest.raises(ValueError, match=said):
         fuse_pair(img, img, max_disparity=8, min_disparity=-2, channels=channels)
+
+
+@pytest.mark.parametrize(
+    ("kw", "says"),
+    [
+        ({"max_disparity": np.array([8])}, "max_disparity: expected a number of pixels, got "),
+        ({"min_disparity": np.array([2])}, "min_disparity: expected a number of pixels, got "),
+        ({"min_disparity": "2"}, "min_disparity: expected a number of pixels, got '2'"),
+    ],
+)
+def test_fuse_pair_refuses_a_range_of_no_number_before_the_matching(
+    kw: dict[str, object], says: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A bound that is no number (np.array([60]) read from a config) was refused by the sparse
+    channels only after the Gabor channel and the census map had run (0.44 s on cones), as
+    'max_disparity must be a non-negative number of pixels, got array([60])', of a value that
+    is one. It is match()'s and depth_map's TypeError now, before any channel runs."""
+    import stereovision.matching.gabor as gabor_mod
+    import stereovision.matching.sgm as sgm_mod
+
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a matcher ran")
+
+    monkeypatch.setattr(sgm_mod, "sgm_disparity", no_run)
+    monkeypatch.setattr(gabor_mod, "gabor_disparity", no_run)
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    with pytest.raises(TypeError, match="^" + re.escape(says)):
+        fuse_pair(img, img, **{"max_disparity": 8, **kw})  # type: ignore[arg-type]
 
 
 def test_fuse_pair_reads_channels_given_as_a_generator() -> None:

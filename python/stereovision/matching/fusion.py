@@ -624,7 +624,8 @@ def fuse_pair(
         runs).
     TypeError
         A switch (``remeasure_gabor``, ``check_members``, ``edge_members``,
-        ``census_members``, ``dense_sgm``) that is not True or False.
+        ``census_members``, ``dense_sgm``) that is not True or False, or a range bound that is
+        not one real number (an array, a string, None; before any channel runs).
     """
     from stereovision._validate import as_gray_float, check_pair
     from stereovision.matching.gabor import gabor_disparity
@@ -649,6 +650,12 @@ def fuse_pair(
     # before the channels run, not after
     mode, *_, min_agree = _fuse_options(**{**DEFAULTS, **params})
     _check_agree(mode, min_agree, channels)
+    # as match() and depth_map say it: np.array([60]) or a Fraction was refused by the sparse
+    # channels only after the Gabor channel and the census map had run (0.44 s on cones), as
+    # 'max_disparity must be a non-negative number of pixels, got array([60])'
+    for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        if not real_number(value):
+            raise TypeError(f"{name}: expected a number of pixels, got {_shown(value)}")
     # The sparse channels search from 0 px: a negative min_disparity was their own error only
     # after the Gabor channel and the census map had run on the whole pair (0.46 s on cones).
     if real_number(min_disparity) and min_disparity < 0:
