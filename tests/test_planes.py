@@ -415,6 +415,13 @@ def test_plane_fill_refuses_a_label_equal_to_the_pixel_count_and_a_negative_min_
         plane_fill(d, np.full((8, 8), 64, np.uint32))
     with pytest.raises(ValueError, match="min_pixels: expected a non-negative count, got -1"):
         plane_fill(d, np.zeros((8, 8), np.uint32), min_pixels=-1)
+    # 1e12 pixels (or 2**70) was said to be no "non-negative count": it is one, too large
+    for big, shown in ((1e12, "1000000000000.0"), (2**70, str(2**70))):
+        with pytest.raises(
+            ValueError,
+            match=rf"^min_pixels: expected a count of at most 2147483647 \(.*\), got {shown}$",
+        ):
+            plane_fill(d, np.zeros((8, 8), np.uint32), min_pixels=big)
 
 
 @pytest.mark.parametrize("fill", ["fill_planes", "side_fill"])

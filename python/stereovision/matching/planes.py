@@ -323,8 +323,13 @@ def plane_fill(
     count = whole_value(min_pixels)
     if count is None:
         raise ValueError(f"min_pixels: expected a whole number, got {_shown(min_pixels)}")
-    if not 0 <= count <= _MAX_COUNT:
+    if count < 0:
         raise ValueError(f"min_pixels: expected a non-negative count, got {_shown(min_pixels)}")
+    if count > _MAX_COUNT:  # 2**70 or 1e12 was said to be no "non-negative count"
+        raise ValueError(
+            f"min_pixels: expected a count of at most {_MAX_COUNT} (the kernel's 32-bit "
+            f"counts), got {_shown(min_pixels)}"
+        )
     for name, v in (("max_residual", max_residual), ("lo", lo), ("hi", hi)):
         _real(v, name)
     out, _, _ = _core.plane_fill(d, lab, count, float(max_residual), lo, hi)
