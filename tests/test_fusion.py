@@ -1914,6 +1914,22 @@ def test_census_clear_names_a_jump_that_is_no_number(jump: object) -> None:
     assert len(census_clear(res, census, jump=np.array([1.5]))) == 1  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize("radius", [np.array([7]), Fraction(7), np.float32(7.0)])
+def test_census_clear_reads_a_whole_radius_as_its_count(radius: object) -> None:
+    """radius was read by int(): np.array([7]) was NumPy's bare 'only 0-dimensional arrays can
+    be converted to Python scalars' and Fraction(7) 'radius: expected a finite number', where
+    jump (e43cafe1) and the library's counts take them. Each is the radius 7."""
+    res = fuse(_dense(10.0), {"hopfield": _m([(5, 5, 10.0), (20, 5, 10.0)])})
+    census = np.full((H, W), 10.0, np.float32)
+    census[5, 12] = 5.0  # a lower census value 7 px from the first member, 8 from the second
+    want = census_clear(res, census, radius=7)
+    assert len(want) == 1
+    got = census_clear(res, census, radius=radius)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(got.matches.xl, want.matches.xl)
+    with pytest.raises(ValueError, match=r"^radius must be a non-negative integer, got 7.5"):
+        census_clear(res, census, radius=7.5)  # type: ignore[arg-type]
+
+
 def test_fused_dense_edge_step_runs_from_a_one_pixel_radius() -> None:
     """Step 7 runs from ``edge_radius`` 1 (only 0 turns it off): a square drawn 1 px too wide
     on every side loses that 1 px ring, which a 1 px look reaches."""

@@ -799,10 +799,12 @@ def census_clear(
     import cv2
 
     c = _check_map(census, "census", res.dispx.shape)
-    if isinstance(radius, (bool, np.bool_)) or int(finite_number(radius, "radius")) != radius:
-        raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
-    if radius < 0:
-        raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
+    # the library's one rule of a count (whole_value), as jump reads its number: np.array([7])
+    # was NumPy's bare "only 0-dimensional arrays can be converted to Python scalars" and
+    # Fraction(7) "radius: expected a finite number"
+    size = whole_value(radius)
+    if size is None or size < 0:
+        raise ValueError(f"radius must be a non-negative integer, got {_shown(radius)}")
     # a string or None failed in the comparison as Python's "'>=' not supported", naming
     # nothing, and True was a jump of 1 px; a size-1 array or a Fraction is its number
     jump = _plain_option(jump)
@@ -810,7 +812,7 @@ def census_clear(
         raise ValueError(f"jump must be >= 0, got {_shown(jump)}")
     # A window wider than the map is the whole map (the border is replicated): 2**70 was NumPy's
     # "Maximum allowed dimension exceeded", 10**5 a 40 GB kernel.
-    r = min(int(radius), max(c.shape))
+    r = min(size, max(c.shape))
     k = np.ones((2 * r + 1, 2 * r + 1), np.uint8)
     # The window's minimum (an erosion); NaN as +inf so that unmeasured pixels never count.
     low = cv2.erode(
