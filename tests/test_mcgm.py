@@ -727,6 +727,17 @@ def test_matches_name_values_float32_cannot_hold() -> None:
     assert m.xr.tolist() == [np.inf, np.float32(3.4e38)] and m.energy_trace.tolist() == [1, 2]
 
 
+def test_matches_read_an_energy_trace_of_fractions_or_decimals() -> None:
+    """210655ad's dtype check refused an energy trace of Decimals or Fractions (a trace read
+    back with parse_float=Decimal: dtype object), which was read as its floats before; text and
+    None in it are still refused."""
+    a = np.zeros(2)
+    m = sv.Matches(a, a, a, a, a, (4, 4), energy_trace=[Decimal("1.5"), Fraction(1, 4)])
+    assert m.energy_trace.dtype == np.float64 and m.energy_trace.tolist() == [1.5, 0.25]
+    with pytest.raises(ValueError, match=r"^energy_trace: expected real values, got dtype object"):
+        sv.Matches(a, a, a, a, a, (4, 4), energy_trace=[1.0, None])
+
+
 def test_matches_are_no_array_for_numpy() -> None:
     """A Matches is a sequence of one-match Matches: np.asarray(m) (as triangulate(m, m, calib)
     does) nested them 64 deep, 36 s for tsukuba's 4,877 MCGM matches, then "setting an array

@@ -7,7 +7,9 @@ y_right`` (about 0 on rectified pairs), stored at the rounded left-image positio
 
 from __future__ import annotations
 
+import decimal
 import math
+import numbers
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -118,6 +120,12 @@ class Matches:
         # None is no trace and no stats: np.asarray(None, float) made a trace of one NaN
         # energy, and None as the stats an AttributeError at the first selection (m[:5])
         trace = np.asarray(np.zeros(0) if self.energy_trace is None else self.energy_trace)
+        # Fractions or Decimals (a trace read back with parse_float=Decimal) are real values,
+        # read as their floats as before 210655ad, whose dtype check refused them (object)
+        if trace.dtype == object and all(
+            isinstance(v, (numbers.Real, decimal.Decimal)) for v in trace.reshape(-1)
+        ):
+            trace = trace.astype(np.float64)
         # text was NumPy's "could not convert string to float", naming nothing
         if trace.dtype.kind not in "biuf":
             raise ValueError(f"energy_trace: expected real values, got dtype {trace.dtype}")
