@@ -1871,6 +1871,20 @@ def test_find_scenes_follows_linked_folders_once(data_dir: Path, tmp_path: Path)
     assert load_scene(tmp_path / "mb" / "venus").name == "mb/venus"  # the link's own name
 
 
+@pytest.mark.parametrize("folder", ["data/cones", Path("data/cones")])
+def test_scene_too_narrow_of_a_folder_says_to_load_it(folder: object) -> None:
+    """scene_too_narrow("data/cones") was "AttributeError: 'str' object has no attribute
+    'max_disparity'", as bench_scene's was (d6b69581): it says it in bench_scene's words."""
+    from stereovision.io import scene_too_narrow
+
+    with pytest.raises(TypeError) as info:
+        scene_too_narrow(folder)  # type: ignore[arg-type]
+    assert str(info.value) == (
+        "scene: got the path 'data/cones', not a scene: load it first "
+        "(stereovision.io.load_scene(path))"
+    )
+
+
 def test_load_scene_keeps_gt_zero_and_large_values_as_disparities(tmp_path: Path) -> None:
     """evaluation.md: only inf or NaN is unknown. A GT of 0 (a point at infinity, TartanAir's
     sky) is a known disparity, not KITTI's raw 'no LiDAR' 0 (its SOURCE conversion made those

@@ -1861,9 +1861,21 @@ def scene_too_narrow(scene: Scene) -> str | None:
         The reason, naming the images' width, the scene's range and the width it needs; for a
         range its GT sets (above 16 px), the GT's largest disparity and that the GT may not
         be in pixels (KITTI's PNGs hold 256 x the disparity).
+
+    Raises
+    ------
+    TypeError
+        If ``scene`` is a path (a scene folder: :func:`load_scene` reads it).
     """
     from stereovision._validate import figure_shown
 
+    if isinstance(scene, (str, bytes, os.PathLike)):
+        # a scene folder was "AttributeError: 'str' object has no attribute 'max_disparity'"
+        # (as bench_scene says it, d6b69581)
+        raise TypeError(
+            f"scene: got the path {os.fsdecode(scene)!r}, not a scene: load it first "
+            "(stereovision.io.load_scene(path))"
+        )
     md, width = scene.max_disparity, scene.left.shape[1]
     if md < width:
         return None
