@@ -5002,3 +5002,12 @@ def test_stereo_camera_refuses_a_source_of_no_kind_naming_it(tmp_path: Path) -> 
                 f"{side} source: expected a device index, a path or a capture object "
                 f"(cv2.VideoCapture's methods), got {kind}"
             )
+
+
+def test_frames_compare_by_identity() -> None:
+    """Two frames of one picture: ``a == b`` (and ``b in [a]``) compared their images and
+    raised NumPy's 'truth value of an array ... is ambiguous'. Equal to itself only."""
+    img = np.zeros((4, 6), np.uint8)
+    a = capmod.StereoFrame(img.copy(), img.copy(), 0.0, 0.0, 0)
+    b = capmod.StereoFrame(img.copy(), img.copy(), 0.0, 0.0, 0)
+    assert a == a and a != b and b not in [a] and len({a, b, a}) == 2

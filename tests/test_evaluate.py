@@ -943,3 +943,13 @@ def test_table1_text_keeps_its_columns_for_a_far_point() -> None:
     assert text[4].split()[3:6] == ["4.265e+05", "10.000", "+4.3e+05"]
     assert text[5].split()[3:9] == ["12.500", "10.000", "+2.500", "41.010", "32.808", "+8.202"]
     assert text[-1] == "RMSE: 1.500e+38 m (4.921e+38 ft) = 1.50e+39 % of the mean distance"
+
+
+def test_table1_reports_compare_and_hash_by_identity() -> None:
+    """Two reports of the same points: ``a == b`` compared their arrays and raised NumPy's
+    'truth value of an array ... is ambiguous', and a report was unhashable. Equal to itself
+    only, and hashable (as TriangulationResult)."""
+    est = np.array([[2.0, 3.1], [4.0, 5.0]])
+    a, b = (table1_report(est, est, points=np.array([[0, 0], [1, 0]])) for _ in range(2))
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

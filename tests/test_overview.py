@@ -919,3 +919,11 @@ def test_a_left_image_of_another_size_than_the_disparity_is_named() -> None:
             disparity=disparity, confidence=conf, depth=None, left_rectified=left
         )
         assert overview_image(same, "t").image.shape[2] == 3
+
+
+def test_overviews_compare_by_identity() -> None:
+    """Two overviews of one picture: ``a == b`` (and ``b in [a]``) compared their images and
+    raised NumPy's 'truth value of an array ... is ambiguous'. Equal to itself only."""
+    img = np.zeros((4, 6, 3), np.uint8)
+    a, b = Overview(img.copy(), "t", {}, {}, 1.0), Overview(img.copy(), "t", {}, {}, 1.0)
+    assert a == a and a != b and b not in [a] and len({a, b, a}) == 2

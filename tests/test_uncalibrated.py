@@ -1754,3 +1754,14 @@ def test_a_12_bit_pair_in_16_bits_is_rectified_from_its_features(data_dir: Path)
     assert rect.matches > 400 and rect.median_dy < 0.3  # the 8-bit pair: 524, 0.05 px
     check = rect.check(*twelve)
     assert check.ok is True and check.matches > 400
+
+
+def test_rectifications_compare_and_hash_by_identity(tmp_path: Path) -> None:
+    """Two rectifications of one file: ``a == b`` (and ``b in [a]``) compared the homographies
+    and raised NumPy's 'truth value of an array ... is ambiguous', and one could not go in a
+    set or key a dict. Equal to itself only, and hashable (as TriangulationResult)."""
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps(_hand_made_rectification()))
+    a, b = UncalibratedRectification.load(path), UncalibratedRectification.load(path)
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

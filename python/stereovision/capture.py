@@ -402,7 +402,7 @@ def fourcc_text(code: float) -> str:
     return text if n and all(" " <= c <= "~" for c in text) else ""
 
 
-@dataclass
+@dataclass(eq=False)  # array fields: == by identity (== raised)
 class StereoFrame:
     """One synchronised pair.
 

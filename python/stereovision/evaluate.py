@@ -373,7 +373,7 @@ def gt_depth(gt: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float32]:
 # -------------------------------------------------------------------------------------- Table 1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity (== raised)
 class Table1Report:
     """The paper's Table-1 test: triangulated vs GT distances at N points (metres).
 

@@ -121,7 +121,7 @@ class ColourBar:
     unit: str = ""
 
 
-@dataclass
+@dataclass(eq=False)  # an array field: == by identity (== raised)
 class Overview:
     """An overview picture and where its parts are.
 

@@ -312,7 +312,7 @@ def _hull_area(pts: F64) -> float:
     return float(cv2.contourArea(cv2.convexHull(pts.astype(np.float32))))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity (== raised)
 class UncalibratedRectification:
     """Two homographies that rectify a pair, found from its features (see the module doc).
 
