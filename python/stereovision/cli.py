@@ -1034,7 +1034,7 @@ def _ground_outputs(
 def cmd_check(args: argparse.Namespace) -> int:
     """``stereovision check LEFT RIGHT [--calib F] [--fix OUT]``: is the pair (still)
     rectified? With ``--fix``, the rig's rotation corrected from the pair is written to OUT."""
-    from stereovision.io import check_pair_files, imread
+    from stereovision.io import check_pair_files, read_image
     from stereovision.rectification_check import check_rectification
 
     if not (math.isfinite(args.tolerance) and args.tolerance > 0):  # before reading the pair
@@ -1042,8 +1042,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.plot and Path(args.plot).suffix.lower() not in ("", ".png"):
         # the plot is PNG bytes: p.jpg (or .gif, .pdf) held a PNG its viewers misread
         raise CliError(f"--plot {args.plot}: the plot is written as PNG; give a .png file name")
-    left = imread(args.left)
-    right = imread(args.right)
+    # 16-bit files keep their 16 bits, as depth reads them: imread's 8-bit copy kept the top 8
+    # (a 12-bit pair's 0-4095 as 0-15), and the rows were told from those grey levels
+    left = read_image(args.left)
+    right = read_image(args.right)
     same = (
         None if left.shape != right.shape else check_pair_files(left, right, args.left, args.right)
     )
