@@ -3796,3 +3796,21 @@ def test_an_empty_path_is_refused_not_taken_as_the_current_folder(
         f"stereovision {argv[0]}: error: argument {name}: expected a value, got '' (an unset "
         f"variable?) (see stereovision {argv[0]} --help)\n"
     )
+
+
+def test_rectify_keeps_a_16_bit_pair_at_16_bits(data_dir: Path, tmp_path: Path) -> None:
+    """A 12-bit camera's pair in 16-bit PNGs: rectify read it with imread, its top 8 bits, and
+    wrote those (0-4095 as 0-15 grey levels: the rest of the pair lost). It reads it as depth
+    does and writes the rectified pair at 16 bits (here, a rectified crop, as given)."""
+    cones = data_dir / "middlebury2003" / "cones"
+    pair = [tmp_path / "left.png", tmp_path / "right.png"]
+    for side, path in zip(("left", "right"), pair, strict=True):
+        grey = cv2.imread(str(cones / f"{side}.png"), cv2.IMREAD_GRAYSCALE)[100:260, 100:340]
+        cv2.imwrite(str(path), grey.astype(np.uint16) * 16 + 8)  # 12-bit values
+    out = tmp_path / "rect"
+    assert main(["rectify", *map(str, pair), "-o", str(out)]) == 0
+    for name, given in zip(("left_rect.png", "right_rect.png"), pair, strict=True):
+        written = cv2.imread(str(out / name), cv2.IMREAD_UNCHANGED)
+        assert written.dtype == np.uint16
+        grey = cv2.imread(str(given), cv2.IMREAD_ANYDEPTH)
+        np.testing.assert_array_equal(written, np.dstack([grey] * 3))  # as imread's 3 channels

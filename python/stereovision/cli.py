@@ -1203,15 +1203,17 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     """``stereovision rectify LEFT RIGHT -o DIR [--calib F] [--force]``: the rectified pair,
     and with no calibration the homographies found from the pair's features (a pair already
     rectified is written as given, unless ``--force``)."""
-    from stereovision.io import check_pair_files, imread
+    from stereovision.io import check_pair_files, read_image
     from stereovision.rectification_check import (
         already_rectified,
         check_rectification,
         draw_rectification_check,
     )
 
-    left = imread(args.left)
-    right = imread(args.right)
+    # 16-bit files keep their 16 bits, and the rectified pair is written at 16 bits: imread's
+    # 8-bit copy kept the top 8 (a 12-bit pair's 0-4095 as 0-15), all that was written
+    left = read_image(args.left)
+    right = read_image(args.right)
     same = (
         None if left.shape != right.shape else check_pair_files(left, right, args.left, args.right)
     )
