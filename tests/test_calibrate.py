@@ -2739,3 +2739,21 @@ def test_a_dark_16_bit_board_image_is_read_at_its_own_range(data_dir: Path, tmp_
 
     same, name = calmod._load_gray(jpg, "left_images[0]")
     assert name == "left01.jpg" and np.array_equal(same, imread(jpg, gray=True))
+
+
+def test_render_chessboard_refuses_a_camera_matrix_not_of_opencvs_form() -> None:
+    """A transposed K (MATLAB's IntrinsicMatrix) drew the board seen from a centre at (0, 0),
+    70 % of the view background, without a word (render_plane refuses it since 1e068c28)."""
+    K = np.array([[700.0, 0.0, 320.0], [0.0, 700.0, 240.0], [0.0, 0.0, 1.0]])
+    pose = ([0.0, 0.0, 0.0], [-4.0, -2.5, 12.0])
+    with pytest.raises(ValueError) as err:
+        render_chessboard(K.T, np.zeros(5), *pose, image_size=(64, 48), supersample=1)
+    assert str(err.value) == (
+        "K: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
+        "[[700.0, 0.0, 0.0], [0.0, 700.0, 0.0], [320.0, 240.0, 1.0]] (transposed? pass K.T)"
+    )
+    with pytest.raises(ValueError, match=r"^K: expected a 3 x 3 camera matrix \(finite\)"):
+        render_chessboard(K[:2], np.zeros(5), *pose, image_size=(64, 48), supersample=1)
+    with pytest.raises(ValueError, match=r"^K: focal lengths must be positive, got fx=0, fy=700"):
+        render_chessboard(K * [[0], [1], [1]], np.zeros(5), *pose, image_size=(64, 48))
+    assert render_chessboard(K, np.zeros(5), *pose, image_size=(64, 48)).shape == (48, 64)

@@ -2666,11 +2666,27 @@ def render_chessboard(
     -------
     numpy.ndarray
         ``(height, width)`` ``uint8`` grey image.
+
+    Raises
+    ------
+    ValueError
+        ``K`` not a finite 3 x 3 camera matrix of positive focal lengths of the form
+        ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` (a transposed one), as
+        :func:`~stereovision.synthetic.render_plane` refuses it.
     """
+    from stereovision.triangulation import _check_matrix_form
+
     w, h = image_size
     ss = int(supersample)
     shift = 4  # fillPoly sub-pixel bits: 1/16 px on the supersampled canvas
     Kf = np.asarray(K, np.float64)
+    # a transposed K (MATLAB's IntrinsicMatrix) drew the board seen from a centre at (0, 0),
+    # 70 % of a 640x480 view background, without a word: render_plane's checks, in its words
+    if Kf.shape != (3, 3) or not np.isfinite(Kf).all():
+        raise ValueError(f"K: expected a 3 x 3 camera matrix (finite), got shape {Kf.shape}")
+    if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
+        raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
+    _check_matrix_form(Kf, "K")
     Df = np.asarray(D, np.float64)
     rv = np.asarray(rvec, np.float64).reshape(3, 1)
     tv = np.asarray(tvec, np.float64).reshape(3, 1)
