@@ -953,3 +953,16 @@ def test_table1_reports_compare_and_hash_by_identity() -> None:
     a, b = (table1_report(est, est, points=np.array([[0, 0], [1, 0]])) for _ in range(2))
     assert a == a and a != b and b not in [a]
     assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2
+
+
+def test_gt_depths_warnings_are_at_the_callers_line() -> None:
+    """A GT map of fixed-point values (KITTI's d * 256 read with cv2.imread) or of the pair
+    resized was warned about at gt_depth's own line in evaluate.py, not the caller's."""
+    cal = Calibration.ideal((64, 48), 60.0, 0.1)
+    for gt, words in (
+        (np.full((48, 64), 20.0 * 256), "disparity: values up to 5120 px"),
+        (np.ones((96, 128)), "disparity map is 128x96 px"),
+    ):
+        with pytest.warns(UserWarning, match=words) as rec:
+            gt_depth(gt, cal)
+        assert [r.filename for r in rec] == [__file__]

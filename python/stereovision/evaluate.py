@@ -363,11 +363,19 @@ def gt_depth(gt: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float32]:
     -------
     numpy.ndarray
         ``(H, W)`` ``float32`` depth in metres, NaN where unknown.
+
+    Warns
+    -----
+    UserWarning
+        As :func:`~stereovision.triangulation.depth_from_disparity`, at the caller's line: for a
+        map of the pair resized or of fixed-point values.
     """
     _require_type(calib, "Calibration", "calib")
-    from stereovision.triangulation import depth_from_disparity
+    from stereovision.triangulation import _depth_from_disparity
 
-    return depth_from_disparity(gt, calib)
+    # 3: renamed_keyword's frame; a map of the pair resized or of fixed-point values (a KITTI
+    # GT PNG read with cv2.imread) was warned about at this line, not the caller's
+    return _depth_from_disparity(gt, calib, "m", 3)
 
 
 # -------------------------------------------------------------------------------------- Table 1
