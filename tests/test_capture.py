@@ -5011,3 +5011,24 @@ def test_frames_compare_by_identity() -> None:
     a = capmod.StereoFrame(img.copy(), img.copy(), 0.0, 0.0, 0)
     b = capmod.StereoFrame(img.copy(), img.copy(), 0.0, 0.0, 0)
     assert a == a and a != b and b not in [a] and len({a, b, a}) == 2
+
+
+def test_save_pair_names_a_dropped_frame_or_a_path(tmp_path: Path) -> None:
+    """A frame the camera dropped (cap.read()'s None) or a path was "cannot encode the left
+    image as .png", as if the format were at fault, and the folder was made. Both are said in
+    the package's words, as TemporalFilter says them, before anything is made."""
+    img = np.zeros((4, 6), np.uint8)
+    folder = tmp_path / "pairs"
+    with pytest.raises(ValueError) as err:
+        capmod.save_pair(folder, 1, None, img)
+    assert str(err.value) == (
+        "left: got None, not an image (cv2.imread returns None for a file it cannot read: "
+        "check the path)"
+    )
+    with pytest.raises(ValueError, match=r"^right: got the path 'r\.png', not an image: read"):
+        capmod.save_pair(folder, 1, img, "r.png")
+    assert not folder.exists()
+    assert [p.name for p in capmod.save_pair(folder, 1, img, img)] == [
+        "left_0001.png",
+        "right_0001.png",
+    ]

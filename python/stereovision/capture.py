@@ -57,8 +57,10 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     NOT_NUMBERS,
+    as_image_array,
     as_path,
     float_sized,
+    path_given,
     positive_whole,
     renamed_keyword,
     source_warning,
@@ -2687,9 +2689,9 @@ def save_pair(
     Raises
     ------
     ValueError
-        If ``index`` is not an integer ``>= 0``, ``ext`` is no extension (``.png``), or an
-        image cannot be encoded in that format, or not without loss (a float image in
-        ``.png``: it would be written as 8 bits).
+        If ``index`` is not an integer ``>= 0``, ``ext`` is no extension (``.png``), an image
+        is None (a frame the camera dropped) or a path, or an image cannot be encoded in that
+        format, or not without loss (a float image in ``.png``: it would be written as 8 bits).
     FileExistsError
         If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind), or
         ``directory`` is a file.
@@ -2702,6 +2704,12 @@ def save_pair(
     if not isinstance(index, (int, np.integer)) or isinstance(index, NOT_NUMBERS) or index < 0:
         raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
     _check_ext(ext)
+    for side, img in (("left", left), ("right", right)):
+        if img is None or path_given(img) is not None:
+            # a frame the camera dropped (cap.read()'s None) or a path was "cannot encode the
+            # left image as .png", a format's fault, and the folder made: said as
+            # TemporalFilter and refine_disparity say it (as_image_array's words)
+            as_image_array(img, side)  # raises
     d = as_path(directory, "directory")
     if d.exists() and not d.is_dir():  # FileExistsError, as mkdir's: capture stops on it
         raise FileExistsError(f"cannot write the pair into {d}: it is a file, not a folder")
