@@ -1032,6 +1032,18 @@ def test_read_pcd_names_what_is_wrong(tmp_path):
         export.read_pcd(quad)
 
 
+def test_read_pcd_coordinate_of_count_2_is_named(tmp_path):
+    """x, y or z of COUNT 2 failed in np.stack, 'all input arrays must have the same shape'
+    (read_pcd, so load_cloud and view); it names the field, in any DATA."""
+    two = _xyz_pcd(tmp_path / "x2.pcd", "1 2 3 4\n5 6 7 8\n", counts="2 1 1")
+    with pytest.raises(ValueError, match=r"x2\.pcd: field 'x' of COUNT 2, expected a coordin"):
+        export.read_pcd(two)
+    z3 = _xyz_pcd(tmp_path / "z3.pcd", "", counts="1 1 3", mode="binary")
+    z3.write_bytes(z3.read_bytes() + np.zeros(10, "<f4").tobytes())
+    with pytest.raises(ValueError, match=r"z3\.pcd: field 'z' of COUNT 3, expected a coordin"):
+        export.load_cloud(z3)
+
+
 def test_read_pcd_without_count_and_in_lower_case(tmp_path):
     """COUNT is optional (1 per field) and the header's keywords are read in any case."""
     path = tmp_path / "c.pcd"

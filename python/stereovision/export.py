@@ -462,6 +462,13 @@ def read_pcd(
             f"PCD file {p}: field {colour!r} of SIZE {sizes[i]} COUNT {counts[i]}, expected a "
             "packed colour (SIZE 4, COUNT 1)"
         )
+    # x y z of COUNT 2 failed late, in np.stack: "all input arrays must have the same shape"
+    axis = next((a for a in ("x", "y", "z") if dtype[a].shape != ()), None)
+    if axis is not None:
+        raise ValueError(
+            f"PCD file {p}: field {axis!r} of COUNT {counts[names.index(axis)]}, expected a "
+            "coordinate (COUNT 1)"
+        )
     n = width * height
     if mode == "binary":
         if len(raw) - pos < n * dtype.itemsize:
