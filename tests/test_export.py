@@ -1044,6 +1044,16 @@ def test_read_pcd_coordinate_of_count_2_is_named(tmp_path):
         export.load_cloud(z3)
 
 
+def test_read_pcd_field_of_count_0_has_no_values_as_pcl_reads_it(tmp_path):
+    """A field of COUNT 0 has no values (PCL's reader drops it): binary data was read as if it
+    had one, the second point [5, 6, 0] for [4, 5, 6]; ASCII failed, 'could not broadcast'."""
+    rows = _xyz_pcd(tmp_path / "a.pcd", "1 2 3\n4 5 6\n", fields="x y z n", counts="1 1 1 0")
+    assert export.read_pcd(rows)[0].tolist() == [[[1, 2, 3], [4, 5, 6]]]
+    flat = _xyz_pcd(tmp_path / "b.pcd", "", fields="x y z n", counts="1 1 1 0", mode="binary")
+    flat.write_bytes(flat.read_bytes() + np.arange(1, 7, dtype="<f4").tobytes() + bytes(64))
+    assert export.read_pcd(flat)[0].tolist() == [[[1, 2, 3], [4, 5, 6]]]
+
+
 def test_read_pcd_without_count_and_in_lower_case(tmp_path):
     """COUNT is optional (1 per field) and the header's keywords are read in any case."""
     path = tmp_path / "c.pcd"

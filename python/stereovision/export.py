@@ -427,6 +427,12 @@ def read_pcd(
         mode = meta["DATA"][0]
     except (KeyError, IndexError, ValueError):
         raise ValueError(f"PCD file {p}: incomplete header") from None
+    if len(counts) == len(names) == len(sizes) == len(types):
+        # PCL's reader drops a field of COUNT 0 (or less): it has no values in the data (taken
+        # as one value, it shifted every point after the first in binary data)
+        keep = [i for i, c in enumerate(counts) if c > 0]
+        names, types = [names[i] for i in keep], [types[i] for i in keep]
+        sizes, counts = [sizes[i] for i in keep], [counts[i] for i in keep]
     if not {"x", "y", "z"} <= set(names):
         raise ValueError(f"PCD file {p}: fields {names}, expected x y z")
     kinds = {"F": "f", "U": "u", "I": "i"}
