@@ -1400,6 +1400,19 @@ def _check_pairing(
     )
 
 
+def _squares_counted(gray: np.ndarray, pat: tuple[int, int]) -> tuple[int, int] | None:
+    """The inner corners of the board ``gray`` shows when ``pat`` counted its squares.
+
+    Both ways first (10x7 for 9x6), then one way alone (10x6 or 9x7: the squares counted along
+    one side, the corners along the other); the first pattern found, or None (a pattern
+    under 3x3 is none).
+    """
+    for fewer in ((pat[0] - 1, pat[1] - 1), (pat[0] - 1, pat[1]), (pat[0], pat[1] - 1)):
+        if min(fewer) >= MIN_PATTERN_CORNERS and find_corners(gray, fewer) is not None:
+            return fewer
+    return None
+
+
 def _rejected_words(rejected: dict[str, str]) -> str:
     """The rejected pairs of a refusal, grouped by why: 'board not found in right' was left
     unsaid, the pairs' names alone giving no clue that one camera never saw the board."""
@@ -1719,14 +1732,13 @@ def calibrate(
         board is None
         and first_gray is not None
         and len(used) < MIN_PAIRS
-        and min(pat) > 3  # one fewer each way is still a pattern
         and all(c is None for c in (*corners_l, *corners_r))
-        and find_corners(first_gray, (pat[0] - 1, pat[1] - 1)) is not None
+        and (fewer := _squares_counted(first_gray, pat)) is not None
     ):  # the squares counted (10x7) for the inner corners (9x6): the most common slip
         board_hint = (
-            f"{first_name} shows a board of {pat[0] - 1}x{pat[1] - 1} inner corners: the "
+            f"{first_name} shows a board of {fewer[0]}x{fewer[1]} inner corners: the "
             "pattern counts the points where four squares meet, one fewer each way than the "
-            f"squares (pattern=({pat[0] - 1}, {pat[1] - 1}))"
+            f"squares (pattern=({fewer[0]}, {fewer[1]}))"
         )
     if board is not None and not board.resolved:
         squares = f"{board.squares[0]}x{board.squares[1]}"
