@@ -1631,6 +1631,33 @@ def test_a_saved_file_without_its_unit_is_refused_not_read_in_metres(tmp_path: P
         Calibration.load(tmp_path / "e.json")
 
 
+def test_a_file_without_its_unit_is_read_in_the_unit_given(tmp_path: Path) -> None:
+    """An OpenCV YAML or a JSON without 'unit' (a script's cv::FileStorage) was refused by
+    from_file(unit='mm') and depth --calib-unit mm alike: 'lacks field 'unit': add unit', the
+    unit given ignored. It is read in that unit now; a file's own unit still wins (refused when
+    it disagrees) and without a unit the CLI's refusal names --calib-unit."""
+    from stereovision.cli import load_calibration
+
+    cal = rect_calib()
+    rec = json.loads(cal.save(tmp_path / "c.json").read_text())
+    del rec["unit"]
+    (tmp_path / "e.json").write_text(json.dumps(rec))
+    fs = cv2.FileStorage(str(tmp_path / "e.yml"), cv2.FILE_STORAGE_WRITE)
+    for key in ("K1", "D1", "K2", "D2", "R", "T"):
+        fs.write(key, np.asarray(getattr(cal, key), float))
+    fs.write("image_width", cal.image_size[0])
+    fs.write("image_height", cal.image_size[1])
+    fs.release()
+    for name in ("e.json", "e.yml"):
+        got = Calibration.from_file(tmp_path / name, unit="cm")
+        assert got.unit == "cm"
+        assert np.array_equal(got.T, cal.T) and np.array_equal(got.K1, cal.K1)
+        with pytest.raises(ValueError, match=r"lacks field 'unit'.* \(or give --calib-unit\)$"):
+            load_calibration(tmp_path / name)
+    with pytest.raises(ValueError, match=r"states its lengths in 'mm', not in the unit 'cm'"):
+        Calibration.from_file(tmp_path / "c.json", unit="cm")
+
+
 @pytest.mark.parametrize(("field", "value"), [("rectified", 2), ("doffs", True)])
 def test_a_saved_rectified_rigs_flag_and_doffs_are_checked(
     tmp_path: Path, field: str, value: object

@@ -1340,7 +1340,9 @@ class Calibration:
             raise ValueError(f"{where}: {exc}") from None
 
     @classmethod
-    def _from_mapping(cls, get: Any, source: str) -> Calibration:
+    def _from_mapping(cls, get: Any, source: str, unit: str | None = None) -> Calibration:
+        # unit: from_file's, for a file without its own (a file's own unit wins; from_file
+        # refuses a disagreeing one)
         def need(key: str, *aliases: str) -> Any:
             for k in (key, *aliases):
                 v = get(k)
@@ -1376,7 +1378,7 @@ class Calibration:
             "D2": need("D2"),
             "R": need("R"),
             "T": need("T"),
-            "unit": str(need("unit")),
+            "unit": str(need("unit")) if unit is None or get("unit") is not None else unit,
         }
         try:
             return cls(
@@ -1392,7 +1394,7 @@ class Calibration:
             raise ValueError(f"calibration file {source}: {exc}") from None
 
     @classmethod
-    def _from_filestorage_text(cls, text: str, source: str) -> Calibration:
+    def _from_filestorage_text(cls, text: str, source: str, unit: str | None = None) -> Calibration:
         fs = _open_filestorage(text, source)
 
         def get(key: str) -> Any:
@@ -1410,12 +1412,12 @@ class Calibration:
         try:
             if all(fs.getNode(k).isNone() for k in _CALIBRATION_FIELDS):
                 raise ValueError(_not_a_calibration(fs, source))
-            return cls._from_mapping(get, source)
+            return cls._from_mapping(get, source, unit)
         finally:
             fs.release()
 
     @classmethod
-    def _from_json_text(cls, text: str, source: str) -> Calibration:
+    def _from_json_text(cls, text: str, source: str, unit: str | None = None) -> Calibration:
         try:
             obj = json.loads(text)
         except json.JSONDecodeError as exc:
@@ -1438,8 +1440,8 @@ class Calibration:
             # {"type_id": "opencv-matrix", "rows", "cols", "data"}, refused as "K1: expected a
             # real array, got dict"; read as OpenCV reads it (which takes a file starting with a
             # blank for YAML)
-            return cls._from_filestorage_text(text.lstrip(), source)
-        return cls._from_mapping(obj.get, source)
+            return cls._from_filestorage_text(text.lstrip(), source, unit)
+        return cls._from_mapping(obj.get, source, unit)
 
     @staticmethod
     def _read_text(path: PathLike, name: str = "path") -> tuple[Path, str]:
@@ -1487,12 +1489,17 @@ class Calibration:
             If the file is not such a calibration, lacks a field (named), or holds invalid
             values (see :class:`Calibration`).
         """
+        return cls._load(path)
+
+    @classmethod
+    def _load(cls, path: PathLike, unit: str | None = None) -> Calibration:
+        """:meth:`load`, a file without ``unit`` given ``unit`` (:meth:`from_file`'s)."""
         p, text = cls._read_text(path)
         head = text.lstrip()
         if head.startswith("%YAML") or head.startswith("<?xml") or head.startswith("<opencv"):
-            return cls._from_filestorage_text(text, str(p))
+            return cls._from_filestorage_text(text, str(p), unit)
         if head.startswith("{"):
-            return cls._from_json_text(text, str(p))
+            return cls._from_json_text(text, str(p), unit)
         raise ValueError(f"not a stereovision calibration file (OpenCV YAML/XML or JSON): {p}")
 
     @classmethod
@@ -1531,10 +1538,11 @@ class Calibration:
             OpenCV's ``stereo_calib`` output); for the others a check: a file of another size
             is refused (:meth:`scaled_to` resizes a calibration), not silently kept.
         unit : str, optional
-            Length unit of ``T`` (``"m"``, ``"mm"``, ...) for the formats that do not state it:
-            OpenCV's ``stereo_calib`` output (the unit of the board's square size; needed) and
-            ``Q.dat`` (default ``"m"``, :meth:`from_q`). For the others a check: a file that
-            states another unit is refused, not silently kept.
+            Length unit of ``T`` (``"m"``, ``"mm"``, ...) for the files that do not state it:
+            OpenCV's ``stereo_calib`` output (the unit of the board's square size; needed), an
+            OpenCV YAML/XML or JSON file without a ``unit`` field (a script's
+            ``cv::FileStorage``; needed) and ``Q.dat`` (default ``"m"``, :meth:`from_q`). For
+            the others a check: a file that states another unit is refused, not silently kept.
 
         Returns
         -------
@@ -1643,7 +1651,7 @@ class Calibration:
             return cls.from_ros(*pair)
         head = text.lstrip()
         if head.startswith(("%YAML", "<?xml", "<opencv", "{")):
-            return cls.load(p)
+            return cls._load(p, unit)  # unit: for a file without its own (a script's)
         if re.search(r"^\s*cam0\s*=", text, re.MULTILINE):
             return cls.from_middlebury(p)
         if re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE):

@@ -180,8 +180,9 @@ def write_overview(result: Any, out_dir: Path, name: str, unit: str = "m") -> di
 CALIB_UNIT_HELP = (
     "length unit of the calibration's T (baseline) when the file does not state it: OpenCV "
     "stereo_calib's intrinsics.yml + extrinsics.yml (the unit of the board's square size; "
-    "needed) or a Q.dat (default m). A file that states its unit (YAML/JSON, calib.txt, KITTI, "
-    "ROS, Kalibr) is refused when it disagrees"
+    "needed), an OpenCV YAML/XML or JSON file without a unit field (needed) or a Q.dat "
+    "(default m). A file that states its unit (YAML/JSON, calib.txt, KITTI, ROS, Kalibr) is "
+    "refused when it disagrees"
 )
 
 
@@ -254,6 +255,8 @@ def load_calibration(
         text = text.replace("unit='m'/'mm'/...", "--calib-unit (m, mm, cm, ft or in)")
         text = re.sub(r"the unit '(\w+)' given", r"--calib-unit \1", text)
         text = text.replace("leave unit out", "leave --calib-unit out")
+        if "lacks field 'unit'" in text:  # a YAML/JSON without it: the option says it too
+            text += " (or give --calib-unit)"
         how = size_words or (
             "the image size: this command cannot read it from its images, so save the rig once "
             "in Python with Calibration.from_file(path, image_size=(width, height), "
