@@ -4,6 +4,7 @@ have is known from the GT), StereoPi's raw pair, OpenCV's hand-held books pair; 
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -11,12 +12,14 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
 import pytest
 
 import stereovision as sv
+import stereovision.uncalibrated as uncalibrated
 from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 from stereovision.rectification_check import check_rectification
@@ -43,6 +46,38 @@ def perturbation(size: tuple[int, int], k_cam: np.ndarray | None = None) -> np.n
     rot = cv2.Rodrigues(np.radians([0.3, 0.5, 1.5]))[0]
     out: np.ndarray = longer @ rot @ np.linalg.inv(k_cam)
     return out
+
+
+def _features_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """:mod:`stereovision.uncalibrated`'s SIFT features and their mutual matches memoised by
+    content, for a test that rectifies or checks one pair many times (each about 0.1 s of CPU):
+    what such a test is about comes after the matches, which are the same every time."""
+    seen: dict[tuple[str, ...], Any] = {}
+
+    def key(name: str, *arrays: np.ndarray) -> tuple[str, ...]:
+        digest = hashlib.sha1()
+        for a in arrays:
+            digest.update(np.ascontiguousarray(a).tobytes())
+        return (name, *(f"{a.shape}{a.dtype.str}" for a in arrays), digest.hexdigest())
+
+    features, matches = uncalibrated._features, uncalibrated._mutual_matches
+
+    def features_once(gray: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        k = key("features", gray)
+        if k not in seen:
+            seen[k] = features(gray)
+        pts, desc = seen[k]
+        return pts.copy(), None if desc is None else desc.copy()
+
+    def matches_once(da: np.ndarray, db: np.ndarray) -> np.ndarray:
+        k = key("matches", da, db)
+        if k not in seen:
+            seen[k] = matches(da, db)
+        pairs: np.ndarray = seen[k].copy()
+        return pairs
+
+    monkeypatch.setattr(uncalibrated, "_features", features_once)
+    monkeypatch.setattr(uncalibrated, "_mutual_matches", matches_once)
 
 
 def expected_disparity(
@@ -706,11 +741,12 @@ def test_hartleys_homographies_keep_the_images_upright(
         rectify_uncalibrated(sc.left, sc.right, model="projective")
 
 
-def test_options_of_the_fit_are_used(data_dir: Path) -> None:
+def test_options_of_the_fit_are_used(data_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """``ransac_px`` is the fundamental matrix's threshold (cones: 500 matches fit within 0.3 px,
     524 within 1, 537 within 3), ``matches`` counts those that fit, not all SIFT matches; and
     ``model="quasi-euclidean"`` refuses a hand-held pair the turned cameras do not fit (OpenCV's
     books: median residual 2.62 px), which ``"auto"`` rectifies with Hartley's homographies."""
+    _features_once(monkeypatch)  # each pair's matches twice, fitted with other options
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     counts = [rectify_uncalibrated(sc.left, sc.right, ransac_px=p).matches for p in (0.3, 3.0)]
     assert counts[0] + 20 < counts[1]
@@ -722,10 +758,11 @@ def test_options_of_the_fit_are_used(data_dir: Path) -> None:
         rectify_uncalibrated(left, right, model="quasi-euclidean")
 
 
-def test_ransac_px_takes_numpy_reals(data_dir: Path) -> None:
+def test_ransac_px_takes_numpy_reals(data_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """``ransac_px=np.float32(1.0)`` or ``np.int64(1)`` was refused as "not a positive number
     of pixels" (only Python int and float passed), where check()'s tolerance takes NumPy reals:
     both now fit as 1.0 does; a bool, 0 and NaN are still refused, naming it."""
+    _features_once(monkeypatch)  # cones' matches fitted three times
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     want = rectify_uncalibrated(sc.left, sc.right, ransac_px=1.0)
     for v in (np.float32(1.0), np.int64(1)):
@@ -1248,7 +1285,7 @@ def test_the_coarse_probe_needs_16_rows_16_columns_and_100_disparities(data_dir:
 
 
 def test_check_keeps_a_match_only_when_both_its_points_lie_in_the_rectified_pair(
-    data_dir: Path,
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A mutation audit found :meth:`check`'s match filter unasserted side by side: the bound on
     the left points' right edge, on the left points' left edge, on the right points' right edge
@@ -1265,6 +1302,7 @@ def test_check_keeps_a_match_only_when_both_its_points_lie_in_the_rectified_pair
         _mutual_matches,
     )
 
+    _features_once(monkeypatch)  # the 14 checks match cones' raw pair alike
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     w, h = sc.left.shape[1] - 60, sc.left.shape[0] - 50  # the rectified size, not the input's
     gl, gr = (cv2.cvtColor(i, cv2.COLOR_BGR2GRAY) for i in (sc.left, sc.right))
@@ -1393,6 +1431,7 @@ def test_an_epipole_on_the_image_border_is_in_the_image(
     0.01 px inside the image's first or last pixel centres (exactly on them the SVD's rounding
     decides) are refused as seeing it in the image; half a pixel beyond those centres, not as
     such (the other image's epipole at infinity)."""
+    _features_once(monkeypatch)  # the 8 fits below match cones alike
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     h, w = sc.left.shape[:2]
     fundamental = cv2.findFundamentalMat
