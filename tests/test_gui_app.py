@@ -4861,14 +4861,14 @@ def test_a_dropped_read_or_open_does_not_leave_its_status(monkeypatch, step):
         def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
             if "open" in hold:
                 inside.set()
-                gate.wait(1.0)
+                gate.wait(30.0)
                 if step == "open fails":
                     raise OSError("cannot open camera 2 (left)")
 
         def read(self):
             if "read" in hold:
                 inside.set()
-                gate.wait(1.0)
+                gate.wait(30.0)
                 if step == "read fails":
                     raise OSError("camera 0 gave no frame")
             return frame.copy(), frame.copy()
@@ -4877,7 +4877,9 @@ def test_a_dropped_read_or_open_does_not_leave_its_status(monkeypatch, step):
             pass
 
     monkeypatch.setattr(capture, "StereoCamera", Cameras)
-    app = _scene_app("test-dropped-read-status", [bundled_data_dir()], read_timeout=2.0)
+    # the gate opens after the scene computed: the bounds only end a hang (1 s and 2 s were
+    # passed by a scene computed under load, the read done before the status was looked at)
+    app = _scene_app("test-dropped-read-status", [bundled_data_dir()], read_timeout=30.0)
     tasks = _collect_reads(app)
 
     async def clicks() -> None:
