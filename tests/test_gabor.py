@@ -685,3 +685,13 @@ def test_gabor_responses_name_a_non_finite_image_by_its_keyword(bad: float) -> N
         ValueError, match=r"^image: image contains non-finite values \(NaN or inf\) at 1 pix"
     ):
         gabor_responses(img)
+
+
+def test_results_compare_and_hash_by_identity() -> None:
+    """Two results of one pair: ``a == b`` (and ``b in [a]``) compared their maps and raised
+    NumPy's 'truth value of an array ... is ambiguous', and a result was unhashable. Equal to
+    itself only, and hashable (as TriangulationResult)."""
+    img = np.random.default_rng(0).random((24, 32)).astype(np.float32)
+    a, b = (gabor_disparity(img, img, max_disparity=4) for _ in range(2))
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

@@ -861,3 +861,14 @@ def test_a_float16_range_gives_the_floats_matches_without_a_warning(method: str)
         sgm = sgm_disparity(left, right, max_disparity=np.float16(12.5))
     np.testing.assert_array_equal(got.to_array(), want.to_array())
     np.testing.assert_array_equal(sgm, sgm_disparity(left, right, max_disparity=12.5))
+
+
+def test_interest_points_compare_and_hash_by_identity() -> None:
+    """Two InterestPoints of one image: ``a == b`` compared their arrays and raised NumPy's
+    'truth value of an array ... is ambiguous', and they were unhashable. Equal to themselves
+    only, and hashable."""
+    img = np.random.default_rng(0).random((24, 32)).astype(np.float32)
+    a, b = hp.interest_points(img), hp.interest_points(img)
+    assert len(a) > 1
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

@@ -1667,3 +1667,13 @@ def test_a_bool_in_a_size_1_array_is_no_number() -> None:
     with pytest.raises(ValueError) as exc:
         mcgm.mcgm_match(left, left, max_disparity=8, A=np.array(True))
     assert str(exc.value) == "A: expected a number, got array(True)"
+
+
+def test_channel_curves_compare_and_hash_by_identity() -> None:
+    """Two curves of one channel: ``a == b`` compared their arrays and raised NumPy's 'truth
+    value of an array ... is ambiguous', and they were unhashable. Equal to themselves only,
+    and hashable."""
+    img = np.random.default_rng(0).random((32, 32)).astype(np.float32)
+    a, b = mcgm.curves(img, sigmas=[2.0])[0], mcgm.curves(img, sigmas=[2.0])[0]
+    assert a == a and a != b and b not in [a]
+    assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2

@@ -67,7 +67,7 @@ DEFAULTS: dict[str, object] = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity (== raised)
 class GaborResult:
     """Output of :func:`gabor_disparity`.
 

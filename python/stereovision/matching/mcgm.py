@@ -101,7 +101,7 @@ DEFAULTS: dict[str, Any] = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity (== raised)
 class ChannelCurves:
     """Intermediate outputs of one LoG channel of one image.
 
