@@ -5032,3 +5032,17 @@ def test_save_pair_names_a_dropped_frame_or_a_path(tmp_path: Path) -> None:
         "left_0001.png",
         "right_0001.png",
     ]
+
+
+def test_save_pair_names_an_empty_frame_or_encoded_bytes(tmp_path: Path) -> None:
+    """An empty frame (a camera's dropped frame as a 0 x 0 array) or a file's bytes was
+    "cannot encode the left image as .png", as if the format were at fault, and the folder
+    was made: said in as_image_array's words, as None and a path are, before anything is
+    made."""
+    img = np.zeros((4, 6), np.uint8)
+    folder = tmp_path / "pairs"
+    with pytest.raises(ValueError, match=r"^left: image is empty \(shape \(0, 0\)\)"):
+        capmod.save_pair(folder, 1, np.zeros((0, 0), np.uint8), img)
+    with pytest.raises(ValueError, match=r"^right: got 5 bytes, not an image: decode"):
+        capmod.save_pair(folder, 1, img, b"\x89PNG\x00")
+    assert not folder.exists()

@@ -2690,8 +2690,9 @@ def save_pair(
     ------
     ValueError
         If ``index`` is not an integer ``>= 0``, ``ext`` is no extension (``.png``), an image
-        is None (a frame the camera dropped) or a path, or an image cannot be encoded in that
-        format, or not without loss (a float image in ``.png``: it would be written as 8 bits).
+        is None or empty (a frame the camera dropped), a path or an encoded file's bytes, or
+        an image cannot be encoded in that format, or not without loss (a float image in
+        ``.png``: it would be written as 8 bits).
     FileExistsError
         If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind), or
         ``directory`` is a file.
@@ -2705,10 +2706,12 @@ def save_pair(
         raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
     _check_ext(ext)
     for side, img in (("left", left), ("right", right)):
-        if img is None or path_given(img) is not None:
-            # a frame the camera dropped (cap.read()'s None) or a path was "cannot encode the
-            # left image as .png", a format's fault, and the folder made: said as
-            # TemporalFilter and refine_disparity say it (as_image_array's words)
+        empty = isinstance(img, np.ndarray) and img.size == 0
+        if img is None or path_given(img) is not None or isinstance(img, bytes) or empty:
+            # a frame the camera dropped (cap.read()'s None or an empty frame), a path or an
+            # encoded file's bytes was "cannot encode the left image as .png", a format's
+            # fault, and the folder made: said as TemporalFilter and refine_disparity say it
+            # (as_image_array's words)
             as_image_array(img, side)  # raises
     d = as_path(directory, "directory")
     if d.exists() and not d.is_dir():  # FileExistsError, as mkdir's: capture stops on it
