@@ -2781,3 +2781,24 @@ def test_render_chessboard_refuses_a_camera_matrix_not_of_opencvs_form() -> None
     with pytest.raises(ValueError, match=r"^K: focal lengths must be positive, got fx=0, fy=700"):
         render_chessboard(K * [[0], [1], [1]], np.zeros(5), *pose, image_size=(64, 48))
     assert render_chessboard(K, np.zeros(5), *pose, image_size=(64, 48)).shape == (48, 64)
+
+
+def test_render_chessboard_refuses_a_pose_or_distortion_not_of_opencvs_lengths() -> None:
+    """42061ab4 took render_plane's checks of K alone: D=None was OpenCV's "Distortion
+    coefficients must be 1x4, ...", a NaN in D or tvec a picture of background only, a tvec of
+    two numbers NumPy's "cannot reshape". Said in render_plane's words; None is no distortion,
+    as in render_plane."""
+    K = np.array([[70.0, 0.0, 32.0], [0.0, 70.0, 24.0], [0.0, 0.0, 1.0]])
+    pose = ([0.0, 0.0, 0.0], [-4.0, -2.5, 12.0])
+    size = {"image_size": (64, 48), "supersample": 1}
+    none = render_chessboard(K, None, *pose, **size)
+    assert np.array_equal(none, render_chessboard(K, np.zeros(5), *pose, **size))
+    with pytest.raises(ValueError) as err:
+        render_chessboard(K, [np.nan, 0, 0, 0, 0], *pose, **size)
+    assert str(err.value) == (
+        "D: expected 4, 5, 8, 12 or 14 coefficients (or none) (finite), got shape (5,)"
+    )
+    with pytest.raises(ValueError, match=r"^tvec: expected 3 numbers \(finite\), got shape \(3,\)"):
+        render_chessboard(K, None, [0.0, 0.0, 0.0], [np.nan, 0.0, 12.0], **size)
+    with pytest.raises(ValueError, match=r"^tvec: expected 3 numbers \(finite\), got shape \(2,\)"):
+        render_chessboard(K, None, [0.0, 0.0, 0.0], [0.0, 12.0], **size)

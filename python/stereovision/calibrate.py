@@ -2658,7 +2658,8 @@ def render_chessboard(
     Parameters
     ----------
     K, D : array_like
-        Camera matrix ``(3, 3)`` and OpenCV distortion coefficients.
+        Camera matrix ``(3, 3)`` and OpenCV distortion coefficients (None or none: no
+        distortion).
     rvec, tvec : array_like
         Board-to-camera rotation (Rodrigues vector) and translation (in ``square_size`` units).
     pattern : tuple of int
@@ -2683,8 +2684,9 @@ def render_chessboard(
     ------
     ValueError
         ``K`` not a finite 3 x 3 camera matrix of positive focal lengths of the form
-        ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` (a transposed one), as
-        :func:`~stereovision.synthetic.render_plane` refuses it.
+        ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` (a transposed one), or ``D``, ``rvec`` or
+        ``tvec`` not finite numbers of OpenCV's lengths, as
+        :func:`~stereovision.synthetic.render_plane` refuses them.
     """
     from stereovision.triangulation import _check_matrix_form
 
@@ -2694,14 +2696,26 @@ def render_chessboard(
     Kf = np.asarray(K, np.float64)
     # a transposed K (MATLAB's IntrinsicMatrix) drew the board seen from a centre at (0, 0),
     # 70 % of a 640x480 view background, without a word: render_plane's checks, in its words
-    if Kf.shape != (3, 3) or not np.isfinite(Kf).all():
-        raise ValueError(f"K: expected a 3 x 3 camera matrix (finite), got shape {Kf.shape}")
+    # D, rvec and tvec too: None was OpenCV's "Distortion coefficients must be 1x4, ...", a NaN
+    # in D or tvec a picture of background only (and NumPy's "invalid value" warning), a tvec
+    # of two numbers NumPy's "cannot reshape array of size 2 into shape (3,1)"
+    Df = np.zeros(0) if D is None else np.asarray(D, np.float64).ravel()
+    rv = np.asarray(rvec, np.float64).ravel()
+    tv = np.asarray(tvec, np.float64).ravel()
+    for name, arr, ok in (
+        ("K", Kf, Kf.shape == (3, 3)),
+        ("D", Df, len(Df) in (0, 4, 5, 8, 12, 14)),
+        ("rvec", rv, rv.shape == (3,)),
+        ("tvec", tv, tv.shape == (3,)),
+    ):
+        if not (ok and np.isfinite(arr).all()):
+            want = {"K": "a 3 x 3 camera matrix", "rvec": "3 numbers", "tvec": "3 numbers"}.get(
+                name, "4, 5, 8, 12 or 14 coefficients (or none)"
+            )
+            raise ValueError(f"{name}: expected {want} (finite), got shape {arr.shape}")
     if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
         raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
     _check_matrix_form(Kf, "K")
-    Df = np.asarray(D, np.float64)
-    rv = np.asarray(rvec, np.float64).reshape(3, 1)
-    tv = np.asarray(tvec, np.float64).reshape(3, 1)
     cols, rows = pattern
 
     def outline(x0: float, y0: float, x1: float, y1: float) -> npt.NDArray[np.int32]:
@@ -2714,7 +2728,7 @@ def render_chessboard(
         ]
         q = np.vstack(sides) * square_size
         pts3 = np.c_[q, np.zeros(len(q))]
-        p, _ = cv2.projectPoints(pts3, rv, tv, Kf, Df)
+        p, _ = cv2.projectPoints(pts3, rv.reshape(3, 1), tv.reshape(3, 1), Kf, Df)
         p = p.reshape(-1, 2)
         # Pixel centres: image pixel (x, y) is the centre of canvas block [x*ss, (x+1)*ss).
         return np.round(((p + 0.5) * ss - 0.5) * (1 << shift)).astype(np.int32)
