@@ -1562,6 +1562,18 @@ def test_no_channel_at_all_is_said_as_no_channel() -> None:
         mcgm.mcgm_match(left, right, max_disparity=8, sigmas=[])
 
 
+def test_sigmas_of_fractions_or_decimals_are_their_floats() -> None:
+    """8ea9350e read half_res_sigma of a config read with parse_float=Decimal as its float,
+    but such sigmas were 'sigmas: expected a number of pixels or a list of them, got
+    [Decimal('2'), Decimal('1')]'. They are their floats, as curves' sigma is."""
+    left, right = _sine_pair()
+    want = mcgm.mcgm_match(left, right, max_disparity=8, sigmas=[2.0, 1.0])
+    got = mcgm.mcgm_match(left, right, max_disparity=8, sigmas=[Decimal("2"), Fraction(1)])
+    assert len(want) > 0
+    np.testing.assert_array_equal(got.xl, want.xl)
+    np.testing.assert_array_equal(got.xr, want.xr)
+
+
 def test_zncc_reference_names_pixels_of_another_layout_or_between_pixels() -> None:
     """zncc_reference reshaped ``pixels`` to (-1, 2) and cast it to int64: a (2, N) array
     (np.nonzero's rows, or x over y) was paired into other pixels, and (10.7, 20.2) truncated

@@ -206,6 +206,9 @@ def _sigmas(sig: object) -> list[float]:
         items = list(sig)
     else:
         items = [sig]
+    # a Fraction or a Decimal (a config read with parse_float=Decimal) as its float, as
+    # half_res_sigma and curves' sigma read it: it was "expected a number of pixels"
+    items = [_plain_real(s) for s in items]
     for s in items:
         if not real_number(s):
             raise ValueError(
