@@ -655,6 +655,24 @@ def test_load_scene_and_view_of_a_pair_named_in_another_case_say_the_names(
     )
 
 
+def test_view_of_a_middlebury_folder_says_the_names(tmp_path: Path) -> None:
+    """A folder of Middlebury's im0.png + im1.png was 'no cloud.ply and no scene (left.png +
+    right.png) in this folder' to view alone, where load_scene, eval and bench name the files
+    to rename (1c96a879 added only Left.png + Right.png's words to view)."""
+    from stereovision import render
+    from stereovision.io import _MIDDLEBURY_NAMES
+
+    for name in ("im0.png", "im1.png"):
+        (tmp_path / name).write_bytes(b"")
+    with pytest.raises(FileNotFoundError) as err:
+        render.load_view_source(tmp_path)
+    assert str(err.value) == (
+        f"{tmp_path}: no cloud.ply and no scene (left.png + right.png) in this folder; it "
+        f"{_MIDDLEBURY_NAMES}"
+    )
+    assert "rename im0.png, im1.png" in str(err.value)
+
+
 @pytest.mark.parametrize("name", ["gt_disp.pfm", "calib.txt", "Q.dat"])
 def test_load_scene_refuses_a_link_to_nothing(tmp_path: Path, name: str) -> None:
     """A scene's GT or calibration that is a link whose target moved (exists() is False) was

@@ -1551,10 +1551,16 @@ def load_view_source(
                 "--calib: no metric 3-D points without one)"
             )
         else:
-            from stereovision.io import _cased_pair
+            from stereovision.io import _MIDDLEBURY_NAMES, _cased_pair
 
             # Left.png + Right.png: "no scene (left.png + right.png)" alone, beside them
             cased = _cased_pair(p)
+            # and a folder as Middlebury ships it (im0.png + im1.png), as load_scene, eval and
+            # bench say it: the names to use were unsaid
+            if not any(os.path.lexists(p / n) for n in ("left.png", "right.png")) and all(
+                (p / n).is_file() for n in ("im0.png", "im1.png")
+            ):
+                cased = _MIDDLEBURY_NAMES
             raise FileNotFoundError(
                 f"{p}: no cloud.ply and no scene (left.png + right.png) in this folder"
                 + (f"; it {cased}" if cased else "")
