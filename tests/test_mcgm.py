@@ -738,6 +738,16 @@ def test_matches_read_an_energy_trace_of_fractions_or_decimals() -> None:
         sv.Matches(a, a, a, a, a, (4, 4), energy_trace=[1.0, None])
 
 
+@pytest.mark.parametrize("value", [10**400, Decimal("sNaN")])
+def test_matches_refuse_an_energy_trace_past_a_float_in_their_words(value: object) -> None:
+    """03f5b361 read a trace of Python numbers as floats: one past a float's range (10**400)
+    or Decimal('sNaN') was a bare 'OverflowError: int too large to convert to float' or
+    'cannot convert signaling NaN to float', where it was energy_trace's refusal before."""
+    a = np.zeros(2)
+    with pytest.raises(ValueError, match=r"^energy_trace: expected real values, got dtype object"):
+        sv.Matches(a, a, a, a, a, (4, 4), energy_trace=[Decimal(1), value])
+
+
 def test_matches_are_no_array_for_numpy() -> None:
     """A Matches is a sequence of one-match Matches: np.asarray(m) (as triangulate(m, m, calib)
     does) nested them 64 deep, 36 s for tsukuba's 4,877 MCGM matches, then "setting an array

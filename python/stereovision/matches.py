@@ -7,6 +7,7 @@ y_right`` (about 0 on rectified pairs), stored at the rounded left-image positio
 
 from __future__ import annotations
 
+import contextlib
 import decimal
 import math
 import numbers
@@ -125,7 +126,10 @@ class Matches:
         if trace.dtype == object and all(
             isinstance(v, (numbers.Real, decimal.Decimal)) for v in trace.reshape(-1)
         ):
-            trace = trace.astype(np.float64)
+            # 10**400 (past a float) or Decimal('sNaN') was a bare OverflowError or "cannot
+            # convert signaling NaN to float": refused below as before (dtype object)
+            with contextlib.suppress(OverflowError, ValueError):
+                trace = trace.astype(np.float64)
         # text was NumPy's "could not convert string to float", naming nothing
         if trace.dtype.kind not in "biuf":
             raise ValueError(f"energy_trace: expected real values, got dtype {trace.dtype}")
