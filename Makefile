@@ -14,7 +14,7 @@ ifdef CI
 export CARGO_INCREMENTAL ?= 0
 endif
 
-.PHONY: help system-deps setup build demo test test-rust test-py lint fmt bench clean
+.PHONY: help system-deps setup build demo test test-rust test-py test-py-live lint fmt bench clean
 
 help:  ## list targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -63,15 +63,23 @@ lint: $(STAMP)  ## cargo fmt/clippy, ruff, mypy
 	$(VENV)/bin/ruff format --check python tests benches
 	$(VENV)/bin/mypy
 
+PYTEST := $(PY) -m pytest -q -n auto --dist loadfile --durations=5
+
 test-py: build  ## pytest (parity, API, CLI, accuracy)
-	$(PY) -m pytest -q -n auto --dist loadfile --durations=5
+	$(PYTEST)
 
 # The core's debug test build and run and the linters overlap the venv's set-up and the release
 # build: pip, mypy and the release build's link steps use one core, and cargo locks each
-# profile's folder apart (clippy and cargo test share one: they take turns).
+# profile's folder apart (clippy and cargo test share one: they take turns). pytest starts
+# when the build is done, beside the linters if they still run (they finished last, and
+# pytest waited for them with a core idle).
 test: system-deps  ## everything CI runs
-	$(MAKE) --no-print-directory -j2 --output-sync=target build test-rust lint
-	$(MAKE) --no-print-directory test-py
+	$(MAKE) --no-print-directory -j2 --output-sync=target build test-rust lint test-py-live
+
+# test-py inside make test's -Otarget: `+` shows pytest's progress as it goes instead of
+# holding it to the end (the catch of `+`: `make -n test` runs pytest)
+test-py-live: build
+	+$(PYTEST)
 
 fmt:  ## format Rust and Python in place
 	cargo fmt --all
