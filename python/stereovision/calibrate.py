@@ -2688,34 +2688,16 @@ def render_chessboard(
         ``tvec`` not finite numbers of OpenCV's lengths, as
         :func:`~stereovision.synthetic.render_plane` refuses them.
     """
-    from stereovision.triangulation import _check_matrix_form
+    from stereovision.synthetic import _camera_pose
 
     w, h = image_size
     ss = int(supersample)
     shift = 4  # fillPoly sub-pixel bits: 1/16 px on the supersampled canvas
-    Kf = np.asarray(K, np.float64)
     # a transposed K (MATLAB's IntrinsicMatrix) drew the board seen from a centre at (0, 0),
-    # 70 % of a 640x480 view background, without a word: render_plane's checks, in its words
-    # D, rvec and tvec too: None was OpenCV's "Distortion coefficients must be 1x4, ...", a NaN
-    # in D or tvec a picture of background only (and NumPy's "invalid value" warning), a tvec
-    # of two numbers NumPy's "cannot reshape array of size 2 into shape (3,1)"
-    Df = np.zeros(0) if D is None else np.asarray(D, np.float64).ravel()
-    rv = np.asarray(rvec, np.float64).ravel()
-    tv = np.asarray(tvec, np.float64).ravel()
-    for name, arr, ok in (
-        ("K", Kf, Kf.shape == (3, 3)),
-        ("D", Df, len(Df) in (0, 4, 5, 8, 12, 14)),
-        ("rvec", rv, rv.shape == (3,)),
-        ("tvec", tv, tv.shape == (3,)),
-    ):
-        if not (ok and np.isfinite(arr).all()):
-            want = {"K": "a 3 x 3 camera matrix", "rvec": "3 numbers", "tvec": "3 numbers"}.get(
-                name, "4, 5, 8, 12 or 14 coefficients (or none)"
-            )
-            raise ValueError(f"{name}: expected {want} (finite), got shape {arr.shape}")
-    if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
-        raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
-    _check_matrix_form(Kf, "K")
+    # 70 % of a 640x480 view background, without a word; None for D was OpenCV's "Distortion
+    # coefficients must be 1x4, ...", a NaN in D or tvec a picture of background only, a tvec
+    # of two numbers NumPy's "cannot reshape": render_plane's checks, in its words
+    Kf, Df, rv, tv = _camera_pose(K, D, rvec, tvec)
     cols, rows = pattern
 
     def outline(x0: float, y0: float, x1: float, y1: float) -> npt.NDArray[np.int32]:

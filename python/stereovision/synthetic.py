@@ -121,6 +121,46 @@ def _fisheye_rays(px: F64, K: F64, D: F64) -> F64:
     return out
 
 
+def _camera_pose(
+    K: object, D: object, rvec: object, tvec: object, model: str | None = None
+) -> tuple[F64, F64, F64, F64]:
+    """``K``, ``D``, ``rvec`` and ``tvec`` of a rendered view as float64 (``D``, ``rvec`` and
+    ``tvec`` flat), refused in :func:`render_plane`'s words (also ``render_chessboard``'s:
+    ``model`` None names no model in the message)."""
+    Kf = np.asarray(K, np.float64)
+    # None is no distortion, as the message below and OpenCV's distCoeffs have it: it was
+    # asarray's NaN, "... (or none) for model 'pinhole' (finite), got shape (1,)"
+    Df = np.zeros(0) if D is None and model != "fisheye" else np.asarray(D, np.float64).ravel()
+    rv = np.asarray(rvec, np.float64).ravel()
+    t = np.asarray(tvec, np.float64).ravel()
+    # OpenCV's lengths; none at all is no distortion for the pinhole model
+    lengths = (4,) if model == "fisheye" else (0, 4, 5, 8, 12, 14)
+    for name, arr, ok in (
+        ("K", Kf, Kf.shape == (3, 3)),
+        ("D", Df, len(Df) in lengths),
+        ("rvec", rv, rv.shape == (3,)),
+        ("tvec", t, t.shape == (3,)),
+    ):
+        if not (ok and np.isfinite(arr).all()):
+            want = {"K": "a 3 x 3 camera matrix", "rvec": "3 numbers", "tvec": "3 numbers"}.get(
+                name,
+                "4 coefficients for model 'fisheye'"
+                if model == "fisheye"
+                else "4, 5, 8, 12 or 14 coefficients (or none)"
+                + (f" for model {model!r}" if model else ""),
+            )
+            got = "None" if name == "D" and D is None else f"shape {arr.shape}"
+            raise ValueError(f"{name}: expected {want} (finite), got {got}")
+    # a zero focal length (the K = 0 of an uncalibrated camera's camera_info) gave every ray
+    # NaN and a picture of background only, with NumPy's "invalid value" warnings; a negative
+    # one a mirrored picture. Calibration's words
+    if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
+        raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
+    # a transposed K (MATLAB's IntrinsicMatrix) drew the plane seen from a centre at (0, 0)
+    _check_matrix_form(Kf, "K")
+    return Kf, Df, rv, t
+
+
 def render_plane(
     texture: npt.ArrayLike,
     units_per_pixel: float,
@@ -227,36 +267,7 @@ def render_plane(
         ox = oy = math.nan
     if not (math.isfinite(ox) and math.isfinite(oy)):
         raise ValueError(f"origin_px: expected two finite numbers (x, y), got {origin_px!r}")
-    Kf = np.asarray(K, np.float64)
-    # None is no distortion, as the message below and OpenCV's distCoeffs have it: it was
-    # asarray's NaN, "... (or none) for model 'pinhole' (finite), got shape (1,)"
-    Df = np.zeros(0) if D is None and model == "pinhole" else np.asarray(D, np.float64).ravel()
-    rv = np.asarray(rvec, np.float64).ravel()
-    t = np.asarray(tvec, np.float64).ravel()
-    # OpenCV's lengths; none at all is no distortion for the pinhole model
-    lengths = (4,) if model == "fisheye" else (0, 4, 5, 8, 12, 14)
-    for name, arr, ok in (
-        ("K", Kf, Kf.shape == (3, 3)),
-        ("D", Df, len(Df) in lengths),
-        ("rvec", rv, rv.shape == (3,)),
-        ("tvec", t, t.shape == (3,)),
-    ):
-        if not (ok and np.isfinite(arr).all()):
-            want = {"K": "a 3 x 3 camera matrix", "rvec": "3 numbers", "tvec": "3 numbers"}.get(
-                name,
-                "4 coefficients for model 'fisheye'"
-                if model == "fisheye"
-                else "4, 5, 8, 12 or 14 coefficients (or none) for model 'pinhole'",
-            )
-            got = "None" if name == "D" and D is None else f"shape {arr.shape}"
-            raise ValueError(f"{name}: expected {want} (finite), got {got}")
-    # a zero focal length (the K = 0 of an uncalibrated camera's camera_info) gave every ray
-    # NaN and a picture of background only, with NumPy's "invalid value" warnings; a negative
-    # one a mirrored picture. Calibration's words
-    if not (Kf[0, 0] > 0 and Kf[1, 1] > 0):
-        raise ValueError(f"K: focal lengths must be positive, got fx={Kf[0, 0]:g}, fy={Kf[1, 1]:g}")
-    # a transposed K (MATLAB's IntrinsicMatrix) drew the plane seen from a centre at (0, 0)
-    _check_matrix_form(Kf, "K")
+    Kf, Df, rv, t = _camera_pose(K, D, rvec, tvec, model)
     Rb, _ = cv2.Rodrigues(rv.reshape(3, 1))
     plane = np.column_stack([Rb[:, 0], Rb[:, 1], t])
     if abs(np.linalg.det(plane)) <= 1e-12 * max(1.0, float(np.abs(t).max())):
