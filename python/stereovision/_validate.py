@@ -349,6 +349,14 @@ ADVICE["resized_map"]["page"] = ADVICE["resized_map"]["cli"]
 LOW_UINT16_ADVICE = ADVICE["low_uint16"]["api"]
 
 
+def refuse_no_image(img: object, name: str) -> None:
+    """Raise :func:`as_image_array`'s error for None (``cv2.imread``'s answer for a file it
+    cannot read, a camera's dropped frame) or a path given as an image: readers that cast
+    first said "expected a uint8 image, got object" (``<U10`` for a path), or "got ()"."""
+    if img is None or path_given(img) is not None:
+        as_image_array(img, name)  # raises
+
+
 def advice_for(text: str, where: str) -> str:
     """``text``, a library warning or error, with its Python advice in the words of ``where``
     (``"cli"`` or ``"page"``): ``img << 4`` or ``calib=`` is no help to a user who gave files

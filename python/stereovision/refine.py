@@ -27,14 +27,13 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     _warn_low_uint16,
-    as_image_array,
     check_index_range,
     check_unit_range,
     disparity_range,
     not_a_result,
     number_shown,
-    path_given,
     real_number,
+    refuse_no_image,
     refuse_unknown,
 )
 
@@ -108,9 +107,9 @@ def _number(v: object, name: str, whole: bool = False) -> float:
 
 
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
-    if name in ("left", "right") and (a is None or path_given(a) is not None):
+    if name in ("left", "right"):
         # "left must be real numbers, got dtype object" (a path: "<U8") of cv2.imread's None
-        as_image_array(a, name)  # raises in the package's words
+        refuse_no_image(a, name)
     arr = np.asarray(a)
     # The float32 cast dropped a complex array's imaginary part with only NumPy's warning.
     if arr.dtype.kind not in "biuf":

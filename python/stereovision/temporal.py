@@ -43,10 +43,9 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     NOT_NUMBERS,
-    as_image_array,
     check_index_range,
-    path_given,
     real_number,
+    refuse_no_image,
 )
 
 __all__ = ["MOTION_MARGIN", "TemporalFilter", "noise_sigma"]
@@ -173,18 +172,10 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     return 0.0 if estimate is None else estimate
 
 
-def _refuse_no_image(img: object, name: str) -> None:
-    """None (``cv2.imread``'s answer for a file it cannot read, a camera's dropped frame) or a
-    path, in the package's words (:func:`as_image_array`'s): they were "expected a uint8 image,
-    got object" (``<U10`` for a path), and :func:`noise_sigma`'s "got ()"."""
-    if img is None or path_given(img) is not None:
-        as_image_array(img, name)  # raises
-
-
 def _measured_noise(image: npt.ArrayLike) -> float | None:
     """:func:`noise_sigma`, None where it has no pixel to measure (all black or white) rather
     than its 0: the stream's summary said such a frame's noise was 0.0."""
-    _refuse_no_image(image, "image")
+    refuse_no_image(image, "image")
     img = np.asarray(image)
     if img.ndim not in (2, 3) or img.shape[0] < 3 or img.shape[1] < 3:
         raise ValueError(
@@ -363,8 +354,8 @@ class TemporalFilter:
             If an image is None (a frame the camera dropped, a file ``cv2.imread`` could not
             read) or a path, is not ``uint8``, or the two differ in shape.
         """
-        _refuse_no_image(left, "left")
-        _refuse_no_image(right, "right")
+        refuse_no_image(left, "left")
+        refuse_no_image(right, "right")
         imgs = [np.asarray(left), np.asarray(right)]
         for name, img in zip(("left", "right"), imgs, strict=True):
             if img.dtype != np.uint8:
