@@ -3430,10 +3430,14 @@ class _FramesBar:
             self.bar.update(read - self.bar.n)
 
     def write(self, line: str) -> None:
+        # each line out as it is said: in a pipe or a file (`capture ... | tee log`) the
+        # "saved" lines waited in the buffer, none there while pairs were written, and a kill
+        # (SIGKILL, a CI timeout) lost them all though their pairs were on disk
         if self.bar is None:
-            print(line)
+            print(line, flush=True)
         else:
             self.bar.write(line, file=sys.stdout)
+            sys.stdout.flush()
 
     def close(self) -> None:
         if self.bar is not None:
@@ -3486,7 +3490,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         bar.write(line)
 
     try:
-        print(cam.describe())
+        print(cam.describe(), flush=True)  # the source's line, before its pairs' lines
         bar.start(_frames_announced(cam))  # below the source's line
         result = capture(
             cam,
