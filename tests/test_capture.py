@@ -5101,3 +5101,35 @@ def test_cli_capture_flushes_each_saved_line_into_a_pipe(
     assert [line.split(" (")[0] for line in lines[-1][1:]] == [
         f"saved left_{i:04d}.png right_{i:04d}.png" for i in (1, 2, 3)
     ]
+
+
+def test_a_dark_10_or_12_bit_board_is_stretched_for_the_live_search(tmp_path: Path) -> None:
+    """A 10-bit camera's frames in 16-bit PNGs (a board of levels 120-426) were cut to their top
+    8 bits for the live search: 3 grey levels, no chessboard or ChArUco board found in any
+    frame (calibrate, which stretches a dark image, found each), and a warning of the image's
+    bits for every frame. A dark frame of more than 8 bits is stretched as calibrate reads it;
+    8-bit frames are searched as before, a black 16-bit frame is no board, without a word."""
+
+    def dim(grey: np.ndarray, bits: int) -> np.ndarray:  # 0.3 of the range, 30 levels up
+        return np.rint((grey * 0.3 + 30) * 2 ** (bits - 8)).astype(np.uint16)
+
+    chess = cv2.cvtColor(_board(POSE_A, 0, False), cv2.COLOR_BGR2GRAY)
+    want = detect_board_live(chess, (9, 6))
+    assert want is not None
+    rv, tv = POSE_A
+    t0 = tv - cv2.Rodrigues(rv)[0] @ np.array([SQUARE, SQUARE, 0.0])
+    charuco = [
+        render_charuco(CHARUCO, K, D, r, t, image_size=BOARD_SIZE, supersample=1)
+        for r, t in ((rv, t0), (rv, RIG_T + t0))
+    ]
+    mk = capmod.StereoFrame
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        for bits in (10, 12):
+            got = detect_board_live(dim(chess, bits), (9, 6))
+            assert got is not None and np.abs(got - want).max() < 1.0, bits
+            col = ChessboardCollector(CHARUCO.inner, board=CHARUCO)
+            frame = mk(dim(charuco[0], bits), dim(charuco[1], bits), 0.0, 0.0, 0)
+            assert col.consider(frame).reason == "new pose", bits
+        assert detect_board_live(np.zeros((48, 64), np.uint16), (9, 6)) is None
+    assert [str(w.message) for w in said] == []

@@ -2763,13 +2763,31 @@ def save_pair(
 # -------------------------------------------------------------------------- chessboard mode
 
 
+def _board_search_image(image: np.ndarray) -> np.ndarray:
+    """``image`` as the live board searches read it: an 8-bit one as it is; one of more bits
+    as 8-bit grey, a dark one (a 10- or 12-bit camera's frames in 16-bit PNGs) stretched by
+    the gain that brings its brightest grey to 255, as calibrate reads it (``_load_gray``).
+    Cut to its top 8 bits, a 10-bit board of levels 120-426 kept 3 grey levels and was found in
+    no frame (calibrate found it in each), with a warning of its bits for every frame."""
+    from stereovision._validate import as_image_array
+    from stereovision.calibrate import _load_gray
+
+    arr = as_image_array(image, "image")
+    if arr.dtype == np.uint8:
+        return arr
+    if not arr.any():  # a black frame (a lens cap): no board, and no warning of its bits
+        return np.zeros(arr.shape[:2], np.uint8)
+    return _load_gray(arr, "image")[0]
+
+
 def detect_board_live(image: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | None:
     """Fast board detection for a live stream (scaled to <= :data:`DETECT_MAX_WIDTH`).
 
     Parameters
     ----------
     image : numpy.ndarray
-        Grey, BGR or BGRA; ``uint8``, ``uint16`` or float in [0, 1] (searched as 8-bit grey).
+        Grey, BGR or BGRA; ``uint8``, ``uint16`` or float in [0, 1] (searched as 8-bit grey; a
+        dark one of more bits, a 10- or 12-bit camera's, stretched as calibrate reads it).
     pattern : tuple of int
         Inner corners ``(cols, rows)``.
 
@@ -2783,7 +2801,7 @@ def detect_board_live(image: np.ndarray, pattern: tuple[int, int]) -> np.ndarray
 
     # 8-bit grey, as calibrate and the ChArUco mode search: an image sequence's 16-bit PNGs
     # came as they are, and findChessboardCorners' cv2.error on them came out raw
-    gray = as_gray_uint8(image, "image")
+    gray = as_gray_uint8(_board_search_image(image), "image")
     scale = min(1.0, DETECT_MAX_WIDTH / gray.shape[1])
     small = gray
     if scale < 1.0:
@@ -2878,15 +2896,17 @@ class ChessboardCollector:
         from stereovision.charuco import corners_span_plane, find_charuco_corners
 
         assert self.board is not None
+        # a dark 10- or 12-bit frame stretched, as the chessboard's search reads it
+        left, right = _board_search_image(frame.left), _board_search_image(frame.right)
         if not self.board.resolved:
-            found = self.board.resolve(frame.left)
+            found = self.board.resolve(left)
             if found is None:
                 return "no board in left"
             self.board = found
-        fl = find_charuco_corners(frame.left, self.board)
+        fl = find_charuco_corners(left, self.board)
         if fl is None:
             return "no board in left"
-        fr = find_charuco_corners(frame.right, self.board)
+        fr = find_charuco_corners(right, self.board)
         if fr is None:
             return "no board in right"
         common = np.intersect1d(fl[0], fr[0])
