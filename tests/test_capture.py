@@ -5133,3 +5133,21 @@ def test_a_dark_10_or_12_bit_board_is_stretched_for_the_live_search(tmp_path: Pa
             assert col.consider(frame).reason == "new pose", bits
         assert detect_board_live(np.zeros((48, 64), np.uint16), (9, 6)) is None
     assert [str(w.message) for w in said] == []
+
+
+def test_every_with_a_board_is_refused_before_any_read(tmp_path: Path) -> None:
+    """capture(chessboard=..., every=3) ignored every without a word (3 new poses read, 3
+    saved), where the CLI refuses --every with a board: refused in the API too, before the
+    camera is read or the folder made."""
+    log: list[str] = []
+    out = tmp_path / "pairs"
+    for board in ({"chessboard": "9x6"}, {"charuco": CHARUCO}):
+        cam = StereoCamera(_FakeCap("L", log), _FakeCap("R", log))
+        with pytest.raises(ValueError) as err:
+            capture(cam, out, every=3, **board)
+        assert str(err.value) == (
+            "every is for a capture without a board: chessboard and charuco save a pair for "
+            "each new pose of the board"
+        )
+        cam.close()
+    assert log == [] and not out.exists()

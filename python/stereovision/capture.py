@@ -3073,7 +3073,8 @@ def capture(
     min_distance : float
         Pose distance of the chessboard mode.
     every : int
-        Without ``chessboard``: save every ``every``-th pair.
+        Save every ``every``-th pair; not with ``chessboard`` or ``charuco`` (the board's new
+        poses choose the pairs).
     ext : str
         Image format of the saved files.
     log : callable, optional
@@ -3108,10 +3109,11 @@ def capture(
     TypeError
         If ``charuco`` is not a :class:`~stereovision.charuco.CharucoBoard`.
     ValueError
-        For an invalid ``count``, ``every``, ``temporal``, ``ext`` or pattern, a ``directory``
-        that is a file (or below one), or one whose saved pairs an image-sequence source would
-        read as its next frames (``--left 'pairs/left_%04d.png' -o pairs``); a recorded frame that
-        does not decode (a bag), its message saying how many pairs were saved and are kept.
+        For an invalid ``count``, ``every`` (or one with a board), ``temporal``, ``ext`` or
+        pattern, a ``directory`` that is a file (or below one), or one whose saved pairs an
+        image-sequence source would read as its next frames (``--left 'pairs/left_%04d.png'
+        -o pairs``); a recorded frame that does not decode (a bag), its message saying how many
+        pairs were saved and are kept.
     PermissionError
         If ``directory`` cannot be written.
     OSError
@@ -3128,6 +3130,13 @@ def capture(
         raise ValueError(f"ext: cannot encode images as {ext}: OpenCV has no writer for it")
     if chessboard and charuco is not None:
         raise ValueError("chessboard and charuco: give one calibration target, not both")
+    if every != 1 and (chessboard or charuco is not None):
+        # ignored without a word (every=3 over 3 new poses saved 3), as --every was before
+        # the CLI refused it: the board's pose chooses the pairs, not their number
+        raise ValueError(
+            "every is for a capture without a board: chessboard and charuco save a pair for "
+            "each new pose of the board"
+        )
     tf = None
     if temporal is not None:
         if not isinstance(temporal, (int, np.integer)) or isinstance(temporal, NOT_NUMBERS):
