@@ -3238,7 +3238,12 @@ def capture(
         if tf is not None:
             if tf.frames == 0:
                 warn_resampled_for_temporal(camera, stacklevel=2, frame=frame)
-            left, right = temporal_average(tf, frame)
+            try:
+                left, right = temporal_average(tf, frame)
+            except KeyboardInterrupt:
+                # Ctrl-C while a frame was averaged (not awaited) dropped the mean unsaid
+                say_unfinished("the capture was interrupted")
+                raise
             averaged = tf.mean_frames()
             # Every pixel's mean full but a few that something crossed (or noise beyond 3
             # sigmas started again).
