@@ -5178,3 +5178,34 @@ def test_a_temporal_mean_an_interrupt_cuts_while_averaging_is_said_unsaved(
         "not saved: the last mean, of 1.0 frames of the 2 asked, was unfinished when the "
         "capture was interrupted"
     )
+
+
+def test_two_cameras_of_other_frame_rates_are_said(tmp_path: Path) -> None:
+    """Two webcams of other rates (30 and 15 fps) were paired without a word: describe() gave
+    both rates in passing and the grab skew said a fraction of a ms, while each pair waits for
+    the slower camera and the faster one's frames queue. One warning at the open says so; none
+    for rates within 1 %, a camera reporting none, a rate asked (said per side), or files (read
+    as they are: their media times are compared instead)."""
+    with pytest.warns(UserWarning) as rec:
+        cam = StereoCamera(_RateCap("L", (30.0,)), _RateCap("R", (15.0,)))
+    assert [str(w.message) for w in rec] == [
+        "left source _RateCap reports 30 fps, right source _RateCap 15 fps: each pair waits for "
+        "the slower camera while the faster one's frames queue in its buffer, so a pair's two "
+        "frames may be taken a frame or more apart, which the grab skew does not show; ask "
+        "both for one rate (fps=15, --fps 15)"
+    ]
+    assert rec[0].filename == __file__  # said at the caller's line
+    cam.close()
+    left = _write_video(tmp_path / "l.avi", [_numbered(0)], fps=10.0)
+    right = _write_video(tmp_path / "r.avi", [_numbered(0)], fps=5.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        StereoCamera(_RateCap("L", (29.97,)), _RateCap("R", (30.0,))).close()
+        StereoCamera(_RateCap("L", (30.0,)), _FakeCap("R", [])).close()  # reports no rate
+        StereoCamera(left, right).close()
+    with pytest.warns(UserWarning) as rec:
+        StereoCamera(_RateCap("L", (30.0,)), _RateCap("R", (30.0, 15.0)), fps=15).close()
+    assert [str(w.message) for w in rec] == [
+        "left source _RateCap reports 30 fps, not the 15 fps asked (a rate this camera does "
+        "not give at this size and format?)"
+    ]

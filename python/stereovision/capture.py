@@ -1546,7 +1546,9 @@ class StereoCamera(PairSource):
         Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
         :attr:`delivered_fps`. A camera or stream that reports another rate (more than 1 %
         off; 0 is none reported) gets one :class:`UserWarning`; a file, or an ``http(s)://``
-        URL (which may name one), is read as it is.
+        URL (which may name one), is read as it is. Without it, two cameras that report other
+        rates (30 and 15 fps) get one: a pair waits for the slower one while the faster one's
+        frames queue, so its two frames may be a frame or more apart.
     fourcc : str, optional
         Pixel format asked of the sources before the size and rate (``CAP_PROP_FOURCC``; with
         V4L2 the format decides which sizes and rates a webcam offers): ``"YUYV"`` for
@@ -1677,6 +1679,26 @@ class StereoCamera(PairSource):
                     UserWarning,
                     stacklevel=3,  # __init__, renamed_keyword's wrapper, the caller
                 )
+            rate = self.delivered_fps
+            slow, fast = sorted((rate.get("left", 0.0), rate.get("right", 0.0)))
+            if (
+                fps is None  # a rate asked and not given is said per side (_open)
+                and all(map(_rate_askable, self.sources.values()))
+                and slow > 0
+                and fast - slow > 0.01 * fast
+            ):
+                # two cameras of other rates (two webcam models): the grab skew said a pair was
+                # a fraction of a ms apart while the faster camera's frames waited in its queue
+                name = {side: _describe_source(src) for side, src in self.sources.items()}
+                warnings.warn(
+                    f"left source {name['left']} reports {rate['left']:g} fps, right source "
+                    f"{name['right']} {rate['right']:g} fps: each pair waits for the slower "
+                    "camera while the faster one's frames queue in its buffer, so a pair's two "
+                    "frames may be taken a frame or more apart, which the grab skew does not "
+                    f"show; ask both for one rate (fps={slow:g}, --fps {slow:g})",
+                    UserWarning,
+                    stacklevel=3,  # __init__, renamed_keyword's wrapper, the caller
+                )
         except BaseException:
             self.close()
             raise
@@ -1752,10 +1774,7 @@ class StereoCamera(PairSource):
         # at that size streamed at 30 without a word; 0 is no rate reported, nothing to compare
         # An http(s) URL may name a video file (as _LIVE_SCHEMES has it): --fps 30 of
         # http://host/clip.mp4 warned "a rate this camera does not give"
-        live = not isinstance(src, (str, os.PathLike)) or (
-            ("://" in os.fspath(src) and not _http_url(os.fspath(src)))
-            or _camera_device(os.fspath(src)) is not None
-        )
+        live = _rate_askable(src)
         if fps is not None and live and rate > 0 and abs(rate - fps) > 0.01 * fps:
             try:
                 warnings.warn(
@@ -2391,6 +2410,16 @@ def _live_stream(src: object) -> bool:
 def _http_url(src: object) -> bool:
     """Whether ``src`` is an ``http://`` or ``https://`` URL, which may name a video file."""
     return isinstance(src, str) and re.match(r"\s*https?://", src, re.IGNORECASE) is not None
+
+
+def _rate_askable(src: object) -> bool:
+    """Whether a frame rate can be asked of ``src``: a camera (an index, its node), a live
+    stream's URL, or a capture object of the caller's; a video file, an image sequence or an
+    ``http(s)://`` URL (which may name a file) is read as it is."""
+    if not isinstance(src, (str, os.PathLike)):
+        return True
+    path = os.fspath(src)
+    return ("://" in path and not _http_url(path)) or _camera_device(path) is not None
 
 
 def _refuse_one_camera_twice(left: object, right: object) -> None:
