@@ -5209,3 +5209,19 @@ def test_two_cameras_of_other_frame_rates_are_said(tmp_path: Path) -> None:
         "left source _RateCap reports 30 fps, not the 15 fps asked (a rate this camera does "
         "not give at this size and format?)"
     ]
+
+
+def test_an_image_the_format_cannot_hold_is_refused_without_opencvs_log_line(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """save_pair of a float32 image as .png was refused in the package's words, but OpenCV's
+    log line came first on stderr ("[ WARN:0@0.640] ... imencodeWithMetadata Unsupported depth
+    image for selected encoder is fallbacked to CV_8U"), as if the image had been written as 8
+    bits. Only the refusal is said now; a uint16 .png is saved as before."""
+    img = np.zeros((4, 6), np.uint8)
+    capfd.readouterr()
+    with pytest.raises(ValueError, match=r"^cannot save the left image \(float32\) as \.png"):
+        capmod.save_pair(tmp_path, 1, img.astype(np.float32), img)
+    assert capfd.readouterr().err == ""
+    paths = capmod.save_pair(tmp_path, 2, img.astype(np.uint16), img)
+    assert cv2.imread(str(paths[0]), cv2.IMREAD_UNCHANGED).dtype == np.uint16

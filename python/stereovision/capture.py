@@ -2750,13 +2750,16 @@ def save_pair(
     make_folder(d)
     data = []
     for side, img in (("left", left), ("right", right)):
+        arr = np.asarray(img)
         try:
-            ok, buf = cv2.imencode(ext, np.asarray(img))
+            # a type the format cannot hold is refused below: OpenCV's log line ("[ WARN ...]
+            # ... fallbacked to CV_8U") came first on stderr, as if the image had been written
+            with _opencv_quiet() if arr.dtype != np.uint8 else contextlib.nullcontext():
+                ok, buf = cv2.imencode(ext, arr)
         except cv2.error:
             ok = False
         if not ok:
             raise ValueError(f"cannot encode the {side} image as {ext}")
-        arr = np.asarray(img)
         if arr.dtype != np.uint8:
             # a format without the image's depth is written as 8 bits: a float image in
             # [0, 1] was saved black (0 and 1), a 16-bit one in .jpg white, without a word
