@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -3814,3 +3815,23 @@ def test_rectify_keeps_a_16_bit_pair_at_16_bits(data_dir: Path, tmp_path: Path) 
         assert written.dtype == np.uint16
         grey = cv2.imread(str(given), cv2.IMREAD_ANYDEPTH)
         np.testing.assert_array_equal(written, np.dstack([grey] * 3))  # as imread's 3 channels
+
+
+def test_rectify_suggests_a_depth_command_the_shell_reads_for_a_folder_with_a_space(
+    crop_terrace: Callable[[slice, slice], Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """rectify prints the depth command to run on its rectified pair; its paths were printed
+    as they are: `-o "my rect"` gave `stereovision depth my rect/left_rect.png ...`, which the
+    shell splits into other words (a file `my` not found). They are quoted for the shell (the
+    line without --calib, `Next: stereovision depth ...`, through the same helper)."""
+    scene = crop_terrace(slice(117, 217), slice(206, 356))  # of eth3d/terrace, 150x100
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    out = tmp_path / "my rect"
+    assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if "stereovision depth " in s)
+    words = shlex.split(line.split("stereovision depth ", 1)[1].split(" -o OUT")[0])
+    names = ("left_rect.png", "right_rect.png", "--calib", "calib_rect.yaml")
+    assert words == [n if n.startswith("-") else str(out / n) for n in names]
+    assert all(Path(w).is_file() for w in words[:2] + words[3:])

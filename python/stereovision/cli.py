@@ -14,6 +14,7 @@ import json
 import math
 import os
 import re
+import shlex
 import signal
 import sys
 import threading
@@ -1304,11 +1305,14 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         written, removed = commit_outputs(
             out, staged, earlier, RECTIFY_MANIFEST, RECTIFY_OUTPUTS, stale=_stale_rectify_output
         )
+    # the command to run next, its paths as the shell reads them: `-o "my rect"` gave
+    # "depth my rect/left_rect.png ...", which the shell split into four words
+    quoted = {name: _shell_path(path) for name, path in written.items()}
     if summary is not None:
         print(summary.describe())
         print(
             f"  disparity, not depth: for depth in metres calibrate the rig. Next: stereovision "
-            f"depth {written['left_rect.png']} {written['right_rect.png']} --max-disparity "
+            f"depth {quoted['left_rect.png']} {quoted['right_rect.png']} --max-disparity "
             f"{summary.max_disparity} -o OUT"
         )
     if given is not None:
@@ -1329,8 +1333,8 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         print(f"  {name:19s} {path}")
     if "calib_rect.yaml" in written:
         print(
-            f"  depth on the rectified pair: stereovision depth {written['left_rect.png']} "
-            f"{written['right_rect.png']} --calib {written['calib_rect.yaml']} -o OUT (the raw "
+            f"  depth on the rectified pair: stereovision depth {quoted['left_rect.png']} "
+            f"{quoted['right_rect.png']} --calib {quoted['calib_rect.yaml']} -o OUT (the raw "
             "rig's calibration would rectify it again)"
         )
     now = (
@@ -1362,6 +1366,16 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             "to depth --rectification with them"
         )
     return 0
+
+
+def _shell_path(path: Path) -> str:
+    """``path`` as a command the CLI suggests names it: quoted for the shell where it holds a
+    space or another character the shell reads (``'my rect/left_rect.png'``), and a relative
+    one that starts with ``-`` after ``./`` (else read as an option)."""
+    text = str(path)
+    if text.startswith("-"):
+        text = f"./{text}"
+    return shlex.quote(text)
 
 
 def _stale_rectify_output(path: Path) -> bool:
