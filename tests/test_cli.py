@@ -3835,3 +3835,26 @@ def test_rectify_suggests_a_depth_command_the_shell_reads_for_a_folder_with_a_sp
     names = ("left_rect.png", "right_rect.png", "--calib", "calib_rect.yaml")
     assert words == [n if n.startswith("-") else str(out / n) for n in names]
     assert all(Path(w).is_file() for w in words[:2] + words[3:])
+
+
+def test_depth_lists_its_files_in_a_folder_named_with_a_newline_one_per_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """depth's list of the files written printed their paths as they are: -o 'o\\nut' cut each
+    line in two ('  disparity.png  .../o' then 'ut/disparity.png'), where its errors and
+    warnings show such a path escaped. Each file is now one line, the newline escaped."""
+    rng = np.random.default_rng(0)
+    left = (rng.random((32, 64)) * 255).astype(np.uint8)
+    pair = [tmp_path / "left.png", tmp_path / "right.png"]
+    cv2.imwrite(str(pair[0]), left)
+    cv2.imwrite(str(pair[1]), np.roll(left, -3, axis=1))
+    out = tmp_path / "o\nut"
+    argv = ["depth", *map(str, pair), "--method", "fast", "--max-disparity", "8"]
+    assert main([*argv, "-o", str(out)]) == 0
+    listed = capsys.readouterr().out.splitlines()[1:]
+    shown = str(out).replace("\n", "\\n")
+    assert listed == [
+        f"  {name:14s} {shown}/{name}"
+        for name in ("disparity.png", "disparity.pfm", "overview.png")
+    ]
+    assert (out / "disparity.pfm").is_file()

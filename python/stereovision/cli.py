@@ -871,7 +871,8 @@ def cmd_depth(args: argparse.Namespace) -> int:
     if res.depth is not None:
         print(f"  {_depth_coverage(res)}")
     for name, path in written.items():
-        print(f"  {name:14s} {path}")
+        # a folder named with a newline cut the line in two (escaped, as errors name it)
+        print(f"  {name:14s} {escaped(str(path))}")
     for path in removed:
         print(f"  removed {path.name} of an earlier run (not written by this one)")
     return 0
@@ -1108,7 +1109,9 @@ def cmd_check(args: argparse.Namespace) -> int:
         _atomic_write_bytes(plot, png)
         if kept_plot is not None:  # on stderr: with --json stdout is the one JSON object
             print(
-                f"stereovision: {plot} replaced; the earlier file is {kept_plot}", file=sys.stderr
+                f"stereovision: {escaped(str(plot))} replaced; the earlier file is "
+                f"{escaped(str(kept_plot))}",
+                file=sys.stderr,
             )
     said = res.as_dict()  # with --json, printed once at the end: stdout is the one JSON object
     if not args.json:
@@ -1124,13 +1127,13 @@ def cmd_check(args: argparse.Namespace) -> int:
             "rectify them from their own features (stereovision rectify LEFT RIGHT -o DIR)"
         )
     if args.plot and not args.json:  # the picture asked for is named, as view -o names its own
-        print(f"plot written to {args.plot}")
+        print(f"plot written to {escaped(args.plot)}")
     if res.ok is None:
         # Not an error of the command line (2), nor a verdict on the rig (1): the pair could
         # not be judged, so there is nothing to correct either.
         if fix is not None:
             print(
-                f"stereovision: not corrected, nothing written to {fix}: "
+                f"stereovision: not corrected, nothing written to {escaped(str(fix))}: "
                 + (
                     "the two images are identical (give the two cameras' views)"
                     if res.identical
@@ -1161,7 +1164,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     if why is not None:
         if args.json:
             print(json.dumps(said))
-        print(f"stereovision: not corrected, nothing written to {fix}: {why}", file=sys.stderr)
+        print(
+            f"stereovision: not corrected, nothing written to {escaped(str(fix))}: {why}",
+            file=sys.stderr,
+        )
         return 1
     turn = float(np.degrees(np.linalg.norm(cv2.Rodrigues(fixed.R @ calib.R.T)[0])))
     said["fixed"] = {"turn_deg": turn, "check": after.as_dict(), "written": None}
@@ -1181,11 +1187,15 @@ def cmd_check(args: argparse.Namespace) -> int:
     said["fixed"]["written"] = str(fix)
     replaced = replaced_words(kept, existed)
     if not args.json:
-        print(f"corrected calibration written to {fix}{replaced}")
+        print(f"corrected calibration written to {escaped(str(fix))}{replaced}")
     else:
         print(json.dumps(said))
         if kept:  # on stderr: stdout is the one JSON object
-            print(f"stereovision: {fix} replaced; the earlier file is {kept}", file=sys.stderr)
+            print(
+                f"stereovision: {escaped(str(fix))} replaced; the earlier file is "
+                f"{escaped(str(kept))}",
+                file=sys.stderr,
+            )
     return 0
 
 
@@ -1330,7 +1340,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
                 f"fit one fundamental matrix, {check.matches} lie on one row model within 1 px)"
             )
     for name, path in written.items():
-        print(f"  {name:19s} {path}")
+        print(f"  {name:19s} {escaped(str(path))}")
     if "calib_rect.yaml" in written:
         print(
             f"  depth on the rectified pair: stereovision depth {quoted['left_rect.png']} "
@@ -1361,7 +1371,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         and _homographies(mine)
     ):
         print(
-            f"  kept {mine} (not listed as an earlier run's output there), but its "
+            f"  kept {escaped(str(mine))} (not listed as an earlier run's output there), but its "
             f"homographies do not fit the images written now ({now}): do not give it "
             "to depth --rectification with them"
         )
@@ -1589,13 +1599,15 @@ def cmd_demo(args: argparse.Namespace) -> int:
             f" {len(res.points)} points in the cloud"
         )
         print(f"  {_depth_coverage(res)}")
-    print(f"outputs in {out_dir.resolve()}:")
+    print(f"outputs in {escaped(str(out_dir.resolve()))}:")
     for name, path in written.items():
-        print(f"  {name:14s} {path}")
+        print(f"  {name:14s} {escaped(str(path))}")
     for path in removed:
         print(f"  removed {path.name} of an earlier run (not written by this one)")
     for name, kept in kept_aside:
-        print(f"  the {name} that was there (no earlier run's output) is kept as {kept}")
+        print(
+            f"  the {name} that was there (no earlier run's output) is kept as {escaped(str(kept))}"
+        )
     return 0
 
 
