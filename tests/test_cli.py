@@ -211,6 +211,21 @@ def test_depth_coverage_leaves_out_the_reasons_with_no_pixel(
     assert _depth_coverage(res) == head + tail
 
 
+def test_depth_coverage_of_a_map_without_any_disparity_says_so() -> None:
+    """A pair with nothing to match (a blank wall: depth --method gabor of two grey images)
+    was said 'depth on 0.0 % of the pixels (disparity on 0.0 %): every pixel with a disparity
+    has one', true of no pixel; it now says that none has a disparity."""
+    from types import SimpleNamespace
+
+    from stereovision.cli import _depth_coverage
+
+    counts = {"pixels": 200, "disparity": 0, "depth": 0, "filled": 0, "dropped": 0}
+    res = SimpleNamespace(depth_counts=lambda: counts, limits={})
+    assert _depth_coverage(res) == (
+        "depth on 0.0 % of the pixels (disparity on 0.0 %): no pixel has a disparity to triangulate"
+    )
+
+
 def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: Path) -> None:
     out = tmp_path / "o"
     out.mkdir()

@@ -885,7 +885,8 @@ def _depth_coverage(res: Any) -> str:
     guesses, not measured) nor on 0 measured (0.0 %) within sigma_d of infinite depth``: the depth
     map's holes where the disparity map has none, said with their reason. A reason with no
     pixel is left out (it read "none on 0 filled (0.0 %, ...) nor on 0 measured (0.0 %)"), and
-    with neither the line says every pixel with a disparity has a depth.
+    with neither the line says every pixel with a disparity has a depth; with no disparity at
+    all, that none has one.
     """
     c = res.depth_counts()
 
@@ -899,6 +900,9 @@ def _depth_coverage(res: Any) -> str:
         parts.append(f"{c['filled']} filled ({pct('filled')}, guesses, not measured)")
     if c["dropped"]:
         parts.append(f"{c['dropped']} measured ({pct('dropped')}) {why} sigma_d of infinite depth")
+    if not c["disparity"]:
+        # "every pixel with a disparity has one" was true of none (a blank wall, a dark frame)
+        return f"{head}: no pixel has a disparity to triangulate"
     if not parts:
         return f"{head}: every pixel with a disparity has one"
     return f"{head}: none on " + " nor on ".join(parts)
