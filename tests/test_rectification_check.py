@@ -18,6 +18,7 @@ from stereovision.calibration import Calibration
 from stereovision.io import imread
 from stereovision.rectification_check import (
     MIN_MATCHES,
+    RectificationCheck,
     _judge_rows,
     check_rectification,
     refine_rectification,
@@ -819,7 +820,9 @@ def test_cli_check_fix_json_keeps_stdout_one_object(
     assert fixed["turn_deg"] == pytest.approx(0.3, abs=0.05)
     assert fixed["written"] == str(earlier)
     kept = tmp_path / "rig2.previous.yaml"
-    assert err == f"stereovision: {earlier} replaced; the earlier file is {kept}\n"
+    lines = err.splitlines()  # on stderr, as the warning that cones agrees as given (rectified)
+    assert lines[0].startswith("stereovision: warning: the images as given have rows that agree")
+    assert lines[1:] == [f"stereovision: {earlier} replaced; the earlier file is {kept}"]
 
 
 def test_cli_check_fix_that_still_fails_writes_nothing_and_exits_1(
@@ -1264,3 +1267,39 @@ def test_cli_check_reads_a_16_bit_pair_at_16_bits(
     said = json.loads(capsys.readouterr().out)
     want = check_rectification(*(read_image(p) for p in paths)).as_dict()
     assert said == want and said["matches"] > 100
+
+
+def test_cli_check_fix_of_rectified_images_with_the_raw_rig_says_they_may_be_rectified_twice(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The StereoPi pair rectified by its rig (as rectify writes left_rect.png), then checked
+    with that raw rig's calibration: rectified twice, 0.71 px. --fix "corrected" the rig to fit
+    the rectified images (0.403 degrees; through it the raw pair's rows went from 0.15 to
+    0.46 px) without a word, and without --fix the line said only to recalibrate. A warning now
+    says that the images as given have rows that agree (0.30 px) and may be rectified already
+    (the line without --fix says it too); --fix still writes: a drift of a rig whose raw rows
+    agree looks the same."""
+    cal = stereopi_calib(data_dir)
+    pair = [tmp_path / "left_rect.png", tmp_path / "right_rect.png"]
+    rectified = cal.rectify(*_pair(data_dir, "stereopi_rig/scene_photo"))
+    for path, img in zip(pair, rectified, strict=True):
+        cv2.imwrite(str(path), img)
+    rig = cal.save(tmp_path / "rig.yaml")
+    # the correction itself is refine_rectification's (tested above): a passing one, cheaply
+    passing = RectificationCheck(100, 0.2, 0.5, 0.0, 0.0, 0.0, True, 0.5)
+    monkeypatch.setattr(
+        "stereovision.rectification_check.refine_rectification", lambda *a, **k: (cal, passing)
+    )
+    fixed = tmp_path / "fixed.yaml"
+    assert sv.cli.main(["check", *map(str, pair), "--calib", str(rig), "--fix", str(fixed)]) == 0
+    err = capsys.readouterr().err
+    assert err == (
+        "stereovision: warning: the images as given have rows that agree already (rows median "
+        "|dy| 0.30 px over 102 matches, tolerance 0.5): if they are rectified images (rectify's "
+        "left_rect.png, a camera's image_rect), the corrected calibration fits them, not the "
+        "rig's raw images: give the raw images\n"
+    )
+    assert fixed.is_file()

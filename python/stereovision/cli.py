@@ -1102,6 +1102,22 @@ def cmd_check(args: argparse.Namespace) -> int:
     if calib is not None:
         left, right = calib.rectify(left, right)
     res = check_rectification(left, right, tolerance=args.tolerance)
+    # Rectified images (rectify's left_rect.png, a camera driver's image_rect) given with the raw
+    # rig's calibration are rectified twice and fail: the line said only to recalibrate or
+    # --fix, which "corrected" the rig to fit them (stereopi: 0.403 degrees; through that rig
+    # its raw pair's rows went from 0.15 to 0.46 px). A drift of a rig whose raw rows agree
+    # looks the same, so it is said, not refused.
+    as_given = None
+    if res.ok is False and not res.swapped and calib is not None and not calib.rectified:
+        as_given = check_rectification(raw_left, raw_right, tolerance=args.tolerance)
+        if as_given.ok is not True or as_given.swapped:
+            as_given = None
+    twice = (
+        None
+        if as_given is None
+        else f"the images as given have rows that agree already ({as_given.rows_agree()}): "
+        "if they are rectified images (rectify's left_rect.png, a camera's image_rect)"
+    )
     if args.plot:
         from stereovision.io import keep_previous
         from stereovision.rectification_check import draw_rectification_check
@@ -1126,6 +1142,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(
             "  the calibration no longer rectifies this rig: recalibrate, or correct the right "
             "camera's pitch and roll with --fix OUT"
+            + (
+                ""
+                if twice is None
+                else f"; but {twice}, the raw rig's calibration rectifies them again: give the "
+                "raw images"
+            )
             if calib is not None
             else "  these images are not rectified: give the rig's calibration (--calib), or "
             "rectify them from their own features (stereovision rectify LEFT RIGHT -o DIR)"
@@ -1182,6 +1204,12 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(json.dumps(said))
         print("stereovision: the corrected calibration still fails: not written", file=sys.stderr)
         return 1
+    if twice is not None:
+        warnings.warn(
+            f"{twice}, the corrected calibration fits them, not the rig's raw images: give the "
+            "raw images",
+            stacklevel=1,
+        )
     from stereovision.io import keep_previous, replaced_words
 
     # the same correction again (a rerun) replaces nothing: no copy is kept
