@@ -18,6 +18,7 @@ import sys
 import tempfile
 import threading
 import time
+import warnings
 from collections import deque
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -1517,10 +1518,15 @@ def test_batch_a_folder_where_an_output_file_goes_fails_that_pair_alone(
     assert pairs["a"]["status"] == "failed" and pairs["b"]["status"] == "done"
 
 
-def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path) -> None:
+def test_batch_reads_16_bit_files_as_depth_does(
+    data_dir: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
     """A 12-bit camera's pair in 16-bit PNGs: batch's disparity is the one `stereovision depth`
     writes for it (batch decoded the top 8 bits of each pixel, 0-15 of 0-4095, while depth
-    keeps the 16 bits since it reads with io.read_image)."""
+    keeps the 16 bits since it reads with io.read_image). Depth's warning of the 12-bit data is
+    the pair's, one line naming it and in the summary: the worker printed it as Python does
+    ('.../dask/_task_spec.py:768: UserWarning: left: uint16 image ...', its advice in Python's
+    words, no pair named) and a remote worker into its own log."""
     src = data_dir / "middlebury2001/tsukuba"
     scene = tmp_path / "in/a"
     scene.mkdir(parents=True)
@@ -1536,11 +1542,33 @@ def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path) 
         str(tmp_path / "depth"),
     ]
     assert main([*argv, *args]) == 0
+    depth_err = capfd.readouterr().err
     assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--workers", "1",
                  *args]) == 0  # fmt: skip
     want = read_pfm(tmp_path / "depth/disparity.pfm")
     got = read_pfm(tmp_path / "out/a/disparity.pfm")
     np.testing.assert_array_equal(got, want)
+    err = capfd.readouterr().err
+    said = _summary(tmp_path / "out")["pairs"]["a"]["warnings"]
+    # depth's own warnings, in the CLI's words (12-bit data shifted left, not img << 4)
+    assert [f"stereovision: warning: {w}" for w in said] == depth_err.splitlines()[:2]
+    assert [w.split(" is ")[0] for w in said] == [
+        "left: uint16 image whose largest value",
+        "right: uint16 image whose largest value",
+    ]
+    warned = [x for x in err.splitlines() if "warning" in x.lower()]
+    assert warned == [f"a: warning: {w}" for w in said]
+    assert "UserWarning" not in err and "_task_spec" not in err
+    # the worker's function gives them back, none left to its process
+    from stereovision.batch import _task, process_pair
+
+    (job,) = find_pairs(tmp_path / "in")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = process_pair(_task(job, {"method": None, "max_disparity": 16, "fill": None}))
+    # the API's words there: run_batch's summary says them in its callers' (words=)
+    assert [w.split(" (")[0] for w in out["warnings"]] == [w.split(" (")[0] for w in said]
+    assert "img << 4" in out["warnings"][0]
 
 
 def _crops(root: Path, data_dir: Path, left: list[str], right: list[str]) -> None:

@@ -39,6 +39,7 @@ import tempfile
 import threading
 import time
 import uuid
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -738,7 +739,8 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
     -------
     dict
         ``files`` ({output file name: bytes}), ``max_disparity``, ``density``, ``points``,
-        ``seconds`` (compute time), ``worker`` (host:pid).
+        ``seconds`` (compute time), ``worker`` (host:pid), ``warnings`` (the messages of the
+        warnings the pair gave, each once, in order; not printed by the worker).
 
     Raises
     ------
@@ -747,13 +749,29 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
         size, ... (as ``stereovision depth`` reports them); ``ground`` without ``calib``.
     """
     from stereovision._validate import ADVICE
-    from stereovision.calibration import Calibration
-    from stereovision.cli import depth_outputs
 
     if task.get("ground") and task.get("calib") is None:
         # before depth_outputs, whose refusal is the CLI's ("CliError: --ground needs
         # --calib"); a CLI run's summary swaps these words back (_error_line)
         raise ValueError(f"{ADVICE['ground_calib']['api']} (the floor is found in metres)")
+    # The pair's warnings go back with its files: a worker printed them on its own stderr as
+    # Python does (".../dask/_task_spec.py:768: UserWarning: left: uint16 image ..." and a
+    # source line, naming no pair, across the progress bar), or into a remote worker's log.
+    # Shown as the CLI shows them: each text once, no ResourceWarning.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        warnings.simplefilter("ignore", ResourceWarning)
+        res = _compute_pair(task)
+    said = [str(w.message) for w in caught]
+    res["warnings"] = [m for i, m in enumerate(said) if m not in said[:i]]
+    return res
+
+
+def _compute_pair(task: dict[str, Any]) -> dict[str, Any]:
+    """:func:`process_pair`'s work, its warnings not yet caught."""
+    from stereovision.calibration import Calibration
+    from stereovision.cli import depth_outputs
+
     t0 = time.perf_counter()
     left = _decode(task["left"][0], task["left"][1])
     right = _decode(task["right"][0], task["right"][1])
@@ -1060,6 +1078,17 @@ def _remove_partials(out: Path, names: list[str]) -> None:
             m = _PARTIAL_RE.fullmatch(e.name)
             if m and m.group(1) in pairs and e.is_dir(follow_symlinks=False):
                 shutil.rmtree(e.path, ignore_errors=True)
+
+
+def _warning_line(text: str, words: str = "api", job: PairJob | None = None) -> str:
+    """A pair's warning (its message, from the worker) as a summary line: its first line with
+    text, the files of ``job`` escaped and its advice in ``words``, as :func:`_error_line` says
+    an error (and the CLI a warning)."""
+    from stereovision._validate import advice_for, first_line
+
+    paths = () if job is None else (job.left, job.right, job.calib, job.name)
+    line = first_line(UserWarning(text), paths)
+    return line if words == "api" else advice_for(line, words)
 
 
 def _error_line(exc: BaseException, words: str = "api", job: PairJob | None = None) -> str:
@@ -1549,8 +1578,9 @@ def run_batch(
         Also redo the pairs that failed before on the same inputs (by default a failed pair is
         redone only once its files or the options change).
     log : callable, optional
-        Receives one line per failed pair, and notes: pairs done before with other options
-        (redone), an output folder that went away during the run.
+        Receives one line per failed pair, one per warning a pair gave (``NAME: warning:
+        ...``, as ``stereovision depth`` warns: 12-bit data in 16-bit files), and notes: pairs
+        done before with other options (redone), an output folder that went away during the run.
     progress : bool
         Show a progress bar on a terminal (stderr), else a plain line on stderr every tenth of
         the pairs or every :data:`PROGRESS_SECONDS`; before it, when the check of the pairs'
@@ -2115,6 +2145,8 @@ def _run_jobs(
     """Run ``todo`` on Dask, recording each pair as it finishes into ``processed`` / ``failed``
     and the summary (errors in ``words``, :func:`_error_line`); a KeyboardInterrupt is raised
     on after Dask is stopped."""
+    from stereovision._validate import escaped
+
     bar = _Progress(len(todo), progress)
     futures: dict[Any, PairJob] = {}
     dask = _Dask()
@@ -2158,8 +2190,6 @@ def _run_jobs(
             return True
 
         def record_failure(job: PairJob, exc: BaseException) -> None:
-            from stereovision._validate import escaped
-
             entry = summary.pairs[job.name]
             entry.update(
                 status="failed",
@@ -2222,10 +2252,18 @@ def _run_jobs(
                     this_run="processed",
                 )
                 entry.pop("error", None)
+                # what `stereovision depth` warns of for these images (12-bit data in 16 bits),
+                # said with the pair's name, not by the worker that ran it
+                said = [_warning_line(text, words, job) for text in res.get("warnings") or []]
+                if said:
+                    entry["warnings"] = said
                 processed.append(job.name)
                 run["processed"] = len(processed)
                 summary.record()
                 bar.update()
+                if log is not None:
+                    for line in said:
+                        log(f"{escaped(job.name)}: warning: {line}")
             fut.release()
             while len(futures) < limit and submit_next():
                 pass
