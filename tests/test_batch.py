@@ -943,7 +943,8 @@ def test_batch_reports_an_image_without_its_pair(
     assert capsys.readouterr().err.strip() == (
         f"stereovision: error: no pair under {root / 'c'} (scene folders with left.png + "
         "right.png, files named ...left... / ...right..., or the same file names in sibling "
-        "camera folders left/ + right/, L/ + R/, image_2/ + image_3/, cam0/ + cam1/); 2 "
+        "camera folders left/ + right/, L/ + R/, image_2/ + image_3/, image_02/ + image_03/, "
+        "cam0/ + cam1/); 2 "
         f"image(s) without the other of their pair, e.g. no x_right.png beside "
         f"{root / 'c/x_left.png'}"
     )
@@ -1660,6 +1661,25 @@ def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
         assert s["pairs"][name]["error"] == error and f"failed {name}: {error}" in said.err
         assert s["pairs"][name]["left"] == str(root / f"s/left/{n}.png")
     assert {p.name for p in (out / "k/image_2/7").iterdir()} == DISPARITY_FILES
+
+
+def test_a_kitti_raw_drive_is_two_rigs_of_camera_folders(tmp_path: Path) -> None:
+    """A KITTI raw drive (image_00/ ... image_03/, each with data/ and timestamps.txt, its
+    calib_cam_to_cam.txt read by --calib) was 'no pair under ...': its camera folders are
+    image_02/ + image_03/ (colour) and image_00/ + image_01/ (grey), not the odometry's image_2/
+    + image_3/. Each rig's pairs keep its left camera's folder, as in an odometry sequence."""
+    drive = tmp_path / "2011_09_26" / "2011_09_26_drive_0001_sync"
+    frames = ("0000000000", "0000000001")
+    _blank(drive, *(f"image_0{c}/data/{f}.png" for c in range(4) for f in frames))
+    for c in range(4):
+        (drive / f"image_0{c}/timestamps.txt").write_text("2011-09-26 13:02:25.964389445\n")
+    jobs = find_pairs(tmp_path / "2011_09_26")
+    rel = "2011_09_26_drive_0001_sync"
+    assert [(j.name, j.left, j.right) for j in jobs] == [
+        (f"{rel}/{left}/data/{f}", drive / f"{left}/data/{f}.png", drive / f"{right}/data/{f}.png")
+        for left, right in (("image_00", "image_01"), ("image_02", "image_03"))
+        for f in frames
+    ]
 
 
 def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(

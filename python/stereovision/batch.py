@@ -93,13 +93,18 @@ _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIBS = ("calib.txt", "Q.dat")
 #: Sibling folders holding a rig's two cameras, left one first (matched without case): images
 #: of the same path under both are a pair (``left/0001.png`` + ``right/0001.png``; KITTI's
-#: ``image_2``/``image_3`` colour and ``image_0``/``image_1`` grey; EuRoC's ``cam0/data`` +
-#: ``cam1/data``).
+#: ``image_2``/``image_3`` colour and ``image_0``/``image_1`` grey, its raw drives'
+#: ``image_02/data``/``image_03/data`` and ``image_00/data``/``image_01/data``; EuRoC's
+#: ``cam0/data`` + ``cam1/data``).
 CAMERA_FOLDERS = (
     ("left", "right"),
     ("l", "r"),
     ("image_2", "image_3"),
     ("image_0", "image_1"),
+    # KITTI's raw drives (2011_09_26_drive_0001_sync/image_02/data/0000000000.png), whose
+    # calib_cam_to_cam.txt --calib reads: a drive was "no pair under ..."
+    ("image_02", "image_03"),
+    ("image_00", "image_01"),
     ("cam0", "cam1"),
 )
 _GONE = "its outputs were gone at the end of the run (the output folder moved or deleted?)"
@@ -218,7 +223,8 @@ def find_pairs(
       separators around it), e.g. ``seq/0001``. Files without a counterpart are not pairs
       (:func:`run_batch` reports them as failed pairs).
     * Two sibling camera folders (:data:`CAMERA_FOLDERS`: ``left/`` + ``right/``, ``L/`` +
-      ``R/``, KITTI's ``image_2/`` + ``image_3/`` and ``image_0/`` + ``image_1/``, EuRoC's
+      ``R/``, KITTI's ``image_2/`` + ``image_3/`` and ``image_0/`` + ``image_1/`` (a raw
+      drive's ``image_02/`` + ``image_03/`` and ``image_00/`` + ``image_01/``), EuRoC's
       ``cam0/`` + ``cam1/``): the images of the same path under both (any depth) are a pair,
       named by the parent folder and that path without the extension (``seq/0001`` for
       ``seq/left/0001.png``, ``mav0/data/1403...`` for ``mav0/cam0/data/1403....png``); when
@@ -1708,7 +1714,8 @@ def run_batch(
         raise ValueError(
             f"no pair under {input_dir} (scene folders with left.png + right.png, "
             "files named ...left... / ...right..., or the same file names in sibling camera "
-            f"folders left/ + right/, L/ + R/, image_2/ + image_3/, cam0/ + cam1/){alone}"
+            "folders left/ + right/, L/ + R/, image_2/ + image_3/, image_02/ + image_03/, "
+            f"cam0/ + cam1/){alone}"
         )
     out = Path(output_dir)
     from stereovision.io import missing_folders
@@ -2455,7 +2462,8 @@ def add_cli(subparsers: Any) -> None:
         "depth` writes): scene folders (left.png + right.png, with calib.txt or Q.dat), image "
         "files named ...left.../...right... (seq/0001_left.png + seq/0001_right.png -> seq/0001), "
         "and images of the same name in sibling camera folders: left/ + right/, L/ + R/, KITTI's "
-        "image_2/ + image_3/ (image_0/ + image_1/), EuRoC's cam0/ + cam1/ (seq/left/0001.png + "
+        "image_2/ + image_3/ (image_0/ + image_1/; a raw drive's image_02/ + image_03/, "
+        "image_00/ + image_01/), EuRoC's cam0/ + cam1/ (seq/left/0001.png + "
         "seq/right/0001.png -> seq/0001; mav0/cam0/data/1.png -> mav0/data/1). An image "
         "without the other of its pair is a failed pair. Pairs are recorded in OUT/summary.json; a "
         "re-run skips finished pairs. Exit status 1 when a pair failed (its error is in the "
