@@ -2024,6 +2024,46 @@ def test_the_camera_info_of_uncalibrated_cameras_is_no_calibration(
     assert "say a camera is uncalibrated (K = 0): disparity only" in err
 
 
+def test_a_bag_with_one_cameras_camera_info_says_which_is_missing(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A bag recorded with the left camera's camera_info but not the right's: ``info`` said
+    "no camera_info beside the image topics" under its own listing of the left one ("<- left
+    camera_info"), and ``stream`` gave disparity only without a word. Both name the topic
+    without one now."""
+    from rosbags.rosbag1 import Reader, Writer
+
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    small = (cones.left[:60, :90], cones.right[:60, :90])  # quick
+    src = write_bag(tmp_path / "src.bag", [(T0, *small[:1], T0, *small[1:])], flavour="ros1",
+                    infos=cams)  # fmt: skip
+    bag = tmp_path / "rig.bag"
+    with Reader(src) as r, Writer(bag) as w:
+        conns: dict[str, Any] = {}
+        for conn, stamp, data in r.messages():
+            if conn.topic == "/stereo/right/camera_info":
+                continue
+            if conn.topic not in conns:
+                conns[conn.topic] = w.add_connection(
+                    conn.topic, conn.msgtype, msgdef=conn.msgdef.data, md5sum=conn.digest
+                )
+            w.write(conns[conn.topic], stamp, data)
+    code, out, err = run("info", str(bag))
+    assert code == 0, err
+    assert out.splitlines()[-1] == (
+        f"no camera_info beside {RIGHT} (the bag's /stereo/left/camera_info is the other "
+        "camera's alone): give the rig's calibration to the command that reads the bag "
+        "(stream --from-bag BAG --calib RIG)"
+    )
+    code, out, err = run("stream", "--from-bag", str(bag), "--no-display", "--method", "fast",
+                         "--max-disparity", "16", "--no-check")  # fmt: skip
+    assert code == 0, err
+    assert (
+        "calibration: none; the bag holds /stereo/left/camera_info but no camera_info beside "
+        f"{RIGHT}: disparity only (--calib RIG for depth)"
+    ) in err.splitlines()
+
+
 def test_rectified_topics_whose_camera_info_fills_p_only_keep_their_calibration(
     cones: Any, tmp_path: Path
 ) -> None:

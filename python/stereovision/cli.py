@@ -1543,6 +1543,16 @@ def cmd_info(args: argparse.Namespace) -> int:
             "its camera_info say a camera is uncalibrated (K = 0): give the rig's "
             "calibration to the command that reads the bag (stream --from-bag BAG --calib RIG)"
         )
+    elif calib is None and any(cam.info_topics.values()):
+        # one camera's camera_info recorded, not the other's: "no camera_info beside the image
+        # topics" under a listing that marks the one there ("<- left camera_info")
+        side = "left" if cam.info_topics["left"] is None else "right"
+        other = cam.info_topics["right" if side == "left" else "left"]
+        print(
+            f"no camera_info beside {cam.topics[side]} (the bag's {other} is the other "
+            "camera's alone): give the rig's calibration to the command that reads the bag "
+            "(stream --from-bag BAG --calib RIG)"
+        )
     elif calib is None:
         print(
             "no camera_info beside the image topics: give the rig's calibration to the command "

@@ -1625,6 +1625,15 @@ def cmd_stream(args: argparse.Namespace) -> int:
                     "a camera is uncalibrated (K = 0): disparity only (--calib RIG for depth)",
                     file=log,
                 )
+            elif any(cam.info_topics.values()):
+                # one camera's camera_info recorded, not the other's: disparity only, unsaid
+                side = "left" if cam.info_topics["left"] is None else "right"
+                other = cam.info_topics["right" if side == "left" else "left"]
+                print(
+                    f"calibration: none; the bag holds {other} but no camera_info beside "
+                    f"{cam.topics[side]}: disparity only (--calib RIG for depth)",
+                    file=log,
+                )
     bag = None
     report: StreamReport | None = None  # None after the try: an error or interrupt is raised
     close_error: str | None = None  # the bag could not be finished (a full disk)
