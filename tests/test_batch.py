@@ -3587,3 +3587,43 @@ def test_a_calib_link_to_nothing_names_its_target_as_depth_does(
     )
     assert capsys.readouterr().err == f"stereovision: error: {said}\n"
     assert not (tmp_path / "out").exists()
+
+
+def test_a_pair_whose_workers_die_says_the_workers_memory_share(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A pair whose worker processes all died (Dask's KilledWorker: a LocalCluster's nanny stops
+    a worker past 95 % of its memory limit, the machine's memory over the workers, one per core:
+    2 GB each on 8 cores and 16 GB, where a 1920x1080 pair peaks at 2.2 GB) was recorded in
+    Dask's words: 'Attempted to run task 'stereovision-5bf7...' on 4 different workers, but all
+    those workers died ... Inspecting worker logs is often a good next step', logs batch
+    silences. It says the workers' share and the remedy, in the caller's words. An in-process
+    client (no cluster processes) whose pair raises what Dask raises then."""
+    from types import SimpleNamespace
+
+    from distributed import Client, KilledWorker
+
+    from stereovision import batch
+
+    def start(self: Any, scheduler: str | None, workers: int) -> None:
+        self.client = Client(processes=False, n_workers=2, threads_per_worker=1,
+                             dashboard_address=None, memory_limit="400MiB")  # fmt: skip
+        self.desc = "in-process"
+
+    def killed(task: dict[str, Any]) -> dict[str, Any]:
+        raise KilledWorker("stereovision-x", SimpleNamespace(address="tcp://127.0.0.1:1"), 3)
+
+    monkeypatch.setattr(batch._Dask, "start", start)
+    monkeypatch.setattr(batch, "process_pair", killed)
+    _noise_pair(tmp_path / "in" / "s")
+    lines: list[str] = []
+    res = batch.run_batch(tmp_path / "in", tmp_path / "out", progress=False, log=lines.append,
+                          words="cli")  # fmt: skip
+    assert res.failed == ["s"]
+    error = (
+        "KilledWorker: the worker processes computing it died on every try: out of memory? "
+        "Each of the 2 workers is stopped past 95 % of its share of the memory, 0.39 GiB; "
+        "fewer --workers give each more"
+    )
+    assert _summary(tmp_path / "out")["pairs"]["s"]["error"] == error
+    assert lines == [f"failed s: {error}"]

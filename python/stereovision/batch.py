@@ -1086,6 +1086,32 @@ def _remove_partials(out: Path, names: list[str]) -> None:
                 shutil.rmtree(e.path, ignore_errors=True)
 
 
+def _killed(memory: int, workers: int, scheduler: str | None, words: str = "api") -> str:
+    """What a pair's ``KilledWorker`` says: the worker processes computing it died on every try.
+
+    Dask said "Attempted to run task 'stereovision-5bf7...' on 4 different workers, but all
+    those workers died while running it ... Inspecting worker logs is often a good next step",
+    logs a LocalCluster's silences: a pair needing more than a worker's memory limit (the
+    machine's memory over the workers, one per core: 2 GB each on 8 cores and 16 GB, where a
+    1920x1080 pair peaks at 2.2 GB) failed so, its remedy unsaid."""
+    if scheduler is None and memory > 0 and workers > 1:
+        option = "--workers" if words == "cli" else "workers"
+        return (
+            "the worker processes computing it died on every try: out of memory? Each of the "
+            f"{workers} workers is stopped past 95 % of its share of the memory, "
+            f"{memory / 2**30:.2f} GiB; fewer {option} give each more"
+        )
+    if scheduler is None and memory > 0:
+        return (
+            "the worker process computing it died on every try: out of memory? It is stopped "
+            f"past 95 % of the memory, {memory / 2**30:.2f} GiB"
+        )
+    return (
+        "the worker processes computing it died on every try (out of memory, or a crash: see "
+        "the workers' logs)"
+    )
+
+
 def _warning_line(text: str, words: str = "api", job: PairJob | None = None) -> str:
     """A pair's warning (its message, from the worker) as a summary line: its first line with
     text, the files of ``job`` escaped and its advice in ``words``, as :func:`_error_line` says
@@ -2164,7 +2190,11 @@ def _run_jobs(
 
         client = dask.client
         run["scheduler"] = dask.desc
-        n_live = len(client.scheduler_info().get("workers", {})) or n_workers
+        live = client.scheduler_info().get("workers", {})
+        n_live = len(live) or n_workers
+        # each worker's memory limit, past 95 % of which its nanny kills it (a LocalCluster's:
+        # the machine's memory over its workers)
+        memory = min((int(w.get("memory_limit") or 0) for w in live.values()), default=0)
         limit = max(1, IN_FLIGHT_PER_WORKER * n_live)
         queue: Iterator[PairJob] = iter(todo)
         ac = as_completed()
@@ -2196,11 +2226,11 @@ def _run_jobs(
             ac.add(fut)
             return True
 
-        def record_failure(job: PairJob, exc: BaseException) -> None:
+        def record_failure(job: PairJob, exc: BaseException, line: str | None = None) -> None:
             entry = summary.pairs[job.name]
             entry.update(
                 status="failed",
-                error=_error_line(exc, words, job),
+                error=line or _error_line(exc, words, job),
                 finished=_now(),
                 this_run="failed",
             )
@@ -2216,7 +2246,12 @@ def _run_jobs(
         for fut in ac:
             job = futures.pop(fut)
             exc = fut.exception()
-            if exc is not None:
+            if exc is not None and type(exc).__name__ == "KilledWorker":
+                # Dask's words sent to "worker logs" a LocalCluster silences, naming a task key
+                record_failure(
+                    job, exc, f"KilledWorker: {_killed(memory, n_live, scheduler, words)}"
+                )
+            elif exc is not None:
                 record_failure(job, exc)
             else:
                 res = fut.result()
