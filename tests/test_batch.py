@@ -2390,6 +2390,29 @@ def test_a_run_killed_while_writing_a_pair_leaves_no_temporary_folder_for_good(
     assert sorted(p.name for p in (out / "s").iterdir()) == ["b"]
 
 
+def test_a_pair_folder_name_near_the_longest_is_written_and_its_leftovers_removed(
+    tmp_path: Path,
+) -> None:
+    """A pair named with 238 to 255 bytes (its folder can be made) was staged in
+    '.NAME.partial-1a2b3c4d', past a file name's 255 bytes: 'File name too long', and the
+    run stopped there ('cannot write the outputs of ...; 0 of N pairs finished'), every run.
+    Its staging folder takes as much of the name as fits, and a killed run's is removed."""
+    from stereovision.batch import _commit_pair, _remove_partials
+
+    out = tmp_path / "out"
+    out.mkdir()
+    name = "\u00e9" * 120  # 240 bytes in UTF-8
+    dest = _commit_pair(out, name, {"disparity.pfm": b"1"})
+    assert (dest / "disparity.pfm").read_bytes() == b"1"
+    _commit_pair(out, name, {"disparity.pfm": b"2"})  # into the folder there
+    assert os.listdir(out) == [name] and (dest / "disparity.pfm").read_bytes() == b"2"
+    # a killed run's staging folder: the name's first 237 bytes, a character cut in two
+    left = os.path.join(os.fsencode(out), b"." + os.fsencode(name)[:237] + b".partial-1a2b3c4d")
+    os.mkdir(left)
+    _remove_partials(out, [name])
+    assert os.listdir(out) == [name]
+
+
 def test_an_image_that_cannot_be_read_fails_its_pair_alone(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

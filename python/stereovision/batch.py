@@ -1032,7 +1032,7 @@ def _commit_pair(
                 "pair's earlier outputs are kept)"
             )
     dest.parent.mkdir(parents=True, exist_ok=True)
-    partial = f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
+    partial = f".{_partial_stem(dest.name)}.partial-{uuid.uuid4().hex[:8]}"
     tmp = dest.parent / partial
     if dest.is_dir() and os.stat(dest).st_dev != os.stat(dest.parent).st_dev:
         # OUT/a a link to (or a mount of) a folder on another disk: no file is renamed across
@@ -1061,6 +1061,21 @@ def _commit_pair(
 
 
 _PARTIAL_RE = re.compile(r"\.(.+)\.partial-[0-9a-f]{8}")
+#: Bytes of a file name (NAME_MAX of the usual filesystems) and those its staging folder's
+#: name adds to the pair's: ``.`` and ``.partial-1a2b3c4d``.
+_NAME_MAX = 255
+_PARTIAL_EXTRA = 18
+
+
+def _partial_stem(name: str) -> str:
+    """The part of a pair's folder name ``name`` its staging folder's name holds: all of it,
+    or as much as fits in a file name. A name of 238 to 255 bytes (its folder can be made) gave
+    a staging folder's name past 255, "File name too long", and every run stopped there."""
+    raw = os.fsencode(name)
+    if len(raw) + _PARTIAL_EXTRA <= _NAME_MAX:
+        return name
+    # a character cut in two stays its bytes (surrogate escapes), as the listing reads them
+    return os.fsdecode(raw[: _NAME_MAX - _PARTIAL_EXTRA])
 
 
 def _remove_partials(out: Path, names: list[str]) -> None:
@@ -1072,9 +1087,9 @@ def _remove_partials(out: Path, names: list[str]) -> None:
     by_parent: dict[Path, set[str]] = {}
     for name in names:
         dest = out / name
-        by_parent.setdefault(dest.parent, set()).add(dest.name)
+        by_parent.setdefault(dest.parent, set()).add(_partial_stem(dest.name))
         # and inside it, where a folder on another disk has them (_commit_pair)
-        by_parent.setdefault(dest, set()).add(dest.name)
+        by_parent.setdefault(dest, set()).add(_partial_stem(dest.name))
     for parent, pairs in by_parent.items():
         try:
             entries = list(os.scandir(parent))
