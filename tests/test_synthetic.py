@@ -101,6 +101,27 @@ def test_a_bad_texture_or_camera_is_named(kw: dict, message: str) -> None:
         render_plane(units_per_pixel=0.01, image_size=(20, 12), **args)
 
 
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"K": np.eye(3, dtype=bool)}, r"^K: expected a 3 x 3 camera matrix \(finite\), got "),
+        ({"D": np.zeros(5, dtype=bool)}, r"^D: expected 4, 5, 8, 12 or 14 coefficients"),
+        ({"rvec": [False] * 3}, r"^rvec: expected 3 numbers \(finite\), got shape"),
+    ],
+)
+def test_a_bool_camera_is_refused_as_triangulate_refuses_it(kw: dict, message: str) -> None:
+    """An identity mask as K was drawn as a camera of focal length 1 px (a mask of five as D
+    was no distortion), without a word; triangulate refuses bools. render_chessboard shares
+    the check."""
+    from stereovision.calibrate import render_chessboard
+
+    args = {"K": K, "D": D, "rvec": np.zeros(3), "tvec": [0, 0, 1.0], **kw}
+    with pytest.raises(ValueError, match=message + r".* dtype bool$"):
+        render_plane(TEX, 0.01, image_size=(20, 12), **args)
+    with pytest.raises(ValueError, match=message + r".* dtype bool$"):
+        render_chessboard(image_size=(20, 12), **args)
+
+
 @pytest.mark.parametrize("model", ["pinhole", "fisheye"])
 @pytest.mark.parametrize(
     ("k", "said"),

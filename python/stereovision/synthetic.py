@@ -127,6 +127,13 @@ def _camera_pose(
     """``K``, ``D``, ``rvec`` and ``tvec`` of a rendered view as float64 (``D``, ``rvec`` and
     ``tvec`` flat), refused in :func:`render_plane`'s words (also ``render_chessboard``'s:
     ``model`` None names no model in the message)."""
+    # bools refused, as triangulate refuses them: an identity mask was a camera of focal
+    # length 1 px, a mask of five a D of zeros, each drawn without a word
+    bools = {
+        name: np.asarray(v).dtype.kind == "b"
+        for name, v in (("K", K), ("D", D), ("rvec", rvec), ("tvec", tvec))
+        if v is not None
+    }
     Kf = np.asarray(K, np.float64)
     # None is no distortion, as the message below and OpenCV's distCoeffs have it: it was
     # asarray's NaN, "... (or none) for model 'pinhole' (finite), got shape (1,)"
@@ -141,7 +148,7 @@ def _camera_pose(
         ("rvec", rv, rv.shape == (3,)),
         ("tvec", t, t.shape == (3,)),
     ):
-        if not (ok and np.isfinite(arr).all()):
+        if not (ok and np.isfinite(arr).all()) or bools.get(name):
             want = {"K": "a 3 x 3 camera matrix", "rvec": "3 numbers", "tvec": "3 numbers"}.get(
                 name,
                 "4 coefficients for model 'fisheye'"
@@ -150,6 +157,7 @@ def _camera_pose(
                 + (f" for model {model!r}" if model else ""),
             )
             got = "None" if name == "D" and D is None else f"shape {arr.shape}"
+            got += " dtype bool" if bools.get(name) else ""
             raise ValueError(f"{name}: expected {want} (finite), got {got}")
     # a zero focal length (the K = 0 of an uncalibrated camera's camera_info) gave every ray
     # NaN and a picture of background only, with NumPy's "invalid value" warnings; a negative
