@@ -11,6 +11,7 @@ import subprocess
 import sys
 import warnings
 from dataclasses import replace
+from fractions import Fraction
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -1808,6 +1809,18 @@ def test_cell_of_a_point_that_is_no_finite_number_is_refused_naming_it() -> None
             grid.cell_of(x, y)  # type: ignore[arg-type]
         assert str(exc.value) == says
     assert grid.cell_of(np.float32(0.05), 0) == (2, 0)
+
+
+def test_cell_of_a_point_too_far_for_a_float_quotient_is_far_outside_the_grid() -> None:
+    """cell_of(1e308, 0) was math.floor's "OverflowError: cannot convert float infinity to
+    integer" (1e308 / 0.1 overflows); it is the exact cell, outside the grid, as for 1e300."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.zeros((4, 4), np.int8), 0.1, (0.0, -0.2))
+    row, col = grid.cell_of(1e308, 0.0)
+    assert row == 2 and col == math.floor(Fraction(1e308) / Fraction(0.1))
+    assert grid.cell_of(0.0, -1e308)[0] < -(10**307)
+    assert grid.cell_of(1e300, 0.0)[1] == math.floor(1e300 / 0.1)
 
 
 def test_a_cell_with_floor_and_obstacle_points_is_occupied() -> None:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import reprlib
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -970,10 +971,18 @@ class OccupancyGrid:
                 raise ValueError(
                     f"{name}: expected a finite number of metres, got {reprlib.repr(v)}"
                 )
-        return (
-            math.floor((y - self.origin[1]) / self.resolution),
-            math.floor((x - self.origin[0]) / self.resolution),
-        )
+        return self._index(y, self.origin[1]), self._index(x, self.origin[0])
+
+    def _index(self, v: float, origin: float) -> int:
+        """Row or column of coordinate ``v``: a finite point so far out that its quotient
+        overflows (``cell_of(1e308, 0)``) was math.floor's OverflowError; it is the exact index,
+        far outside the grid, as for any point far outside it."""
+        with np.errstate(over="ignore"):  # an np.float32 coordinate's quotient is float32
+            q = (v - origin) / self.resolution
+        if math.isfinite(q):
+            return math.floor(q)
+        exact = (Fraction(float(v)) - Fraction(float(origin))) / Fraction(float(self.resolution))
+        return math.floor(exact)
 
     def image(self) -> npt.NDArray[np.uint8]:
         """map_server's picture: occupied 0 (black), free 254, unknown 205. As map_server reads
