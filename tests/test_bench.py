@@ -674,6 +674,13 @@ def test_bench_scene_of_a_folder_says_to_load_it(folder: object) -> None:
     )
 
 
+def test_bench_scene_of_none_is_a_type_error_naming_scene() -> None:
+    """bench_scene(None) was "AttributeError: 'NoneType' object has no attribute 'left'"."""
+    with pytest.raises(TypeError) as info:
+        bench_scene(None, runs=5)  # type: ignore[arg-type]
+    assert str(info.value) == "scene: expected a scene (stereovision.io.load_scene(path)), got None"
+
+
 def test_bench_of_several_scenes_goes_on_past_a_damaged_one(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1903,6 +1903,16 @@ def test_scene_too_narrow_of_a_folder_says_to_load_it(folder: object) -> None:
     )
 
 
+def test_scene_too_narrow_of_none_is_a_type_error_naming_scene() -> None:
+    """scene_too_narrow(None) was "AttributeError: 'NoneType' object has no attribute
+    'max_disparity'", naming no argument."""
+    from stereovision.io import scene_too_narrow
+
+    with pytest.raises(TypeError) as info:
+        scene_too_narrow(None)  # type: ignore[arg-type]
+    assert str(info.value) == "scene: expected a scene (stereovision.io.load_scene(path)), got None"
+
+
 def test_load_scene_keeps_gt_zero_and_large_values_as_disparities(tmp_path: Path) -> None:
     """evaluation.md: only inf or NaN is unknown. A GT of 0 (a point at infinity, TartanAir's
     sky) is a known disparity, not KITTI's raw 'no LiDAR' 0 (its SOURCE conversion made those

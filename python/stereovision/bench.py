@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import statistics
 import sys
 import time
@@ -223,21 +222,18 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
         If ``runs`` is not an integer or is < :data:`MIN_RUNS` (the median of fewer runs is not
         a figure to report).
     TypeError
-        If ``scene`` is a path (a scene folder: :func:`stereovision.io.load_scene` reads it).
+        If ``scene`` is a path (a scene folder: :func:`stereovision.io.load_scene` reads it) or
+        no scene (None).
     """
     from stereovision import baselines
     from stereovision._validate import as_gray_float
     from stereovision.depth import METHODS, _run_matcher, depth_map
+    from stereovision.io import _refuse_no_scene
     from stereovision.match import METHODS as SPARSE_METHODS
     from stereovision.match import match
 
     _check_runs(runs, "runs")
-    if isinstance(scene, (str, bytes, os.PathLike)):
-        # a scene folder was "AttributeError: 'str' object has no attribute 'left'"
-        raise TypeError(
-            f"scene: got the path {os.fsdecode(scene)!r}, not a scene: load it first "
-            "(stereovision.io.load_scene(path))"
-        )
+    _refuse_no_scene(scene)  # a folder or None was an AttributeError naming no argument
     left, right, gt, md = scene.left, scene.right, scene.gt, int(scene.max_disparity)
     calib = scene.calib if scene.calib is not None and scene.calib.rectified else None
     gl, gr = as_gray_float(left, "left"), as_gray_float(right, "right")

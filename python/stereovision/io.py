@@ -1845,6 +1845,25 @@ class Scene:
         )
 
 
+def _refuse_no_scene(scene: object) -> None:
+    """Refuse what is not a scene (a :class:`Scene` or an object with its attributes) with a
+    TypeError naming ``scene``, in :func:`scene_too_narrow`'s and ``bench_scene``'s words.
+
+    A scene folder was "AttributeError: 'str' object has no attribute 'max_disparity'" (as
+    bench_scene said it, d6b69581), None "'NoneType' object has no attribute 'left'"."""
+    from stereovision._validate import _shown
+
+    if isinstance(scene, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"scene: got the path {os.fsdecode(scene)!r}, not a scene: load it first "
+            "(stereovision.io.load_scene(path))"
+        )
+    if not all(hasattr(scene, a) for a in ("left", "right", "gt", "calib", "max_disparity")):
+        raise TypeError(
+            f"scene: expected a scene (stereovision.io.load_scene(path)), got {_shown(scene)}"
+        )
+
+
 def scene_too_narrow(scene: Scene) -> str | None:
     """Why a scene cannot be matched over its own range, or None: images not wider than its
     ``max_disparity`` (:func:`scene_max_disparity`, 16 px at least). ``eval`` and ``bench`` say
@@ -1865,17 +1884,12 @@ def scene_too_narrow(scene: Scene) -> str | None:
     Raises
     ------
     TypeError
-        If ``scene`` is a path (a scene folder: :func:`load_scene` reads it).
+        If ``scene`` is a path (a scene folder: :func:`load_scene` reads it) or no scene
+        (None).
     """
     from stereovision._validate import figure_shown
 
-    if isinstance(scene, (str, bytes, os.PathLike)):
-        # a scene folder was "AttributeError: 'str' object has no attribute 'max_disparity'"
-        # (as bench_scene says it, d6b69581)
-        raise TypeError(
-            f"scene: got the path {os.fsdecode(scene)!r}, not a scene: load it first "
-            "(stereovision.io.load_scene(path))"
-        )
+    _refuse_no_scene(scene)
     md, width = scene.max_disparity, scene.left.shape[1]
     if md < width:
         return None
