@@ -978,6 +978,21 @@ def test_mesh_ply_refuses_quads(tmp_path):
     assert not (tmp_path / "q.ply").exists()
 
 
+def test_mesh_ply_refuses_float64_vertices_beyond_float32(tmp_path):
+    """A float64 vertex of 1e39 m was written as inf by the float32 cast (NumPy's overflow
+    warning alone); refused now in write_ply's words (3581344), nothing written."""
+    from types import SimpleNamespace
+
+    pts = np.array([[0.0, 0.0, 1.0], [1e39, 0.0, 1.0], [0.0, 1.0, 1.0]])
+    mesh = SimpleNamespace(points=pts, faces=np.array([3, 0, 1, 2]), point_data={})
+    with pytest.raises(ValueError) as exc:
+        export.write_mesh_ply(tmp_path / "m.ply", mesh)
+    assert str(exc.value) == (
+        "mesh.points: 1 finite value(s) beyond float32's range (e.g. 1e+39) would be written as inf"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_unpack_rgb_refuses_values_that_are_not_4_bytes():
     with pytest.raises(ValueError, match="packed rgb: expected 4-byte values, got float64"):
         export._unpack_rgb(np.array([1.0, 2.0]))

@@ -42,6 +42,7 @@ from stereovision._validate import (
     check_index_range,
     not_a_result,
     number_shown,
+    refuse_beyond_float32,
     renamed_keyword,
     text_shown,
 )
@@ -223,7 +224,8 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     TypeError
         If ``mesh`` is not a mesh (no points, faces and point data), e.g. a DepthResult.
     ValueError
-        If the mesh has non-triangle faces, or colours outside 0-255 (0-1 for floats).
+        If the mesh has non-triangle faces, colours outside 0-255 (0-1 for floats), or finite
+        vertex coordinates beyond float32's range (they would become inf).
     """
     dest = as_path(path, file=True)
     if not all(hasattr(mesh, a) for a in ("points", "faces", "point_data")):
@@ -237,7 +239,11 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
         raise TypeError(
             f"mesh: expected a pyvista.PolyData triangle mesh, got {type(mesh).__name__}{hint}"
         )
-    pts = np.asarray(mesh.points, dtype=np.float32)
+    pts = np.asarray(mesh.points)
+    # a float64 vertex past float32's range was written as inf, NumPy's overflow warning alone
+    # (write_ply's check, 3581344)
+    refuse_beyond_float32(pts, "mesh.points", "would be written as inf")
+    pts = pts.astype(np.float32, copy=False)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     if faces.size % 4 or (faces.size and (faces.reshape(-1, 4)[:, 0] != 3).any()):
         raise ValueError("write_mesh_ply: only triangle meshes are supported")
