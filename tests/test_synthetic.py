@@ -348,3 +348,27 @@ def test_a_texture_of_no_grey_levels_is_refused() -> None:
             render_plane(mask.astype(np.complex64), *args, image_size=(20, 12))
     grey = render_plane(mask.astype(np.uint8) * 255, *args, image_size=(20, 12))
     assert grey.dtype == np.uint8 and 0.4 < (grey > 127).mean() < 0.6
+
+
+def test_the_ray_cache_is_bounded_by_bytes_least_recently_used_first(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The rays were kept for up to nine cameras whatever their size: three 1080p cameras at
+    supersample 3 held 896 MB. The cache now keeps _RAYS_MAX_BYTES (here two 20 x 10
+    cameras' rays, 3200 bytes each), the least recently used going first, the newest kept."""
+    from stereovision import synthetic
+
+    monkeypatch.setattr(synthetic, "_RAYS", {})
+    monkeypatch.setattr(synthetic, "_RAYS_MAX_BYTES", 7000, raising=False)
+    cams = [np.array([[100.0 + i, 0.0, 9.5], [0.0, 100.0, 4.5], [0.0, 0.0, 1.0]]) for i in range(4)]
+    first = pixel_rays(cams[0], D, (20, 10), 1)
+    for k in cams[1:3]:
+        pixel_rays(k, D, (20, 10), 1)
+    assert [key[0] for key in synthetic._RAYS] == [cams[1].tobytes(), cams[2].tobytes()]
+    pixel_rays(cams[1], D, (20, 10), 1)  # used again: cams[2]'s rays are now the oldest
+    pixel_rays(cams[3], D, (20, 10), 1)
+    assert [key[0] for key in synthetic._RAYS] == [cams[1].tobytes(), cams[3].tobytes()]
+    np.testing.assert_array_equal(pixel_rays(cams[0], D, (20, 10), 1), first)  # recomputed
+    monkeypatch.setattr(synthetic, "_RAYS_MAX_BYTES", 1000)
+    pixel_rays(cams[2], D, (20, 10), 1)  # larger than the bound: kept alone
+    assert [key[0] for key in synthetic._RAYS] == [cams[2].tobytes()]

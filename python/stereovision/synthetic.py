@@ -24,12 +24,17 @@ __all__ = ["render_plane"]
 F64 = npt.NDArray[np.float64]
 
 _RAYS: dict[tuple[Any, ...], F64] = {}
+#: Bytes of rays :func:`pixel_rays` keeps (the least recently used go first; the newest camera's
+#: are kept even when larger). Nine cameras were kept whatever their size: three 1080p ones
+#: at supersample 3 held 896 MB after their renders. 256 MiB, as the SGM cost volume's bound.
+_RAYS_MAX_BYTES = 256 << 20
 
 
 def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pinhole") -> F64:
     """Normalised undistorted ray ``(x, y)`` (``z = 1``) of every supersampled pixel centre.
 
-    Cached per camera. Supersampled pixel ``j`` covers ``[j / ss - 0.5, (j + 1) / ss - 0.5]``
+    Cached per camera (at most :data:`_RAYS_MAX_BYTES` of rays besides the newest camera's).
+    Supersampled pixel ``j`` covers ``[j / ss - 0.5, (j + 1) / ss - 0.5]``
     of the image's x axis (pixel centres at integers).
 
     Returns
@@ -38,7 +43,9 @@ def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pin
         ``(h * ss, w * ss, 2)`` float64; NaN where the model has no ray in front of the camera.
     """
     key = (K.tobytes(), D.tobytes(), size, ss, model)
-    if key not in _RAYS:
+    if key in _RAYS:
+        _RAYS[key] = _RAYS.pop(key)  # the most recently used last
+    else:
         w, h = size
         xs = (np.arange(w * ss) + 0.5) / ss - 0.5
         ys = (np.arange(h * ss) + 0.5) / ss - 0.5
@@ -65,8 +72,10 @@ def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pin
                 # r = f pi / 2 came back wrong and were cut (f 300 px, k 0.1, -0.02, 0.005,
                 # -0.001: 243808 pixels of a 2000 x 1500 image seeing the background)
                 rays[bad] = _fisheye_rays(pts[bad.ravel(), 0], K, D)
-        if len(_RAYS) > 8:
-            _RAYS.clear()
+        # the least recently used first, until the rest and these fit (or none is left)
+        kept = sum(r.nbytes for r in _RAYS.values())
+        while _RAYS and (len(_RAYS) > 8 or kept + rays.nbytes > _RAYS_MAX_BYTES):
+            kept -= _RAYS.pop(next(iter(_RAYS))).nbytes
         _RAYS[key] = rays
     return _RAYS[key]
 
