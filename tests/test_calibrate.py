@@ -2765,6 +2765,25 @@ def test_a_dark_16_bit_board_image_is_read_at_its_own_range(data_dir: Path, tmp_
     assert name == "left01.jpg" and np.array_equal(same, imread(jpg, gray=True))
 
 
+def test_find_corners_reads_a_dark_uint16_board_at_its_own_range() -> None:
+    """find_corners on a 12-bit board in a uint16 array used its top 8 bits (0-15 grey levels),
+    with only the matchers' "8-bit or 12-bit data in a 16-bit container?" warning: the corners
+    moved 0.083 px from the 8-bit board's. It stretches by the image's range, as calibrate
+    does (c74a955): no warning, 0.005 px."""
+    k = np.array([[260.0, 0.0, 159.5], [0.0, 260.0, 119.5], [0.0, 0.0, 1.0]])
+    img = render_chessboard(
+        k, None, [0.2, -0.3, 0.1], [-0.12, -0.075, 0.45], square_size=0.03,
+        image_size=(320, 240), supersample=2,
+    )  # fmt: skip
+    ref = find_corners(img, (9, 6))
+    deep = np.rint(img * (4095 / 255)).astype(np.uint16)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        found = find_corners(deep, (9, 6))
+    assert ref is not None and found is not None
+    assert np.abs(found - ref).max() < 0.02
+
+
 def test_render_chessboard_refuses_a_camera_matrix_not_of_opencvs_form() -> None:
     """A transposed K (MATLAB's IntrinsicMatrix) drew the board seen from a centre at (0, 0),
     70 % of the view background, without a word (render_plane refuses it since 1e068c28)."""

@@ -10,6 +10,7 @@ import re
 import struct
 import subprocess
 import sys
+import warnings
 import zlib
 from dataclasses import replace
 from pathlib import Path
@@ -1416,3 +1417,20 @@ def test_calibration_from_recordings_names_a_board_that_is_no_charuco_board(
         calibrate([frame] * 3, [frame] * 3, board=given)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match=want):
         find_charuco_corners(cv2.imread(str(frame)), given)  # type: ignore[arg-type]
+
+
+def test_a_dark_uint16_board_is_read_at_its_own_range() -> None:
+    """find_charuco_corners on a 12-bit board in a uint16 array used its top 8 bits (0-15 grey
+    levels), with only the matchers' 16-bit container warning: no board found where the 8-bit
+    image gives 18 corners. It stretches by the image's range, as calibrate does (c74a955)."""
+    k = np.array([[300.0, 0.0, 159.5], [0.0, 300.0, 119.5], [0.0, 0.0, 1.0]])
+    rv, tv = np.array([0.15, -0.2, 0.05]), np.array([-0.15, -0.1, 0.42])
+    img = render_charuco(BOARD, k, None, rv, tv, image_size=(320, 240), supersample=2)
+    ref = find_charuco_corners(img, BOARD)
+    deep = np.rint(img * (4095 / 255)).astype(np.uint16)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        found = find_charuco_corners(deep, BOARD)
+    assert ref is not None and found is not None
+    np.testing.assert_array_equal(found[0], ref[0])
+    assert np.abs(found[1] - ref[1]).max() < 0.02

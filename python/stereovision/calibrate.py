@@ -459,6 +459,8 @@ def find_corners(image: npt.ArrayLike, pattern: tuple[int, int] = (9, 6)) -> F64
     ----------
     image : array_like
         Grey or BGR image (``uint8``, ``uint16`` or float in [0, 1]).
+        A dark image of more than 8 bits (12-bit data in ``uint16``) is stretched by its own
+        range, as :func:`~stereovision.calibrate.calibrate` reads it.
     pattern : tuple of int
         ``(cols, rows)`` inner corners.
 
@@ -478,10 +480,10 @@ def find_corners(image: npt.ArrayLike, pattern: tuple[int, int] = (9, 6)) -> F64
     TypeError
         If ``pattern`` is not a pair of integers or a ``"COLSxROWS"`` string.
     """
-    from stereovision._validate import as_gray_uint8
-
     pattern = parse_pattern(pattern)
-    gray = as_gray_uint8(image, "image")
+    # a dark image of more than 8 bits at its own range, as calibrate reads it (c74a955): its
+    # top 8 bits (a 12-bit board: 0-15 grey levels) moved the corners 0.07 px, with a warning
+    gray = _board_gray(image, "image")
     if min(gray.shape[:2]) < MIN_BOARD_IMAGE_SIDE:
         return None  # no board fits (and the classic detector fails an assertion there)
     found: npt.NDArray[np.float32] | None = None
@@ -1251,7 +1253,20 @@ def _charuco_hint(board: CharucoBoard, gray: np.ndarray, name: str) -> str:
 
 
 def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
-    """Grey uint8 image from a path or an array; the file name when it was a path.
+    """Grey uint8 image from a path or an array (:func:`_board_gray`); the file name when it
+    was a path."""
+    name = None
+    if isinstance(item, (str, os.PathLike)):
+        from stereovision.io import read_image
+
+        # read_image keeps a 16-bit file's bits (imread(gray=True) kept its top 8)
+        name = Path(item).name
+        item = read_image(item)
+    return _board_gray(item, what), name
+
+
+def _board_gray(image: object, what: str) -> npt.NDArray[np.uint8]:
+    """Grey uint8 image of a board for OpenCV's detectors.
 
     An image of more than 8 bits that is dark (its brightest grey under ``_DARK_PAIR`` of the
     range: a 10- or 12-bit camera's frames in a 16-bit PNG) is stretched by the gain that brings
@@ -1262,20 +1277,14 @@ def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
     from stereovision._validate import as_gray_float, as_gray_uint8, as_image_array
     from stereovision.depth import _DARK_PAIR
 
-    name = None
-    if isinstance(item, (str, os.PathLike)):
-        from stereovision.io import read_image
-
-        # read_image keeps a 16-bit file's bits (imread(gray=True) kept its top 8)
-        name = Path(item).name
-        item = read_image(item)
-    arr = as_image_array(item, what)
+    arr = as_image_array(image, what)
     if arr.dtype != np.uint8:
         grey = as_gray_float(arr, what, warn=False)
         top = float(grey.max())
         if 0.0 < top < _DARK_PAIR:
-            return np.rint(grey * np.float32(255.0 / top)).astype(np.uint8), name
-    return as_gray_uint8(arr, what), name
+            out: npt.NDArray[np.uint8] = np.rint(grey * np.float32(255.0 / top)).astype(np.uint8)
+            return out
+    return as_gray_uint8(arr, what)
 
 
 def _pair_names(

@@ -624,6 +624,8 @@ def find_charuco_corners(
     ----------
     image : array_like
         Grey or BGR image (``uint8``, ``uint16`` or float in [0, 1]).
+        A dark image of more than 8 bits (12-bit data in ``uint16``) is stretched by its own
+        range, as :func:`~stereovision.calibrate.calibrate` reads it.
     board : CharucoBoard
         The board; with ``dictionary="auto"`` or an undecided layout it is first resolved on
         this image (:meth:`CharucoBoard.resolve`).
@@ -640,10 +642,10 @@ def find_charuco_corners(
     TypeError
         If ``board`` is not a :class:`CharucoBoard`.
     """
-    from stereovision._validate import as_gray_uint8
+    from stereovision.calibrate import _board_gray
 
     _require_board(board)
-    gray = as_gray_uint8(image, "image")
+    gray = _board_gray(image, "image")  # a dark 12-bit image at its own range, as calibrate's
     if not board.resolved:
         resolved = board.resolve(gray)
         if resolved is None:
