@@ -875,7 +875,11 @@ class DepthResult:
         lim = self.limits
         if filled and "max_sigma" not in lim and "max_relative_sigma" not in lim:
             z = z.copy()
-            guessed = cal.depth_from_disparity(self.disparity)  # filled pixels have no depth
+            from stereovision.triangulation import _depth_from_disparity
+
+            # filled pixels have no depth; a map wider than the calibration's images is warned
+            # of at the caller's line (Calibration.depth_from_disparity's pointed at this one)
+            guessed = _depth_from_disparity(self.disparity, cal, "m", user_stacklevel())
             # confidence 0 marks a filled disparity; a measured one without a depth was dropped
             # (within sigma_d of infinity, or outside the limits) and stays out
             guess = ~np.isfinite(z) & np.isfinite(guessed) & (self.confidence == 0)
