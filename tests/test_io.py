@@ -2840,3 +2840,22 @@ def test_atomic_write_refuses_a_name_ending_in_a_slash(tmp_path: Path) -> None:
     with pytest.raises(IsADirectoryError, match=r": it is a folder; give a file name$"):
         with atomic_write(f"{tmp_path}/"):
             pass
+
+
+def test_load_scene_full_bits_keeps_a_16_bit_pair_and_reads_8_bits_alike(tmp_path: Path) -> None:
+    """eval and bench load scenes with full_bits (a 16-bit pair was read at its top 8 bits, 0-4095
+    as 0-15, where `depth` keeps 16); the default and an 8-bit pair are read as before."""
+    import cv2
+
+    from stereovision.io import load_scene
+
+    deep = (np.arange(24 * 32 * 3).reshape(24, 32, 3) % 4096).astype(np.uint16)
+    for name, img in (("s16", deep), ("s8", (deep // 16).astype(np.uint8))):
+        (tmp_path / name).mkdir()
+        for n in ("left.png", "right.png"):
+            cv2.imwrite(str(tmp_path / name / n), img)
+    full = load_scene(tmp_path / "s16", full_bits=True)
+    assert full.left.dtype == np.uint16 and np.array_equal(full.right, deep)
+    assert load_scene(tmp_path / "s16").left.max() == deep.max() >> 8  # default: the top 8 bits
+    eight = load_scene(tmp_path / "s8")
+    assert np.array_equal(load_scene(tmp_path / "s8", full_bits=True).left, eight.left)

@@ -420,7 +420,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     try:
         for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
             try:
-                scene = load_scene(d)
+                scene = load_scene(d, full_bits=True)  # as `depth` reads a 16-bit pair
                 scene.name = names[d]
                 narrow = scene_too_narrow(scene)
                 if narrow:

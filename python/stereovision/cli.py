@@ -1975,7 +1975,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     try:
         for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
             try:
-                scene = load_scene(d)
+                scene = load_scene(d, full_bits=True)  # as `depth` reads a 16-bit pair
                 scene.name = names[d]
                 # a GT map with no known pixel (all +inf) is no ground truth either: its figures
                 # would all be NaN (and NaN in the --json line, which is not JSON)

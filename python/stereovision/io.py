@@ -1813,7 +1813,8 @@ class Scene:
     name : str
         ``"<family>/<scene>"``, e.g. ``"middlebury2001/tsukuba"``.
     left, right : numpy.ndarray
-        The rectified pair as read: ``(H, W, 3)`` ``uint8`` BGR.
+        The rectified pair as read: ``(H, W, 3)`` ``uint8`` BGR (``uint16`` for 16-bit files
+        loaded with ``full_bits``).
     gt : numpy.ndarray or None
         ``(H, W)`` ``float32`` GT disparity of the left image in pixels, NaN where unknown
         (the files' ``+inf``); None when the scene has no ``gt_disp.pfm``.
@@ -1829,8 +1830,8 @@ class Scene:
     """
 
     name: str
-    left: npt.NDArray[np.uint8]
-    right: npt.NDArray[np.uint8]
+    left: npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
+    right: npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
     gt: npt.NDArray[np.float32] | None
     calib: Calibration | None
     max_disparity: int
@@ -2019,7 +2020,7 @@ def _present(path: Path) -> bool:
     return False
 
 
-def load_scene(directory: PathLike) -> Scene:
+def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
     """Load one scene directory (``left.png``, ``right.png``, optional GT and calibration).
 
     The calibration is ``calib.txt`` (Middlebury format, :meth:`Calibration.from_middlebury`),
@@ -2030,6 +2031,10 @@ def load_scene(directory: PathLike) -> Scene:
     ----------
     directory : str or os.PathLike
         Scene directory.
+    full_bits : bool
+        Read a 16-bit ``left.png`` / ``right.png`` at its 16 bits (:func:`read_image`, as
+        ``stereovision depth`` and ``batch`` read them: ``eval`` and ``bench`` do); by default
+        their top 8 (:func:`imread`). 8-bit files are read alike either way.
 
     Returns
     -------
@@ -2061,8 +2066,8 @@ def load_scene(directory: PathLike) -> Scene:
     cased = _cased_pair(d)
     if cased:  # Left.png + Right.png: "image file not found: .../left.png" alone, beside them
         raise FileNotFoundError(f"image file not found: {d / 'left.png'}; {d} {cased}")
-    left = imread(d / "left.png")
-    right = imread(d / "right.png")
+    read = read_image if full_bits else imread
+    left, right = read(d / "left.png"), read(d / "right.png")
     if left.shape != right.shape:
         raise ValueError(
             f"scene {d}: left.png is {image_size_text(left)}, right.png is "
