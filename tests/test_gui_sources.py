@@ -1370,3 +1370,26 @@ def test_video_pair_takes_a_stream_or_device_node_for_no_file(fake_cap: type[Fak
     # A local path that does not exist is still refused as a file.
     with pytest.raises(FileNotFoundError, match=r"^left camera source not found: nope\.avi$"):
         VideoPair("nope.avi", "/dev/video7")
+
+
+def test_a_loop_of_links_in_a_data_folder_is_no_file_and_stops_nothing(tmp_path: Path) -> None:
+    """A loop of symbolic links in a --data folder (a.png -> b.png -> a.png) stopped the GUI at
+    start-up: listing the folder's images raised Python 3.11's RuntimeError "Symlink loop from
+    '.../a.png'" ('stereovision: error: Symlink loop from ...', exit 2), and one typed on the
+    page (a file, a Save folder) went past the handlers. The loop is now no file: left out of
+    the lists, said as one where a file is asked for, a Save folder checked as any other."""
+    (tmp_path / "a.png").symlink_to("b.png")
+    (tmp_path / "b.png").symlink_to("a.png")
+    (tmp_path / "loop").symlink_to("loop")
+    cv2.imwrite(str(tmp_path / "ok.png"), np.zeros((4, 4, 3), np.uint8))
+    folders = AllowedFolders([tmp_path])
+    assert folders.files(frozenset({".png"})) == [tmp_path.resolve() / "ok.png"]
+    loop = "one of a loop of links that never reaches a file"
+    with pytest.raises(
+        FileNotFoundError, match=rf"^no such file: a\.png \(a link to b\.png, {loop}\)$"
+    ):
+        folders.resolve("a.png")
+    with pytest.raises(FileNotFoundError, match=r"^no such file: loop/x\.png$"):
+        folders.resolve("loop/x.png")
+    assert not folders.contains("loop")
+    assert folders.resolve_output("loop/x") == tmp_path.resolve() / "loop" / "x"

@@ -61,6 +61,7 @@ from stereovision.gui.sources import (
     expand_home,
     open_stereo_source,
     parse_source,
+    real_path,
     scale_pair,
     scaled_calibration,
 )
@@ -1771,7 +1772,7 @@ class StereoApp:
         text = typed.strip()
         p = expand_home(text) if text else None
         if p is not None and "\x00" not in text and not p.is_absolute():
-            here = (Path.cwd() / p).resolve()
+            here = real_path(Path.cwd() / p)
             if any(here == r or here.is_relative_to(r) for r in self._save_roots):
                 return here
         return self.folders.resolve_output(typed, self._save_roots)

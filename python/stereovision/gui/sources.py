@@ -133,6 +133,33 @@ def expand_home(text: str) -> Path:
         ) from None
 
 
+def real_path(p: Path) -> Path:
+    """``p`` with every symbolic link and ``..`` resolved (``Path.resolve``), as far as they
+    lead: a link in a loop (``a.png -> b.png -> a.png``) is left where the loop was found,
+    a path that does not exist, where Python 3.11's ``resolve`` raised RuntimeError("Symlink
+    loop from ...") past the handlers (one such link in a ``--data`` folder stopped the GUI's
+    start-up, listing its files)."""
+    try:
+        return p.resolve()
+    except RuntimeError:
+        return Path(os.path.realpath(p))
+
+
+def _loop_note(p: Path) -> str:
+    """`` (a link to b.png, one of a loop of links that never reaches a file)`` when ``p``
+    (as typed, not resolved) is such a link, else ""."""
+    with contextlib.suppress(OSError):
+        os.stat(p)
+        return ""
+    with contextlib.suppress(OSError):
+        if p.is_symlink():
+            from stereovision.io import _broken_link
+
+            why = _broken_link(p)
+            return f" ({why})" if "loop" in why else ""
+    return ""
+
+
 class AllowedFolders:
     """The folders the page may read files from, and the check that keeps it inside them.
 
@@ -204,11 +231,11 @@ class AllowedFolders:
             if not self.roots:
                 raise ValueError(f"path outside the allowed folders: {said}")
             p = self.roots[0] / p
-        real = p.resolve()
+        real = real_path(p)
         if not any(real == r or real.is_relative_to(r) for r in self.roots):
             raise ValueError(f"path outside the allowed folders: {said}")
         if not real.exists():
-            raise FileNotFoundError(f"no such file: {said}")
+            raise FileNotFoundError(f"no such file: {said}{_loop_note(p)}")
         return real
 
     def resolve_output(
@@ -238,7 +265,7 @@ class AllowedFolders:
         p = expand_home(text.strip())
         if not p.is_absolute():
             p = allowed[0] / p
-        real = p.resolve()  # the existing part's links resolved, the rest as written
+        real = real_path(p)  # the existing part's links resolved, the rest as written
         if not any(real == r or real.is_relative_to(r) for r in allowed):
             raise ValueError(f"folder outside the --data folders: {text}")
         return real
