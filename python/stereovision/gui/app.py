@@ -2663,6 +2663,9 @@ class StereoApp:
             "source_label": self.state.source_label,
             "rows_label": self.state.rows_label,
             "_scene": self._scene,
+            # its GT with it: a scene that failed to compute left its own, and the pair put
+            # back lost its statistics' GT figures (bad-2.0, precision@1) from then on
+            "_scene_gt": self._scene_gt,
             # put back with the pair: a Capture says so over a scene or files, not over cameras
             "_other_on_show": self._other_on_show,
         }
