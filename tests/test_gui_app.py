@@ -6998,3 +6998,41 @@ def test_a_scene_put_back_after_another_failed_keeps_its_gt_figures(tmp_path):
     assert app.state.error.endswith("(the page still shows the previous pair)")
     app._on_method()  # computed again (a method or resolution chosen)
     assert app.state.error == "" and ", on GT bad-2.0 " in app.state.stats
+
+
+def test_image_sequences_typed_as_cameras_that_start_apart_are_said_paired_in_order(tmp_path):
+    """Two image sequences opened on the page that start at different numbers (left01.png
+    deleted, blurred) are paired in order, not by number: every left image with the right one
+    before its own. StereoCamera's warning of it went to the server's log alone; the page said
+    nothing ("cameras left%02d.png / right%02d.png", no error). It is now said under the pair,
+    as a pair of files' warning is; sequences that start together say nothing."""
+    import warnings
+
+    from stereovision.gui import bundled_data_dir
+
+    img = np.zeros((24, 40, 3), np.uint8)
+    (tmp_path / "seq").mkdir()
+    for k in (2, 3):
+        cv2.imwrite(str(tmp_path / "seq" / f"left{k:02d}.png"), img)
+        cv2.imwrite(str(tmp_path / "seq" / f"right{k - 1:02d}.png"), img)
+    app = _scene_app("test-camera-sequences-apart", [bundled_data_dir(), tmp_path])
+    app.state.cam_left = str(tmp_path / "seq" / "left%02d.png")
+    app.state.cam_right = str(tmp_path / "seq" / "right%02d.png")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # the server's log's
+        _open_cameras(app)
+    try:
+        assert app.state.error == "" and app.state.source_label.startswith("cameras left%02d")
+        assert app.state.rows_label == (
+            "warning: the left sequence starts at left02.png, the right one at right01.png: "
+            "images are paired in order (left02.png with right01.png), not by their numbers; "
+            "if the numbers name the pairs, remove the images without a partner (or renumber)"
+        )
+    finally:
+        app.source.close()
+    cv2.imwrite(str(tmp_path / "seq" / "left01.png"), img)  # now both start at 01
+    _open_cameras(app)
+    try:
+        assert app.state.error == "" and app.state.rows_label == ""
+    finally:
+        app.source.close()

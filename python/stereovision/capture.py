@@ -1524,6 +1524,30 @@ class PairSource:
         self.close()
 
 
+def _paired_in_order_note(camera: Any) -> str | None:
+    """What :class:`StereoCamera` warns of at its open when its two image sequences start at
+    different numbers (they are paired in order, not by number), None otherwise (or for a
+    source that is no StereoCamera): for a caller that says it elsewhere (the GUI's page).
+
+    Pairs are read in order: left_0001.png deleted (blurred) paired every left image with the
+    right one before its own, without a word until the end.
+    """
+    starts = getattr(camera, "_sequence_start", None) or {}
+    if len(starts) != 2 or starts["left"] == starts["right"]:
+        return None
+    first = {
+        side: os.path.basename(_sequence_name(os.fspath(src), starts[side]))
+        for side, src in camera.sources.items()
+        if isinstance(src, (str, os.PathLike))  # a sequence is a path
+    }
+    return (
+        f"the left sequence starts at {first['left']}, the right one at "
+        f"{first['right']}: images are paired in order ({first['left']} with "
+        f"{first['right']}), not by their numbers; if the numbers name the pairs, "
+        "remove the images without a partner (or renumber)"
+    )
+
+
 class StereoCamera(PairSource):
     """Two video sources read as synchronised pairs.
 
@@ -1661,21 +1685,10 @@ class StereoCamera(PairSource):
                 self._caps[side] = self._open(side, src, fps, open_timeout)
                 path = os.fspath(src) if isinstance(src, os.PathLike) else src
                 self._device[side] = _camera_device(path) is not None or _live_stream(path)
-            starts = self._sequence_start
-            if len(starts) == 2 and starts["left"] != starts["right"]:
-                # pairs are read in order, not by number: left_0001.png deleted (blurred)
-                # paired every left image with the right one before its own, without a word
-                # until the end
-                first = {
-                    side: os.path.basename(_sequence_name(os.fspath(src), starts[side]))
-                    for side, src in self.sources.items()
-                    if isinstance(src, (str, os.PathLike))  # a sequence is a path
-                }
+            note = _paired_in_order_note(self)
+            if note is not None:
                 warnings.warn(
-                    f"the left sequence starts at {first['left']}, the right one at "
-                    f"{first['right']}: images are paired in order ({first['left']} with "
-                    f"{first['right']}), not by their numbers; if the numbers name the pairs, "
-                    "remove the images without a partner (or renumber)",
+                    note,
                     UserWarning,
                     stacklevel=3,  # __init__, renamed_keyword's wrapper, the caller
                 )

@@ -2448,6 +2448,12 @@ class StereoApp:
             self._fail(exc, outlasts=True)
             return
         self._shows += 1
+        # what the open warned of (sequences paired in order, not by their numbers) went to
+        # the server's log alone: said under the pair, as a pair of files' warning is
+        notes = getattr(source, "notes", None)
+        said = notes() if callable(notes) else []
+        if said:
+            self.state.rows_label = "; ".join(f"warning: {n}" for n in said)
         if before[0] is not None:
             self._close_source(before[0])  # a Capture may still be reading it
         self.state.live = True

@@ -576,6 +576,15 @@ class _CaptureAdapter:
             left, right = got.left, got.right
         return np.asarray(left), np.asarray(right)
 
+    def notes(self) -> list[str]:
+        """What the source's open warned of that concerns every pair, for the page to say (the
+        warning went to the server's log alone): two image sequences that start at different
+        numbers, paired in order (:func:`~stereovision.capture._paired_in_order_note`)."""
+        from stereovision.capture import _paired_in_order_note
+
+        note = _paired_in_order_note(self._camera)
+        return [] if note is None else [note]
+
     def close(self) -> None:
         for name in ("close", "release"):
             fn = getattr(self._camera, name, None)
