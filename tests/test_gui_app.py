@@ -7036,3 +7036,31 @@ def test_image_sequences_typed_as_cameras_that_start_apart_are_said_paired_in_or
         assert app.state.error == "" and app.state.rows_label == ""
     finally:
         app.source.close()
+
+
+def test_a_max_disparity_refused_while_a_pair_computes_stays_said_after_it():
+    """A max disparity refused while a pair computed ("500" on the 450 px cones: "... is not
+    smaller than the pair's width 450 px") was cleared by the computation's end, "ready" said
+    under a field still holding 500 over a result of the old range (0-64 px), as if it had
+    been taken. The refusal now stays after the computation, as a camera's failed read does."""
+    import asyncio
+
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-max-disp-refused-while-computing", [bundled_data_dir()])
+    left, right = (cv2.imread(str(CONES / f"{s}.png"))[150:190] for s in ("left", "right"))
+    app.pair = app.raw_pair = (left, right)  # 40 rows of the cones: 450 px wide
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        app.apply_max_disparity(text="500")
+        await computing
+
+    asyncio.run(run())
+    refusal = "max disparity 500 px is not smaller than the pair's width 450 px"
+    assert app.state.computations == 1 and app.chosen_max_disparity is None
+    assert (app.state.error, app.state.status) == (refusal, "error")
+    app.apply_max_disparity(text="auto")  # the range in use typed again: the refusal goes
+    assert (app.state.error, app.state.status) == ("", "ready")

@@ -2798,7 +2798,9 @@ class StereoApp:
             width = self.pair[0].shape[1] if self.pair is not None else math.inf
             chosen = parse_max_disparity(self.state.max_disp, int(min(width, 2**31)))
         except ValueError as exc:
-            self._fail(exc)
+            # kept past a computation under way: its end cleared the refusal, the field still
+            # holding the value refused ("500" on a 450 px pair) over a result of the old range
+            self._fail(exc, outlasts=True)
             self._max_disp_refused = self.state.error
             return
         if chosen == self.chosen_max_disparity:
