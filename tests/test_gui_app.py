@@ -7064,3 +7064,26 @@ def test_a_max_disparity_refused_while_a_pair_computes_stays_said_after_it():
     assert (app.state.error, app.state.status) == (refusal, "error")
     app.apply_max_disparity(text="auto")  # the range in use typed again: the refusal goes
     assert (app.state.error, app.state.status) == ("", "ready")
+
+
+def test_a_load_or_scene_taken_after_a_failure_clears_it_before_computing(tmp_path):
+    """A Load (or a scene chosen) after one that failed kept the failure on the page while the
+    new pair computed: "no such file: cones/none.png" above the files being computed, as if
+    this Load had failed too (until the computation's end). A choice taken clears it, as a
+    Capture, a Play and an Open clear it when they start; a refused one still says its own."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-load-clears-failure", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = spawned.append
+    app.state.left_file, app.state.right_file = "cones/none.png", "cones/right.png"
+    app.load_files()
+    assert app.state.error == "no such file: cones/none.png" and spawned == []
+    app.state.left_file = "cones/left.png"
+    app.load_files()
+    assert (app.state.error, app.state.source_label, len(spawned)) == ("", "files", 1)
+    spawned.pop().close()
+    app._fail(ValueError("an earlier failure"))
+    app._on_scene(scene=str(bundled_data_dir() / "cones"))
+    assert (app.state.error, app.state.source_label, len(spawned)) == ("", "scene data/cones", 1)
+    spawned.pop().close()

@@ -2022,6 +2022,7 @@ class StereoApp:
             return
         self._scene = scene
         self._choice += 1  # an open still under way must not replace this scene
+        self._done()  # an earlier failure stayed on the page while the scene computed
         self._spawn(self.recompute())
 
     def capture(self) -> None:
@@ -2498,6 +2499,9 @@ class StereoApp:
         self.state.rows_label = "; ".join(
             n for n in (f"warning: {same}" if same else "", note) if n
         )
+        # the files are taken: an earlier failure ("no such file: ...") stayed on the page
+        # while they computed, as if this Load had failed
+        self._done()
         self._spawn(self.recompute())
 
     def open_cloud(self) -> None:
