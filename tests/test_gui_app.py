@@ -7005,7 +7005,9 @@ def test_image_sequences_typed_as_cameras_that_start_apart_are_said_paired_in_or
     deleted, blurred) are paired in order, not by number: every left image with the right one
     before its own. StereoCamera's warning of it went to the server's log alone; the page said
     nothing ("cameras left%02d.png / right%02d.png", no error). It is now said under the pair,
-    as a pair of files' warning is; sequences that start together say nothing."""
+    as a pair of files' warning is (given to gui --left/--right: under the first pair, the
+    terminal's line at start-up being out of the page's sight); sequences that start together
+    say nothing."""
     import warnings
 
     from stereovision.gui import bundled_data_dir
@@ -7030,6 +7032,23 @@ def test_image_sequences_typed_as_cameras_that_start_apart_are_said_paired_in_or
         )
     finally:
         app.source.close()
+    # given to gui --left/--right: said in the terminal at start-up, and under the first pair
+    from stereovision.gui import add_arguments, build_app
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = ["--data", str(tmp_path), "--left", app.state.cam_left, "--right"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        started = build_app(parser.parse_args([*args, app.state.cam_right]))
+    started._spawn = lambda coro: coro.close()
+    _start(started)
+    try:
+        assert started.state.error == "" and started.state.rows_label == app.state.rows_label
+        _capture(started)  # a pair of its own: no warning under it (as after an Open)
+        assert started.state.captures == 2 and started.state.rows_label == ""
+    finally:
+        started.source.close()
     cv2.imwrite(str(tmp_path / "seq" / "left01.png"), img)  # now both start at 01
     _open_cameras(app)
     try:

@@ -2092,6 +2092,8 @@ class StereoApp:
         try:
             with self.state:
                 self._use_pair(got)
+                if self.state.captures == 0:  # the start-up cameras' first pair
+                    self._say_source_notes(source)
                 self.state.captures += 1
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc, outlasts=True)
@@ -2449,12 +2451,7 @@ class StereoApp:
             self._fail(exc, outlasts=True)
             return
         self._shows += 1
-        # what the open warned of (sequences paired in order, not by their numbers) went to
-        # the server's log alone: said under the pair, as a pair of files' warning is
-        notes = getattr(source, "notes", None)
-        said = notes() if callable(notes) else []
-        if said:
-            self.state.rows_label = "; ".join(f"warning: {n}" for n in said)
+        self._say_source_notes(source)
         if before[0] is not None:
             self._close_source(before[0])  # a Capture may still be reading it
         self.state.live = True
@@ -2462,6 +2459,15 @@ class StereoApp:
         self.state.error = ""
         self.state.captures += 1
         self._spawn(self.recompute())
+
+    def _say_source_notes(self, source: StereoSource) -> None:
+        """Say under the pair on show what ``source``'s open warned of (image sequences
+        paired in order, not by their numbers: ``notes()`` of the page's sources), as a pair of
+        files' warning is: the warning went to the server's log (or the terminal) alone."""
+        notes = getattr(source, "notes", None)
+        said = notes() if callable(notes) else []
+        if said:
+            self.state.rows_label = "; ".join(f"warning: {n}" for n in said)
 
     def load_files(self) -> None:
         """Use the chosen left / right image files (calibration: ``--calib`` if its size fits;
