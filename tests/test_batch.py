@@ -129,6 +129,22 @@ def _not_ours(out: Path, pair: str, name: str) -> str:
     )
 
 
+@pytest.fixture
+def in_process_dask(monkeypatch: pytest.MonkeyPatch) -> None:
+    """batch's LocalCluster with its worker a thread of this process, for the tests whose point
+    is batch's bookkeeping (skips, redos, summary, errors), not Dask's processes: started and
+    closed by each run as before, at a sixth of the CPU (a worker process starts Python, NumPy
+    and OpenCV: about 2 s of CPU a run, ~0.3 s in process). Tests of the cluster itself (its
+    workers, signals, memory, what reaches a worker) keep real worker processes."""
+    real = distributed.LocalCluster
+
+    def in_process(*args: Any, **kwargs: Any) -> Any:
+        kwargs.pop("env", None)  # a worker process's environment: none to set in process
+        return real(*args, **{**kwargs, "processes": False})
+
+    monkeypatch.setattr(distributed, "LocalCluster", in_process)
+
+
 def test_batch_runs_skips_and_records_failures(
     scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -464,7 +480,7 @@ def test_ros_camera_info_folder_as_batch_calibration(scenes: Path, tmp_path: Pat
     np.testing.assert_array_equal(depth, ref.depth)
 
 
-def test_batch_ground_outputs(data_dir: Path, tmp_path: Path) -> None:
+def test_batch_ground_outputs(data_dir: Path, tmp_path: Path, in_process_dask: None) -> None:
     """--ground: a worker writes the pair's floor and obstacles (and with --grid its occupancy
     grid) beside the depth outputs; the options of a run without it are those of earlier
     versions (outputs made before stay valid)."""
@@ -637,7 +653,7 @@ def test_batch_switches_are_true_or_false(tmp_path: Path) -> None:
 
 
 def test_batch_a_pair_failed_on_an_obstacle_is_done_once_it_is_gone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A file where pair a's output folder goes failed the pair with its fingerprint and
     options recorded: once the file was moved away the rerun skipped a as 'failed before'
@@ -676,7 +692,9 @@ def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Pat
     assert not (tmp_path / "o").exists()
 
 
-def test_batch_redoes_the_pairs_when_the_grid_cell_changes(data_dir: Path, tmp_path: Path) -> None:
+def test_batch_redoes_the_pairs_when_the_grid_cell_changes(
+    data_dir: Path, tmp_path: Path, in_process_dask: None
+) -> None:
     """--grid is one of the options a pair was done with: a run with another cell side redoes
     it (it was skipped as done, its map.yaml still of the old cell), said as grid 0.2 -> 0.5."""
     from stereovision.batch import run_batch
@@ -904,7 +922,7 @@ def _change(path: Path) -> None:
 
 
 def test_batch_reports_an_image_without_its_pair(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """left.png without right.png, x_left.png without x_right.png, y_right.png without
     y_left.png: each a failed pair saying which file is missing, exit 1 (they were ignored:
@@ -1003,6 +1021,7 @@ def test_batch_progress_lines_when_stderr_is_not_a_terminal(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
+    in_process_dask: None,
 ) -> None:
     """Without a terminal (a log file, a pipe) a plain line every tenth of the pairs, or every
     PROGRESS_SECONDS (there was none: tqdm only shows on a terminal)."""
@@ -1033,6 +1052,7 @@ def test_batch_output_folder_moved_during_the_run(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
+    in_process_dask: None,
 ) -> None:
     """The output folder moved away after two pairs: the pairs written before are counted as
     missing (pending in the summary), exit 1, and a re-run redoes them (the summary said all
@@ -1076,7 +1096,7 @@ def test_batch_output_folder_moved_during_the_run(
 
 
 def test_batch_says_when_other_options_redo_finished_pairs(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """Another --method redoes every finished pair: one line says so before (it was silent)."""
     from stereovision.batch import _changes
@@ -1106,7 +1126,7 @@ def test_batch_says_when_other_options_redo_finished_pairs(
 
 
 def test_batch_never_deletes_what_an_output_folder_already_holds(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, in_process_dask: None
 ) -> None:
     """A pair's outputs go into a folder that holds other things: the input images (-o given as
     the input folder), the outputs of a pair nested in it, a user's file. They are kept; a pair
@@ -1192,7 +1212,7 @@ def test_a_large_summary_is_not_rewritten_after_every_pair(
 
 
 def test_batch_refuses_to_replace_the_outputs_of_another_input(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A second drive whose pairs have the first one's names, into the same -o: refused before
     any work, one line (the first drive's outputs were replaced without a word). The same input
@@ -1299,7 +1319,7 @@ def test_batch_a_skip_through_a_link_keeps_the_images_it_recorded(
 
 
 def test_batch_refuses_to_replace_a_file_it_did_not_write(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair's output folder holding the user's own disparity.png (no run recorded writing it):
     it was replaced silently; now refused before any work, one line naming it, exit 2. A rerun
@@ -1323,7 +1343,7 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
 
 
 def test_batch_refuses_to_replace_a_link_put_under_an_output_name_it_wrote(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair's disparity.png (recorded as written) that the user replaced by a link to a file
     of theirs: the redo replaced the link with its own file, unsaid (a redo that does not write
@@ -1348,7 +1368,7 @@ def test_batch_refuses_to_replace_a_link_put_under_an_output_name_it_wrote(
 
 
 def test_batch_resumes_a_pair_written_by_a_run_killed_before_recording_it(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A run killed after writing a pair's folder but before its summary recorded it (record()
     holds writes back; SIGKILL, the OOM killer) leaves the pair "pending" with no outputs
@@ -1392,7 +1412,7 @@ def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
 
 
 def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """Two input folders with pairs of other names share one -o; a changed image of the first
     is redone when the first is run again (it was refused as 'made from other images, in
@@ -1464,7 +1484,7 @@ def test_a_pair_folder_linked_to_another_disk_is_written(tmp_path: Path) -> None
 
 
 def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """OUT/a is a user's file: pair a fails naming it, the file is kept, pair b is done (the
     run stopped at '[Errno 20] Not a directory: .../.a.partial-.../disparity.png', b undone;
@@ -1487,7 +1507,7 @@ def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
 
 
 def test_batch_a_folder_where_an_output_file_goes_fails_that_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A rerun where OUT/a/disparity.pfm is a user's folder: the run stopped there ("cannot
     write the outputs of a ...: Is a directory; ... run again to continue", exit 2, as for a
@@ -1598,7 +1618,12 @@ def _crops(root: Path, data_dir: Path, left: list[str], right: list[str]) -> Non
     ids=["left-right", "L-R", "kitti", "euroc"],
 )  # fmt: skip
 def test_batch_pairs_images_of_the_same_name_in_sibling_camera_folders(
-    data_dir: Path, tmp_path: Path, left: list[str], right: list[str], names: list[str]
+    data_dir: Path,
+    tmp_path: Path,
+    left: list[str],
+    right: list[str],
+    names: list[str],
+    in_process_dask: None,
 ) -> None:
     """left/0001.png + right/0001.png (L/ R/, KITTI's image_2/ image_3/, EuRoC's cam0/data/
     cam1/data/) are pairs, named by the parent and the path under the camera folder, whose
@@ -1628,7 +1653,7 @@ def test_batch_pairs_images_of_the_same_name_in_sibling_camera_folders(
 
 
 def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """An image in one camera folder without the other is a failed pair saying which file is
     missing; several rigs in one folder keep their left camera's folder in the names; a clash
@@ -1706,7 +1731,7 @@ def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
 
 
 def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_listed(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, in_process_dask: None
 ) -> None:
     """A pair done with --ground, redone without it by a run stopped before the pair was
     written: the summary still lists the earlier run's outputs (it listed none), so the next
@@ -1843,7 +1868,9 @@ def test_a_scene_with_only_q_dat_is_calibrated_as_load_scene_calibrates_it(
     assert job.calib == tartan / "calib.txt"
 
 
-def test_a_scene_with_only_q_dat_is_batched_with_depth(data_dir: Path, tmp_path: Path) -> None:
+def test_a_scene_with_only_q_dat_is_batched_with_depth(
+    data_dir: Path, tmp_path: Path, in_process_dask: None
+) -> None:
     """The worker got the scene's Q.dat alone, in a temporary folder without the left.png
     that sizes it: every such pair failed ('Q.dat does not give the image size and there is
     no left.png beside it'). It is shipped as the calibration read beside its images."""
@@ -1922,7 +1949,7 @@ def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
 
 
 def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A summary.json of a batch before ed0f5f2 (version 1): a pair done, then redone on a
     damaged image, was recorded failed without its outputs list, and a pair whose right image
@@ -1986,7 +2013,7 @@ def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
 
 
 def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair removed from the input (or of another input folder run into the same -o) kept
     its record's "this_run": "processed" from the run that did it, so a script reading the
@@ -2022,7 +2049,7 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
 
 
 def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair recorded as done whose folder the user deleted since: the next run redoes it (it
     is not skipped as done), and its outputs are there again."""
@@ -2040,7 +2067,7 @@ def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
 
 
 def test_retry_failed_redoes_the_pairs_that_failed_on_the_same_images(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair that failed is skipped on unchanged images, and tried again with --retry-failed
     (the done pairs stay skipped)."""
@@ -2071,7 +2098,7 @@ def test_retry_failed_redoes_the_pairs_that_failed_on_the_same_images(
 
 
 def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A done pair whose right image goes is a failed pair that keeps its outputs listed: when
     the image comes back the pair is redone over them (not refused as files no run wrote). An
@@ -2102,7 +2129,7 @@ def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone
 
 
 def test_a_pair_name_taken_by_other_files_of_the_same_input_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """The scene folder ``a/`` replaced by ``a_left.png`` + ``a_right.png`` (other images, the
     same pair name) in the same input folder: redone; only another input's pairs are refused
@@ -2121,7 +2148,7 @@ def test_a_pair_name_taken_by_other_files_of_the_same_input_is_redone(
 
 
 def test_a_run_killed_after_one_with_other_outputs_is_resumed_over_both(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A run with --calib wrote depth files; a run without it was killed before recording the
     pair (pending, calib None, the first run's outputs still listed). A third run with --calib
@@ -2143,7 +2170,7 @@ def test_a_run_killed_after_one_with_other_outputs_is_resumed_over_both(
 
 
 def test_a_redo_without_calib_removes_the_stale_depth_files_but_not_a_link(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, in_process_dask: None
 ) -> None:
     """A pair done with --calib, redone without it: its depth files (an earlier run's, not
     written now) are removed; one the user replaced with a link is left alone."""
@@ -2193,7 +2220,7 @@ def test_batch_keeps_dask_logs_off_for_a_restarted_worker_and_restores_the_confi
 
 
 def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair done before whose cloud.ply had gone (deleted, lost in a copy) was skipped as done
     on a rerun (only disparity.pfm was looked for): its cloud was never written again. It is
@@ -2237,7 +2264,7 @@ def test_a_done_pair_missing_one_of_its_outputs_is_done_again(
 
 
 def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A version 1 summary lists no outputs: its entries take the files found in their folders
     as their list, so one whose disparity.pfm had gone listed the others alone, and a done pair
@@ -2264,7 +2291,7 @@ def test_a_done_pair_of_an_older_summary_without_its_disparity_pfm_is_done_again
 
 
 def test_a_changed_pair_is_redone_from_another_working_directory(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, in_process_dask: None
 ) -> None:
     """The summary recorded a pair's images as given (``drive/a/left.png`` for ``batch drive``),
     and read them against the working directory of the next run: after a run over another
@@ -2287,7 +2314,7 @@ def test_a_changed_pair_is_redone_from_another_working_directory(
 
 
 def test_the_summary_records_the_files_read_through_a_link_and_dotdot(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """``batch home/link/../drive`` with ``link`` a link to ``real/sub``: the OS reads
     ``real/drive``, but the summary recorded ``home/drive`` (os.path.abspath folds '..' as
@@ -2414,7 +2441,7 @@ def test_a_pair_folder_name_near_the_longest_is_written_and_its_leftovers_remove
 
 
 def test_an_image_that_cannot_be_read_fails_its_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A pair's image that is a broken link (a drive not mounted, a sync not finished) stopped
     the whole run before any pair, '[Errno 2] No such file or directory: ...', exit 2. That
@@ -2473,7 +2500,7 @@ def test_an_image_that_cannot_be_read_when_sent_is_tried_again(
 
 
 def test_a_calibration_that_cannot_be_read_for_its_hash_fails_its_pair_alone(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, in_process_dask: None
 ) -> None:
     """A pair's calibration file read for its sha256 after its task was made (permission
     denied, an I/O error, a share gone between the two reads) raised out of the run: it
@@ -2540,7 +2567,7 @@ def test_calib_unit_reaches_the_workers(
 
 
 def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no image size: batch refused
     them ("this command cannot read it from its images, so save the rig once in Python ..."),
@@ -2572,7 +2599,7 @@ def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
 
 
 def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A dataset copied without its modification times (cp -r) and run into the same -o was
     refused as 'made from other images' (size + time only), exit 2. The summary records each
@@ -2638,6 +2665,7 @@ def test_the_check_of_a_copy_without_its_times_shows_its_progress(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
+    in_process_dask: None,
 ) -> None:
     """Files copied without their times are read again (their sha256 against the summary's)
     before the pairs' bar starts, which took long on a large dataset with nothing shown. That
@@ -2680,7 +2708,7 @@ def test_the_check_of_a_copy_without_its_times_shows_its_progress(
 
 
 def test_a_copy_without_its_times_of_a_calibration_is_up_to_date(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """The --calib file copied without its time beside the images is checked against its
     recorded sha256 as they are: the same bytes, the pairs are up to date."""
@@ -2739,7 +2767,7 @@ def test_one_cameras_ros_file_reaches_the_workers_with_its_partner(
 
 
 def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """--calib rig/ (OpenCV stereo_calib's two files): the folder's own size and time were the
     calibration's fingerprint, and a file rewritten in place in it (a baseline of 240 mm for
@@ -2769,7 +2797,7 @@ def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
 
 
 def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """OpenCV stereo_calib output is sized by the first pair by name: a pair of another size
     added later that sorts first (00 before 01) changed calib_size for every pair, so all were
@@ -2796,7 +2824,7 @@ def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
 
 
 def test_the_image_sizing_a_calibration_is_fingerprinted_as_its_files_are(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """--calib rig/Q.dat is sized by the rig/left.png beside it (a Q matrix holds no image
     size), which was not fingerprinted: another image there (192x128 for 96x64) changed the
@@ -2871,6 +2899,7 @@ def test_a_full_output_disk_names_the_pair_and_closes_the_record(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
+    in_process_dask: None,
 ) -> None:
     """The output disk full (a robot's SD card) while the third pair was written: the run
     stopped with "stereovision: error: [Errno 28] No space left on device", naming neither the
@@ -3130,7 +3159,7 @@ def test_the_summary_of_a_cli_run_says_its_errors_in_the_clis_words(
 
 
 def test_ground_without_a_calibration_is_said_in_the_callers_words(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """run_batch(ground=True) on a pair with no calibration recorded "CliError: --ground needs
     --calib": the command line's option and an internal class of the CLI's in the Python API
@@ -3408,7 +3437,11 @@ def test_camera_folders_pair_a_side_of_one_image_at_the_other_sides_number(
     ],
 )
 def test_a_bad_scheduler_address_is_refused_when_every_pair_is_done(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str, says: str
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    address: str,
+    says: str,
+    in_process_dask: None,
 ) -> None:
     """``--scheduler`` was only read by Dask once a pair was to be done: a rerun with every pair
     done took any value and exited 0. It is refused before any work now, as Dask says it."""
@@ -3463,7 +3496,7 @@ def test_a_fifo_named_as_an_image_fails_its_pair_and_does_not_hang(
 
 
 def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, in_process_dask: None
 ) -> None:
     root = tmp_path / "in"
     _crops(root, data_dir, ["left/0001.png"], ["right/0001.png"])
