@@ -1245,7 +1245,7 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
 
 
 def test_batch_skipped_pairs_record_where_their_images_are_now(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """An input folder moved (its images' times kept) and run again: its pairs are skipped,
     and their records name the images where they are now. They named the old place, a path
@@ -1284,7 +1284,7 @@ def test_batch_skipped_pairs_record_where_their_images_are_now(
 
 
 def test_batch_a_skip_through_a_link_keeps_the_images_it_recorded(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A drive run as it is, then through a link to it (its pairs skipped): the skip rewrote
     the records to name the images through the link, so once the link was pointed at another
@@ -1391,7 +1391,7 @@ def test_batch_resumes_a_pair_written_by_a_run_killed_before_recording_it(
 
 
 def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """-o naming a folder with the user's own summary.json (not a batch summary): it was read
     as unreadable and replaced by the run's. Refused before any work, one line naming it."""
@@ -1770,6 +1770,7 @@ def test_a_second_batch_into_an_output_folder_in_use_is_refused(
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
+    in_process_dask: None,
 ) -> None:
     """A run started while another one writes into the same -o stops before any work, one
     line; each run replaced the whole summary with its own, so the one that finished last
@@ -1894,7 +1895,7 @@ def test_a_scene_with_only_q_dat_is_batched_with_depth(
 
 
 def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A scene's Q.dat is read before its pair is sent (8ab621e): one that is not a Q matrix
     stopped the whole run ('error: .../b/Q.dat: not a rectified Q matrix', exit 2, pair a left
@@ -1912,7 +1913,7 @@ def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
 
 
 def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A version 1 summary's entry without an outputs list takes the standard output names
     in its folder as its own, but no version 1 batch wrote overview.png (4715e5e came after
@@ -2364,7 +2365,7 @@ def test_the_progress_lines_estimate_the_time_left_from_the_pairs_pace(
 
 
 def test_scene_folders_linked_into_the_input_are_batched(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A drive's scenes linked into the input folder (in/b -> /data/b, camera folders too) were
     not entered: their pairs were left out without a word ('1 processed ... 0 failed', exit 0).
@@ -2395,7 +2396,7 @@ def test_scene_folders_linked_into_the_input_are_batched(
 
 
 def test_a_run_killed_while_writing_a_pair_leaves_no_temporary_folder_for_good(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, in_process_dask: None
 ) -> None:
     """A run killed (SIGKILL, the OOM killer) while writing a pair left its hidden temporary
     folder (.a.partial-1a2b3c4d, the pair's outputs) beside the pair's folder, and no run
@@ -2950,6 +2951,7 @@ def test_a_full_output_disk_that_the_summary_cannot_be_written_to_is_said(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
+    in_process_dask: None,
 ) -> None:
     """The disk full while the third pair was written, and summary.json (a long run's, written
     every few pairs) not writable either: the summary's own "[Errno 28] No space left on
@@ -3087,7 +3089,7 @@ def test_a_failed_pairs_error_that_cannot_say_its_message_is_its_type(exc: Excep
 
 
 def test_a_run_killed_without_calib_does_not_own_the_depth_names(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A run without --calib killed before recording its pair (pending, calib None) wrote no
     depth files: a cloud.ply the user put in the pair's folder is not taken for its output by a
@@ -3111,7 +3113,7 @@ def test_a_run_killed_without_calib_does_not_own_the_depth_names(
 
 
 def test_the_summary_of_a_cli_run_says_its_errors_in_the_clis_words(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """`stereovision batch` logged a pair's error in the CLI's words but recorded it in
     summary.json in Python's: "calib.scaled_to((225, 188))" for a resized pair, "give a
@@ -3514,7 +3516,7 @@ def test_a_pair_name_with_a_newline_is_shown_escaped_when_it_fails(
 
 
 def test_a_pair_output_folder_with_a_newline_is_shown_escaped_when_it_fails(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, in_process_dask: None
 ) -> None:
     """The pair's output folder (OUT/<name>/, its name from the images') was not among the
     paths its error line escapes (its images' and calib's alone, whose part is ``a\\nb.png``):
@@ -3552,7 +3554,7 @@ def test_a_scene_of_left_and_right_of_another_suffix_reads_its_calib(
 
 @pytest.mark.parametrize("address", ["ucx://10.0.0.1:13337", "inproc://10.0.0.1/123/1"])
 def test_a_scheduler_address_dask_reads_no_port_of_is_left_to_dask(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str, in_process_dask: None
 ) -> None:
     """The check read every address as a host and a port, which the UCX and in-process
     transports' addresses have none of to Dask before it connects: a UCX scheduler was refused
@@ -3568,7 +3570,7 @@ def test_a_scheduler_address_dask_reads_no_port_of_is_left_to_dask(
 
 
 def test_a_jpg_scene_with_a_kitti_calib_without_its_size_is_sized_by_its_left_jpg(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
     """A scene of left.jpg + right.jpg with a KITTI calib.txt lacking S_rect_02 failed its pair
     with "... pass image_size=(width, height)", Python advice a batch user cannot act on: the
