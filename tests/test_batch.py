@@ -3685,3 +3685,39 @@ def test_a_pair_whose_workers_die_says_the_workers_memory_share(
     )
     assert _summary(tmp_path / "out")["pairs"]["s"]["error"] == error
     assert lines == [f"failed s: {error}"]
+
+
+def test_process_pair_warnings_stay_with_their_pair_across_threads(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A worker with two threads (``dask worker --nthreads 2``, in-process workers) computes two
+    pairs at once: catch_warnings swapped process-wide state, so each warning given once both
+    had started went to the pair started last. Each pair keeps its own; the process's warning
+    state is restored after, and a later pair in the same thread still gets a warning from a
+    line an earlier pair warned from."""
+    from stereovision import batch
+
+    both = threading.Barrier(2, timeout=5)
+
+    def compute(task: dict[str, Any]) -> dict[str, Any]:
+        for i in range(2):
+            warnings.warn(f"{task['name']} {i}", UserWarning, stacklevel=2)
+            if task.get("wait"):
+                both.wait()
+        return {}
+
+    monkeypatch.setattr(batch, "_compute_pair", compute)
+    shown = warnings.showwarning
+    got: dict[str, list[str]] = {}
+
+    def run(name: str) -> None:
+        got[name] = batch.process_pair({"name": name, "wait": True})["warnings"]
+
+    threads = [threading.Thread(target=run, args=(n,)) for n in ("a", "b")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert got == {"a": ["a 0", "a 1"], "b": ["b 0", "b 1"]}
+    assert warnings.showwarning is shown
+    assert batch.process_pair({"name": "a"})["warnings"] == ["a 0", "a 1"]

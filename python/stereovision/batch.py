@@ -764,13 +764,71 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
     # Python does (".../dask/_task_spec.py:768: UserWarning: left: uint16 image ..." and a
     # source line, naming no pair, across the progress bar), or into a remote worker's log.
     # Shown as the CLI shows them: each text once, no ResourceWarning.
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("default")
-        warnings.simplefilter("ignore", ResourceWarning)
+    with _pair_warnings() as said:
         res = _compute_pair(task)
-    said = [str(w.message) for w in caught]
     res["warnings"] = [m for i, m in enumerate(said) if m not in said[:i]]
     return res
+
+
+#: The warnings of the pair each thread computes (:func:`_pair_warnings`).
+_PAIR_SINK = threading.local()
+_PAIR_LOCK = threading.Lock()
+#: Pairs being computed in this process, and the state they replaced (the first one's).
+_pair_count = 0
+_pair_state: contextlib.ExitStack | None = None
+
+
+@contextlib.contextmanager
+def _pair_warnings() -> Iterator[list[str]]:
+    """Collect the messages of the warnings this thread gives, as :func:`process_pair` returns
+    them.
+
+    ``warnings.catch_warnings`` swaps process-wide state: a worker computing two pairs at once
+    (``dask worker --nthreads 2``, a cluster's default; in-process workers) gave one pair's
+    warnings to the other, and the last to end could leave a finished pair's recorder in place.
+    The state is set once while any pair runs in this process (the first sets it, the last
+    restores it) and each warning goes to its own thread's pair; other threads' warnings are
+    shown as they were (with the pairs' filter meanwhile).
+    """
+    global _pair_count, _pair_state
+    caught: list[str] = []
+    with _PAIR_LOCK:
+        if _pair_count == 0:
+            stack = contextlib.ExitStack()
+            stack.enter_context(warnings.catch_warnings())
+            shown = warnings.showwarning
+
+            def show(
+                message: Warning | str,
+                category: type[Warning],
+                filename: str,
+                lineno: int,
+                file: Any = None,
+                line: str | None = None,
+            ) -> None:
+                sink = getattr(_PAIR_SINK, "caught", None)
+                if sink is None:
+                    shown(message, category, filename, lineno, file, line)
+                else:
+                    sink.append(str(message))
+
+            warnings.showwarning = show
+            _pair_state = stack
+        # set afresh for each pair: a filter set resets the registry that would hide a
+        # message an earlier pair gave from the same line ("default": once per line)
+        warnings.simplefilter("default")
+        warnings.simplefilter("ignore", ResourceWarning)
+        _pair_count += 1
+    _PAIR_SINK.caught = caught
+    try:
+        yield caught
+    finally:
+        _PAIR_SINK.caught = None
+        with _PAIR_LOCK:
+            _pair_count -= 1
+            if _pair_count == 0 and _pair_state is not None:
+                _pair_state.close()
+                _pair_state = None
 
 
 def _compute_pair(task: dict[str, Any]) -> dict[str, Any]:
