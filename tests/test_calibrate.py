@@ -2784,6 +2784,21 @@ def test_find_corners_reads_a_dark_uint16_board_at_its_own_range() -> None:
     assert np.abs(found - ref).max() < 0.02
 
 
+def test_a_black_uint16_board_image_is_no_board_without_a_warning_of_its_bits() -> None:
+    """A black 16-bit frame (a lens cap) gave find_corners, find_charuco_corners and calibrate's
+    reading the matchers' "uint16 image whose largest value is 0 ... scale it" warning, advice
+    that fits no black frame (the live search said nothing already, 11ef4916). No board, no
+    warning now."""
+    from stereovision.charuco import CharucoBoard, find_charuco_corners
+
+    black = np.zeros((240, 320), np.uint16)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert find_corners(black, (9, 6)) is None
+        board = CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_100")
+        assert find_charuco_corners(black, board) is None
+
+
 def test_render_chessboard_refuses_a_camera_matrix_not_of_opencvs_form() -> None:
     """A transposed K (MATLAB's IntrinsicMatrix) drew the board seen from a centre at (0, 0),
     70 % of the view background, without a word (render_plane refuses it since 1e068c28)."""

@@ -1273,12 +1273,15 @@ def _board_gray(image: object, what: str) -> npt.NDArray[np.uint8]:
     its brightest grey to 255, as ``depth_map``'s automatic range and the rectification check
     stretch a dark pair: cut to its top 8 bits, a 10-bit frame kept 4 grey levels, and the
     board's corners were found from them (OpenCV's chessboard pairs: RMS 0.30 px, 0.20 px at
-    8 bits). An 8-bit image is read as before."""
+    8 bits). A black one (a lens cap, a camera's first frame) is black, without the warning of
+    its bits ("largest value is 0 ... scale it"). An 8-bit image is read as before."""
     from stereovision._validate import as_gray_float, as_gray_uint8, as_image_array
     from stereovision.depth import _DARK_PAIR
 
     arr = as_image_array(image, what)
     if arr.dtype != np.uint8:
+        if not arr.any():
+            return np.zeros(arr.shape[:2], np.uint8)
         grey = as_gray_float(arr, what, warn=False)
         top = float(grey.max())
         if 0.0 < top < _DARK_PAIR:

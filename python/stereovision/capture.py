@@ -2811,18 +2811,15 @@ def save_pair(
 def _board_search_image(image: np.ndarray) -> np.ndarray:
     """``image`` as the live board searches read it: an 8-bit one as it is; one of more bits
     as 8-bit grey, a dark one (a 10- or 12-bit camera's frames in 16-bit PNGs) stretched by
-    the gain that brings its brightest grey to 255, as calibrate reads it (``_load_gray``).
+    the gain that brings its brightest grey to 255, as calibrate reads it (``_board_gray``).
     Cut to its top 8 bits, a 10-bit board of levels 120-426 kept 3 grey levels and was found in
-    no frame (calibrate found it in each), with a warning of its bits for every frame."""
+    no frame (calibrate found it in each), with a warning of its bits for every frame. A
+    black one is black, without that warning (``_board_gray``'s rules, one place)."""
     from stereovision._validate import as_image_array
-    from stereovision.calibrate import _load_gray
+    from stereovision.calibrate import _board_gray
 
     arr = as_image_array(image, "image")
-    if arr.dtype == np.uint8:
-        return arr
-    if not arr.any():  # a black frame (a lens cap): no board, and no warning of its bits
-        return np.zeros(arr.shape[:2], np.uint8)
-    return _load_gray(arr, "image")[0]
+    return arr if arr.dtype == np.uint8 else _board_gray(arr, "image")
 
 
 def detect_board_live(image: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | None:
