@@ -1867,6 +1867,35 @@ def test_view_of_a_scene_matches_the_scene_s_own_disparity_range(monkeypatch, re
     assert scene.max_disparity is not None and seen == [scene.max_disparity]
 
 
+def test_view_of_a_16_bit_scene_matches_its_16_bits(tmp_path, monkeypatch, result):
+    """view of a scene folder read its 16-bit PNGs at their top 8 bits (load_scene's imread)
+    where `depth`, `eval` and `bench` keep 16 (f8930bc): a 12-bit pair was matched from its
+    0-15 grey levels. It is matched as `depth` reads it now."""
+    import shutil
+
+    import cv2
+
+    from stereovision import depth
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import read_image
+
+    src = bundled_data_dir() / "cones"
+    shutil.copy(src / "calib.txt", tmp_path / "calib.txt")
+    for name in ("left.png", "right.png"):
+        img = cv2.imread(str(src / name), cv2.IMREAD_COLOR)[:60, :80]
+        cv2.imwrite(str(tmp_path / name), np.rint(img * (4095 / 255)).astype(np.uint16))
+    seen = []
+
+    def fake_depth_map(left, right, calib, **kwargs):
+        seen.append(left)
+        return result
+
+    monkeypatch.setattr(depth, "depth_map", fake_depth_map)
+    render.load_view_source(tmp_path)
+    assert seen[0].dtype == np.uint16 and seen[0].max() > 255
+    assert np.array_equal(seen[0], read_image(tmp_path / "left.png"))
+
+
 def test_a_mesh_without_colours_is_drawn_as_a_surface(mesh):
     """Only a cloud without colours is coloured by depth as points: a triangle mesh without
     RGB nor texture stays a surface."""

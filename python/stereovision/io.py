@@ -2033,8 +2033,8 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
         Scene directory.
     full_bits : bool
         Read a 16-bit ``left.png`` / ``right.png`` at its 16 bits (:func:`read_image`, as
-        ``stereovision depth`` and ``batch`` read them: ``eval`` and ``bench`` do); by default
-        their top 8 (:func:`imread`). 8-bit files are read alike either way.
+        ``stereovision depth`` and ``batch`` read them: ``eval``, ``bench`` and ``view`` do); by
+        default their top 8 (:func:`imread`). 8-bit files are read alike either way.
 
     Returns
     -------

@@ -1534,7 +1534,7 @@ def load_view_source(
             from stereovision.depth import depth_map
             from stereovision.io import load_scene, scene_too_narrow
 
-            scene = load_scene(p)
+            scene = load_scene(p, full_bits=True)  # a 16-bit pair as `depth` reads it
             if scene.calib is None:
                 raise ValueError(f"scene {p} has no calib.txt: no metric 3-D points to show")
             narrow = scene_too_narrow(scene)
