@@ -1638,6 +1638,23 @@ def test_points_outside_the_band_or_behind_the_grid_are_no_obstacle() -> None:
     assert (grid.data == -1).all()
 
 
+def test_a_point_past_int64_cells_is_outside_the_grid_without_a_cast_warning() -> None:
+    """A finite point 1e30 m ahead (its cell past int64) was NumPy's "RuntimeWarning: invalid
+    value encountered in cast" from ground.py (the cell was cast before the grid's bounds
+    were checked); it is outside the grid without a word, the other cells as before
+    (cell_of's far points alike, 627b9b5)."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    pts = _camera_points([(2.1, 0.6, 0.5)] * 3 + [(1e30, 0.0, 0.5), (0.0, -1e30, 0.5)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        grid = occupancy_grid(pts, plane, resolution=0.5, forward=(0, 4), lateral=(-2, 2))
+    want = np.full((8, 8), -1, np.int8)
+    want[5, 4] = 100
+    np.testing.assert_array_equal(grid.data, want)
+
+
 @pytest.mark.parametrize("seed", [-1, 1.5, True, "0"])
 def test_a_bad_seed_is_named(seed: object) -> None:
     """fit_ground_plane(seed=-1) was NumPy's 'expected non-negative integer' and 1.5 its

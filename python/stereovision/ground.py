@@ -1179,9 +1179,13 @@ def occupancy_grid(
     axes = floor_frame(plane)
     xyz = flat @ axes.T
     h = xyz[:, 2] + plane.height  # height above the floor
-    j = np.floor((xyz[:, 0] - x0) / res).astype(np.int64)
-    i = np.floor((xyz[:, 1] - y0) / res).astype(np.int64)
-    inside = (j >= 0) & (j < cols) & (i >= 0) & (i < rows)
+    fj = np.floor((xyz[:, 0] - x0) / res)
+    fi = np.floor((xyz[:, 1] - y0) / res)
+    # the cells are counted as floats, cast once inside: a finite point past int64's range
+    # (1e30 m away) was NumPy's "RuntimeWarning: invalid value encountered in cast"
+    inside = (fj >= 0) & (fj < cols) & (fi >= 0) & (fi < rows)
+    j = np.where(inside, fj, 0).astype(np.int64)
+    i = np.where(inside, fi, 0).astype(np.int64)
     obstacle = inside & (h > lo) & (h < hi)
     floor = inside & (np.abs(h) <= lo)
     n_obs = np.bincount(i[obstacle] * cols + j[obstacle], minlength=rows * cols)
