@@ -1546,7 +1546,10 @@ class _Dask:
 
 
 def _calib_payload(
-    path: Path, unit: str | None = None, size: tuple[int, int] | list[int] | None = None
+    path: Path,
+    unit: str | None = None,
+    size: tuple[int, int] | list[int] | None = None,
+    grey: bool = False,
 ) -> tuple[str, bytes]:
     """A calibration as one file's name and bytes for a worker: a ROS camera_info folder
     (left.yaml, right.yaml) is read here and shipped as this package's JSON, and so is a
@@ -1557,10 +1560,16 @@ def _calib_payload(
     A file is shipped as it is only when a lone copy of it reads as the same calibration: one
     camera's ROS camera_info (``left.yaml``, its partner beside it) or a KITTI file sized by
     the image beside it was shipped alone, and every pair failed in the worker ("its partner
-    ... is not beside it")."""
+    ... is not beside it"). ``grey``: a KITTI file read for its grey cameras 0 and 1
+    (:func:`_grey_kitti`)."""
     from stereovision.calibration import Calibration
 
     image_size = None if size is None else (int(size[0]), int(size[1]))
+    if grey:
+        calib = Calibration.from_kitti(path, image_size=image_size, cameras=(0, 1))
+        with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
+            out = calib.save(Path(tmp) / "calib.json")
+            return out.name, out.read_bytes()
     calib = Calibration.from_file(path, image_size=image_size, unit=unit)
     with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
         if path.is_file() and unit is None and size is None:
@@ -1577,8 +1586,44 @@ def _calib_payload(
         return out.name, out.read_bytes()
 
 
+#: KITTI's grey rig's camera folders (odometry's, a raw drive's), left and right.
+_KITTI_GREY = (("image_0", "image_1"), ("image_00", "image_01"))
+
+
+def _grey_kitti(job: PairJob) -> bool:
+    """Whether ``job`` is a pair of KITTI's grey cameras (``image_0/`` + ``image_1/``, a raw
+    drive's ``image_00/`` + ``image_01/``) calibrated by a KITTI file that holds them
+    (``P_rect_00``/``P_rect_01``, ``P0``/``P1``): read as the colour pair, as that file is
+    by default, their depths were 0.8 % short (baselines 0.537 against 0.533 m)."""
+    from stereovision.calibration import parse_kitti_calib
+
+    if job.calib is None or not job.calib.is_file():
+        return False
+    left, right = [x.lower() for x in job.left.parts], [x.lower() for x in job.right.parts]
+    if len(left) != len(right):
+        return False
+    if [(a, b) for a, b in zip(left, right, strict=True) if a != b] not in (
+        [pair] for pair in _KITTI_GREY
+    ):
+        return False
+    try:
+        if job.calib.stat().st_size > 65536:
+            return False
+        text = job.calib.read_text(encoding="utf-8")
+        if text.lstrip().startswith(("%YAML", "<?xml", "<opencv", "{")) or not re.search(
+            r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE
+        ):
+            return False  # read as another format (as Calibration.from_file orders them)
+        keys = parse_kitti_calib(job.calib)
+    except (OSError, UnicodeDecodeError, ValueError):
+        return False
+    return {"P_rect_00", "P_rect_01"} <= keys.keys() or {"P0", "P1"} <= keys.keys()
+
+
 def _task(
-    job: PairJob, opts: dict[str, Any], payloads: dict[Path, tuple[str, bytes]] | None = None
+    job: PairJob,
+    opts: dict[str, Any],
+    payloads: dict[tuple[Path, bool], tuple[str, bytes]] | None = None,
 ) -> dict[str, Any]:
     """A pair's task for a worker. ``payloads`` holds the run's calibrations already made
     ready (:func:`_calib_payload`): a ``--calib`` shared by every pair is read once a run,
@@ -1587,10 +1632,14 @@ def _task(
         payloads = {}
     calib = None
     if job.calib is not None:
-        calib = payloads.get(job.calib)
+        # a KITTI file calibrates the grey pairs by their own cameras (0 and 1)
+        key = (job.calib, _grey_kitti(job))
+        calib = payloads.get(key)
         if calib is None:
-            calib = _calib_payload(job.calib, opts.get("calib_unit"), opts.get("calib_size"))
-            payloads[job.calib] = calib
+            calib = _calib_payload(
+                job.calib, opts.get("calib_unit"), opts.get("calib_size"), grey=key[1]
+            )
+            payloads[key] = calib
     return {
         "name": job.name,
         "left": (str(job.left), job.left.read_bytes()),
@@ -2271,7 +2320,7 @@ def _run_jobs(
         limit = max(1, IN_FLIGHT_PER_WORKER * n_live)
         queue: Iterator[PairJob] = iter(todo)
         ac = as_completed()
-        payloads: dict[Path, tuple[str, bytes]] = {}
+        payloads: dict[tuple[Path, bool], tuple[str, bytes]] = {}
 
         def submit_next() -> bool:
             job = next(queue, None)
