@@ -1434,3 +1434,20 @@ def test_a_dark_uint16_board_is_read_at_its_own_range() -> None:
     assert ref is not None and found is not None
     np.testing.assert_array_equal(found[0], ref[0])
     assert np.abs(found[1] - ref[1]).max() < 0.02
+
+
+def test_resolve_reads_a_dark_uint16_board_at_its_own_range() -> None:
+    """CharucoBoard.resolve and markers_seen on a 12-bit board in a uint16 array used its top 8
+    bits with the matchers' 16-bit container warning, as find_charuco_corners did (c59fa44):
+    no board (None, ('', 0) markers) where the 8-bit image gives DICT_5X5_50 and 21 markers.
+    They stretch by the image's range now, as find_charuco_corners does."""
+    k = np.array([[300.0, 0.0, 159.5], [0.0, 300.0, 119.5], [0.0, 0.0, 1.0]])
+    rv, tv = np.array([0.15, -0.2, 0.05]), np.array([-0.15, -0.1, 0.42])
+    img = render_charuco(BOARD, k, None, rv, tv, image_size=(320, 240), supersample=2)
+    deep = np.rint(img * (4095 / 255)).astype(np.uint16)
+    auto = CharucoBoard("10x7", 0.03, 0.022)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert auto.markers_seen(deep) == ("DICT_5X5_50", 21)
+        found = auto.resolve(deep)
+    assert found is not None and found.dictionary == "DICT_5X5_50"

@@ -398,7 +398,8 @@ class CharucoBoard:
         Parameters
         ----------
         image : array_like
-            Grey or BGR image.
+            Grey or BGR image (a dark one of more than 8 bits stretched by its own range, as
+            :func:`find_charuco_corners` reads it).
 
         Returns
         -------
@@ -406,9 +407,9 @@ class CharucoBoard:
             The family's smallest dictionary that holds the board's markers (``""`` if none
             decodes any) and how many markers with the board's ids it decodes.
         """
-        from stereovision._validate import as_gray_uint8
+        from stereovision.calibrate import _board_gray
 
-        gray = as_gray_uint8(image, "image")
+        gray = _board_gray(image, "image")  # a dark 12-bit image at its own range (c59fa44)
         best, best_count = "", 0
         for members in DICTIONARY_FAMILIES.values():
             fitting = [name for name, size in members if size >= self.n_markers]
@@ -428,7 +429,8 @@ class CharucoBoard:
         Parameters
         ----------
         image : array_like
-            Grey or BGR image showing the board.
+            Grey or BGR image showing the board (a dark one of more than 8 bits stretched by
+            its own range, as :func:`find_charuco_corners` reads it).
 
         Returns
         -------
@@ -436,9 +438,9 @@ class CharucoBoard:
             A copy with ``dictionary`` and ``legacy`` decided (``self`` itself when both were
             known), or None if the image shows too few markers or corners to decide.
         """
-        from stereovision._validate import as_gray_uint8
+        from stereovision.calibrate import _board_gray
 
-        gray = as_gray_uint8(image, "image")
+        gray = _board_gray(image, "image")  # a dark 12-bit image at its own range (c59fa44)
         board = self
         if board.dictionary == "auto":
             best, best_count = self.markers_seen(gray)
