@@ -3873,3 +3873,29 @@ def test_depth_lists_its_files_in_a_folder_named_with_a_newline_one_per_line(
         for name in ("disparity.png", "disparity.pfm", "overview.png")
     ]
     assert (out / "disparity.pfm").is_file()
+
+
+def test_board_names_a_folder_with_a_newline_escaped_on_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """board's line of the file written (and of the one kept aside) printed its path as it is,
+    as depth's list did before: -o 'o\\nut/board.png' cut the line in two ('.../o' then
+    'ut/board.png: chessboard ...'), where its warnings show it escaped. One line now, the
+    newline escaped; calibrate's and check --fix's "(the one it replaced kept as ...)" alike
+    (io.replaced_words)."""
+    from stereovision.io import replaced_words
+
+    folder = tmp_path / "o\nut"
+    folder.mkdir()
+    shown = str(folder).replace("\n", "\\n")
+    board = folder / "board.png"
+    board.write_bytes(b"a picture of the user's")
+    argv = ["board", "-o", str(board), "--pattern", "3x3", "--square", "0.01", "--dpi", "50"]
+    assert main(argv) == 0
+    assert capsys.readouterr().out.splitlines()[0] == (
+        f"{shown}/board.png: chessboard 3x3 inner corners, square 0.01 m (the one it replaced "
+        f"kept as {shown}/board.previous.png)"
+    )
+    assert replaced_words(folder / "rig.previous.yaml", True) == (
+        f" (the one it replaced kept as {shown}/rig.previous.yaml)"
+    )

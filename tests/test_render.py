@@ -2373,3 +2373,25 @@ def test_the_depth_bar_of_a_flat_far_cloud_has_short_labels() -> None:
         finally:
             plotter.close()
         assert fmt % lo == label, (z, fmt % lo)
+
+
+def test_view_names_a_folder_with_a_newline_escaped_on_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """view -o's line printed the screenshot's path as it is: -o 'o\\nut/shot.png' cut it in
+    two ('3 points -> .../o' then 'ut/shot.png'), where its warnings show the path escaped.
+    One line now, the newline escaped, the copy kept aside too (the render is tested above)."""
+    from stereovision import cli
+    from stereovision.io import write_ply
+
+    monkeypatch.setattr(render, "render_view", lambda *a, **k: np.zeros((4, 4, 3), np.uint8))
+    pts = np.array([[0, 0, 2], [0.1, 0, 2], [0, 0.1, 2]], np.float32)
+    ply = write_ply(tmp_path / "c.ply", pts, np.full((3, 3), 200, np.uint8))
+    folder = tmp_path / "o\nut"
+    folder.mkdir()
+    (folder / "shot.png").write_bytes(b"the user's picture")
+    shown = str(folder).replace("\n", "\\n")
+    assert cli.main(["view", str(ply), "-o", str(folder / "shot.png")]) == 0
+    assert capsys.readouterr().out == (
+        f"3 points -> {shown}/shot.png (the one it replaced kept as {shown}/shot.previous.png)\n"
+    )

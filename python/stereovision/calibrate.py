@@ -59,7 +59,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path, whole_value
+from stereovision._validate import NOT_NUMBERS, as_path, escaped, whole_value
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
@@ -3179,7 +3179,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(description)
-    print(f"calibration written to {out}{replaced_words(kept, existed)}")
+    # a folder named with a newline cut the line in two (escaped, as errors name it)
+    print(f"calibration written to {escaped(str(out))}{replaced_words(kept, existed)}")
     if ros_dir is not None:
         try:
             # refused (a rig ROS cannot hold) before the earlier files are copied
@@ -3197,12 +3198,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
                 f"calibration written to {out}, but not as ROS camera_info: {exc}"
             ) from None
         print(
-            f"ROS camera_info written to {left_yaml} and {right_yaml}"
+            f"ROS camera_info written to {escaped(str(left_yaml))} and "
+            f"{escaped(str(right_yaml))}"
             + replaced_words(" and ".join(map(str, ros_kept)), existed, "the ones they", "they")
         )
     if args.report:
         paths = rep.write(args.report)
-        print(f"report written to {paths['html']}")
+        print(f"report written to {escaped(str(paths['html']))}")
     return 0
 
 
@@ -3319,7 +3321,9 @@ def cmd_board(args: argparse.Namespace) -> int:
     # the PNG's resolution makes the whole-pixel square its exact size (_board_scale)
     pix, ppm = _board_scale(square * UNIT_TO_METRES[args.unit], dpi)
     mm = 1000 / ppm
-    print(f"{out}: {what}" + (f" (the one it replaced kept as {kept})" if kept else ""))
+    # a folder named with a newline cut the line in two (escaped, as its warnings name it)
+    replaced = f" (the one it replaced kept as {escaped(str(kept))})" if kept else ""
+    print(f"{escaped(str(out))}: {what}{replaced}")
     print(
         f"{w}x{h} px at {ppm} px/m ({ppm * 0.0254:.2f} dpi: {pix} px per square at {dpi:g} "
         f"dpi); printed at 100 % scale it is {w * mm:.1f} x {h * mm:.1f} mm with "

@@ -33,7 +33,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path
+from stereovision._validate import NOT_NUMBERS, as_path, escaped
 from stereovision.baselines import round_up16
 
 if TYPE_CHECKING:
@@ -403,8 +403,8 @@ def replaced_words(
         `` (the one it replaced kept as X)``, `` (unchanged: it held this calibration)`` when
         the file held the new bytes already (no copy made), or ``""`` for a new file.
     """
-    if kept:
-        return f" ({replaced} replaced kept as {kept})"
+    if kept:  # escaped: a folder named with a newline cut the line in two
+        return f" ({replaced} replaced kept as {escaped(str(kept))})"
     return f" (unchanged: {held} held this calibration)" if existed else ""
 
 

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path
+from stereovision._validate import NOT_NUMBERS, as_path, escaped
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.depth import DepthResult
@@ -1747,8 +1747,9 @@ def cmd_view(args: argparse.Namespace) -> int:
         what = f"{shown} point{'s' if shown != 1 else ''}"  # a one-point cloud: "1 points"
     faces = geometry.n_faces
     what += f", {faces} triangle{'s' if faces != 1 else ''}" if faces else ""
-    replaced = f" (the one it replaced kept as {kept})" if kept else ""
-    print(f"{what} -> {out}{replaced}", file=sys.stdout)
+    # a folder named with a newline cut the line in two (escaped, as its warnings name it)
+    replaced = f" (the one it replaced kept as {escaped(str(kept))})" if kept else ""
+    print(f"{what} -> {escaped(str(out))}{replaced}", file=sys.stdout)
     return 0
 
 
