@@ -3899,3 +3899,29 @@ def test_board_names_a_folder_with_a_newline_escaped_on_one_line(
     assert replaced_words(folder / "rig.previous.yaml", True) == (
         f" (the one it replaced kept as {shown}/rig.previous.yaml)"
     )
+
+
+def test_rectify_suggests_a_depth_command_on_one_line_for_a_folder_with_a_newline(
+    crop_terrace: Callable[[slice, slice], Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """rectify's suggested depth command quoted its paths for the shell as they are: -o
+    'o\\nut' cut it into four lines ("stereovision depth '.../o", "ut/left_rect.png' '.../o",
+    ...), under a list of the files naming them escaped. Such a path is ANSI-C quoted now
+    ($'.../o\\nut/left_rect.png'): one line, which bash reads as the files written."""
+    scene = crop_terrace(slice(117, 217), slice(206, 356))  # of eth3d/terrace, 150x100
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    out = tmp_path / "o\nut"
+    assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if "stereovision depth " in s)
+    command = line.split("stereovision depth ", 1)[1].split(" -o OUT")[0]
+    assert command.startswith(f"$'{str(out).replace(chr(10), chr(92) + 'n')}/left_rect.png' ")
+    bash = shutil.which("bash")
+    if bash is None:  # the line is checked above; bash reads it back
+        return
+    said = subprocess.run(
+        [bash, "-c", f"printf '%s\\0' {command}"], capture_output=True, text=True, check=True
+    )
+    names = ("left_rect.png", "right_rect.png", "--calib", "calib_rect.yaml")
+    assert said.stdout.split("\0")[:-1] == [n if n[0] == "-" else str(out / n) for n in names]

@@ -1413,10 +1413,15 @@ def cmd_rectify(args: argparse.Namespace) -> int:
 def _shell_path(path: Path) -> str:
     """``path`` as a command the CLI suggests names it: quoted for the shell where it holds a
     space or another character the shell reads (``'my rect/left_rect.png'``), and a relative
-    one that starts with ``-`` after ``./`` (else read as an option)."""
+    one that starts with ``-`` after ``./`` (else read as an option). One with a control
+    character is ANSI-C quoted (``$'o\\nut/left_rect.png'``, as bash and zsh read it), its
+    characters escaped as :func:`escaped` shows them: quoted as it is, a newline cut the line."""
     text = str(path)
     if text.startswith("-"):
         text = f"./{text}"
+    shown = escaped(text)
+    if shown != text:  # "\n", "\x1b", "\u2028" and doubled backslashes: $'...' reads them so
+        return "$'" + shown.replace("'", "\\'") + "'"
     return shlex.quote(text)
 
 
