@@ -1118,6 +1118,13 @@ def cmd_check(args: argparse.Namespace) -> int:
         else f"the images as given have rows that agree already ({as_given.rows_agree()}): "
         "if they are rectified images (rectify's left_rect.png, a camera's image_rect)"
     )
+    # the end of the lines that leave the rig as it is (its check failing, --fix not writing):
+    # --fix's "calibrate the rig again" or "still fails" alone sent them to recalibrate
+    again = (
+        ""
+        if twice is None
+        else f"; but {twice}, the raw rig's calibration rectifies them again: give the raw images"
+    )
     if args.plot:
         from stereovision.io import keep_previous
         from stereovision.rectification_check import draw_rectification_check
@@ -1141,13 +1148,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     if res.ok is False and not res.swapped and not args.json and fix is None:
         print(
             "  the calibration no longer rectifies this rig: recalibrate, or correct the right "
-            "camera's pitch and roll with --fix OUT"
-            + (
-                ""
-                if twice is None
-                else f"; but {twice}, the raw rig's calibration rectifies them again: give the "
-                "raw images"
-            )
+            "camera's pitch and roll with --fix OUT" + again
             if calib is not None
             else "  these images are not rectified: give the rig's calibration (--calib), or "
             "rectify them from their own features (stereovision rectify LEFT RIGHT -o DIR)"
@@ -1191,7 +1192,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         if args.json:
             print(json.dumps(said))
         print(
-            f"stereovision: not corrected, nothing written to {escaped(str(fix))}: {why}",
+            f"stereovision: not corrected, nothing written to {escaped(str(fix))}: {why}{again}",
             file=sys.stderr,
         )
         return 1
@@ -1202,7 +1203,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     if not after.ok:
         if args.json:
             print(json.dumps(said))
-        print("stereovision: the corrected calibration still fails: not written", file=sys.stderr)
+        print(
+            f"stereovision: the corrected calibration still fails: not written{again}",
+            file=sys.stderr,
+        )
         return 1
     if twice is not None:
         warnings.warn(
