@@ -5225,3 +5225,32 @@ def test_an_image_the_format_cannot_hold_is_refused_without_opencvs_log_line(
     assert capfd.readouterr().err == ""
     paths = capmod.save_pair(tmp_path, 2, img.astype(np.uint16), img)
     assert cv2.imread(str(paths[0]), cv2.IMREAD_UNCHANGED).dtype == np.uint16
+
+
+def test_cli_capture_names_a_folder_with_a_newline_escaped_on_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """capture's last line, and its line of a killed capture's temporary files removed,
+    printed -o as it is: 'o\\nut' cut them in two ('3 pairs saved in .../o' then 'ut (end of
+    stream); ...'), as depth's list of files did before 895b579. One line each now, the
+    newline escaped (the "saved" lines name the files alone)."""
+    from stereovision.cli import main
+
+    seq = tmp_path / "seq"
+    seq.mkdir()
+    for i in range(2):
+        for side in ("left", "right"):
+            cv2.imwrite(str(seq / f"{side}_{i:03d}.png"), np.full((8, 12), 10 * i, np.uint8))
+    out = tmp_path / "o\nut"
+    out.mkdir()
+    (out / ".left_0003.png.k3x_9a2b.tmp").write_bytes(b"")  # left by a killed capture
+    shown = str(out).replace("\n", "\\n")
+    argv = ["capture", "--left", str(seq / "left_%03d.png"), "--right", str(seq / "right_%03d.png")]
+    assert main([*argv, "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == (
+        f"removed 1 temporary file an interrupted capture left in {shown}: "
+        ".left_0003.png.k3x_9a2b.tmp"
+    )
+    assert lines[-1].startswith(f"2 pairs saved in {shown} (end of stream); 2 pairs read; ")
+    assert len(lines) == 5 and (out / "right_0002.png").is_file()

@@ -59,6 +59,7 @@ from stereovision._validate import (
     NOT_NUMBERS,
     as_image_array,
     as_path,
+    escaped,
     float_sized,
     path_given,
     positive_whole,
@@ -3209,7 +3210,7 @@ def capture(
     if stale and log is not None:
         log(
             f"removed {len(stale)} temporary file{'s' if len(stale) > 1 else ''} an interrupted "
-            f"capture left in {out}: {', '.join(stale)}"
+            f"capture left in {escaped(str(out))}: {', '.join(stale)}"
         )
     index = next_pair_index(out)
     saved: list[tuple[Path, Path]] = []
@@ -3589,7 +3590,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         n = saved[0]  # the pair being saved is saved whole, and said
         print(
-            f"stereovision: {what}: {_pairs(n)} saved in {args.output} this run "
+            f"stereovision: {what}: {_pairs(n)} saved in {escaped(args.output)} this run "
             f"{'is' if n == 1 else 'are'} kept; run "
             "again to add more",
             file=sys.stderr,
@@ -3599,8 +3600,9 @@ def cmd_capture(args: argparse.Namespace) -> int:
         bar.close()  # off the screen before the last words (or the error)
         cam.close()
     sk = result.skew
+    # a folder named with a newline cut the line in two (escaped, as errors name it)
     print(
-        f"{_pairs(len(result.saved))} saved in {args.output} ({result.ended}); "
+        f"{_pairs(len(result.saved))} saved in {escaped(args.output)} ({result.ended}); "
         f"{_pairs(result.frames_read)} read; delivered {cam.describe()}; "
         f"skew mean {sk['mean_ms']:.2f} ms, max {sk['max_ms']:.2f} ms"
     )
