@@ -7106,3 +7106,93 @@ def test_a_load_or_scene_taken_after_a_failure_clears_it_before_computing(tmp_pa
     app._on_scene(scene=str(bundled_data_dir() / "cones"))
     assert (app.state.error, app.state.source_label, len(spawned)) == ("", "scene data/cones", 1)
     spawned.pop().close()
+
+
+def test_a_click_refused_while_a_pair_computes_stays_said_after_it(tmp_path, monkeypatch):
+    """A Load of a missing file, a Show, an Open, a scene, a Play, a Capture or a Save refused
+    while a pair computed was said until the computation's end, which then said "ready" and
+    cleared it ("no such file: cones/none.png" gone, as if the files had been taken; a Save
+    whose writer failed, as if saved). The refusal now stays after it, as a camera's read."""
+    import asyncio
+    import threading
+
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-click-refused-while-computing", [bundled_data_dir(), tmp_path])
+    left, right = (cv2.imread(str(CONES / f"{s}.png"))[150:190] for s in ("left", "right"))
+    app.pair = app.raw_pair = (left, right)  # 40 rows of the cones: fast
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "overview.png").write_bytes(b"")
+    st = app.state
+    computed, written = threading.Event(), threading.Event()
+    real = gui_app.compute_view
+
+    def gated(*args: Any, **kwargs: Any) -> Any:
+        computed.wait(2.0)  # bounded: a broken app cannot hang the test
+        return real(*args, **kwargs)
+
+    def failing_write(*_: Any) -> list[str]:
+        written.wait(2.0)  # fails once the pair computes
+        raise OSError("disk full")
+
+    monkeypatch.setattr(gui_app, "compute_view", gated)
+
+    def load() -> None:
+        st.left_file, st.right_file = "cones/none.png", "cones/right.png"
+        app.load_files()
+
+    def show() -> None:
+        st.cloud_path = "cones/none.ply"
+        app.open_cloud()
+
+    def open_twice() -> None:
+        st.cam_left = st.cam_right = "/dev/video0"
+        app.open_cameras()
+
+    def play() -> None:
+        st.pair_folder = "cones/left.png"
+        app.open_pair_folder()
+
+    clicks = [
+        (load, "no such file: cones/none.png"),
+        (show, "no such file: cones/none.ply"),
+        (open_twice, "the left and right fields are both camera /dev/video0: give the rig's"),
+        (lambda: app._on_scene(scene="nowhere"), "no such file: nowhere"),
+        (play, "not a folder: data/cones/left.png"),
+        (app.capture, "no camera open: give --left/--right or open cameras below"),
+        (lambda: app.save_clicked("mine"), f"save: {tmp_path.name}/mine already holds "),
+    ]
+
+    async def run() -> list[tuple[str, str]]:
+        app._lock = asyncio.Lock()
+        app._spawn = asyncio.ensure_future
+        computed.set()
+        await app.recompute()  # a result on show (a Save needs one)
+        said = []
+        for click, _ in clicks:
+            computed.clear()
+            computing = asyncio.ensure_future(app.recompute())
+            await _until(lambda: app._computing)
+            click()
+            await asyncio.sleep(0.01)  # a Save's task runs to its refusal
+            computed.set()
+            await computing
+            said.append((st.status, st.error))
+        app._write_save = failing_write  # a Save under way when the pair starts computing
+        st.save_dir = ""
+        saving = asyncio.ensure_future(app.save())
+        await asyncio.sleep(0.01)
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        written.set()
+        await saving
+        await computing
+        said.append((st.status, st.error))
+        return said
+
+    said = asyncio.run(run())
+    assert st.computations == 1 + len(clicks) + 1
+    for (status, error), (_, start) in zip(said, clicks, strict=False):
+        assert status == "error" and error.startswith(start), (status, error)
+    assert said[-1][0] == "error" and said[-1][1].endswith("disk full"), said[-1]

@@ -1804,8 +1804,10 @@ class StereoApp:
 
     def _fail(self, exc: BaseException, path: Path | None = None, outlasts: bool = False) -> None:
         """Say ``exc`` on the page (its first line), ``path`` in it as the page shows paths
-        (:func:`short_paths`) when given. With ``outlasts`` (a camera's read or open), an error
-        said while a pair computes stays on the page after the computation's end."""
+        (:func:`short_paths`) when given. With ``outlasts`` (a camera's read or open, a click
+        refused: a Load, a Show, an Open, a Save), an error said while a pair computes stays on
+        the page after the computation's end (it cleared a missing file's "no such file", as
+        if the click had been taken)."""
         if isinstance(exc, BUG_ERRORS):  # caught as a RuntimeError by the handlers: a bug
             exc = _as_said(exc, "an action")
         said = short_paths(_message(exc), path) if path is not None else ""
@@ -2015,7 +2017,7 @@ class StereoApp:
         try:
             self._load_scene(scene)
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             # the list shows the scene on show again, so that choosing the failed one retries
             # (trame reports only a changed value)
             self.state.scene = self._scene or None
@@ -2067,7 +2069,7 @@ class StereoApp:
                     f"it{replug}"
                 )
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         average = bool(self.state.average)
         self._begin_read(source, what)
@@ -2267,7 +2269,7 @@ class StereoApp:
                     "returned): wait for it, or unplug and replug the camera"
                 )
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail_open(exc, outlasts=False)
+            self._fail_open(exc)
             return
         names = (str(self.state.cam_left), str(self.state.cam_right))
         self._choice += 1
@@ -2421,7 +2423,7 @@ class StereoApp:
                 raise NotADirectoryError(f"not a folder: {label}")
             source = FolderPairs(folder, label, keep=self.folders.contains)
         except (ValueError, OSError) as exc:
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         self._choice += 1  # an open still under way must not replace these pairs
         what = self._source_what(source)
@@ -2483,7 +2485,7 @@ class StereoApp:
             same = check_pair_files(left, right, lpath, rpath, names=labels)
             c, note = self._calib_for(left), ""
         except (ValueError, OSError) as exc:
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         self._choice += 1  # an open still under way must not replace these files
         self.pair = self.raw_pair = (left, right)
@@ -2522,7 +2524,7 @@ class StereoApp:
             del pts, cols  # the drawn subset is a copy: the file's arrays can go
         except (ValueError, OSError) as exc:
             # the file as the page shows paths, not its whole absolute path
-            self._fail(exc, path)
+            self._fail(exc, path, outlasts=True)
             return
         self._cloud = cloud
         self._cloud_caption = f"{label}: {count}"
@@ -2958,7 +2960,7 @@ class StereoApp:
                 )
             check_output_folder(folder, "save folder")
         except (ValueError, OSError) as exc:
-            self._fail(exc, folder)
+            self._fail(exc, folder, outlasts=True)
             return
 
         # The 3-D view rendered here, in the thread that renders the page's view (VTK's
@@ -2988,12 +2990,13 @@ class StereoApp:
             )
         except SaveFailed as exc:
             msg = short_paths(f"save: {exc}; nothing was saved in {label}", target)
-            self._fail(ValueError(msg))
+            self._fail(ValueError(msg), outlasts=True)
             with self.state:
                 self.state.save_label = msg
             return
         except Exception as exc:
-            self._fail(exc if isinstance(exc, CliError) else _as_said(exc, "saving"), target)
+            said = exc if isinstance(exc, CliError) else _as_said(exc, "saving")
+            self._fail(said, target, outlasts=True)
             return
         finally:
             self._saving_into.discard(target)
