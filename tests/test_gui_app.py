@@ -6995,7 +6995,13 @@ def test_a_scene_put_back_after_another_failed_keeps_its_gt_figures(tmp_path):
     choose("good")
     assert ", on GT bad-2.0 " in app.state.stats
     choose("tiny")
-    assert app.state.error.endswith("(the page still shows the previous pair)")
+    # the scene's own range in eval's words: "disparity range 16 is not smaller than the
+    # image width 8" named a range nobody gave
+    assert app.state.error == (
+        "images 8 px wide, not wider than the scene's disparity range (16 px, evaluation.md's "
+        "rule: 16 at least): a scene needs images at least 17 px wide, or give a max_disparity "
+        "below 8 (the page still shows the previous pair)"
+    )
     app._on_method()  # computed again (a method or resolution chosen)
     assert app.state.error == "" and ", on GT bad-2.0 " in app.state.stats
 

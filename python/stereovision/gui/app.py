@@ -42,6 +42,7 @@ import numpy.typing as npt
 
 from stereovision import release_memory
 from stereovision._validate import (
+    ADVICE,
     BUG_ERRORS,
     _message,
     advice_for,
@@ -1513,6 +1514,9 @@ class StereoApp:
         self.raw_pair: tuple[np.ndarray, np.ndarray] | None = None
         self.calib: Any = None
         self._scene_gt: tuple[Any, Any] = (None, None)
+        #: Why the scene on show cannot be matched over its own range (:func:`scene_too_narrow`),
+        #: with the pair it belongs to, or None.
+        self._scene_narrow: tuple[Any, str | None] = (None, None)
         #: Why the pair has no calibration when ``--calib`` would not help (a scene without
         #: calib.txt, files another calibration does not fit); None: "give --calib".
         self._no_calib: str | None = None
@@ -1859,7 +1863,7 @@ class StereoApp:
     # ------------------------------------------------------------------------- sources
 
     def _load_scene(self, path: str | Path) -> None:
-        from stereovision.io import load_scene
+        from stereovision.io import load_scene, scene_too_narrow
 
         scene_dir = self.folders.resolve(path) if Path(path) != self.demo_scene else Path(path)
         scene = load_scene(scene_dir)
@@ -1868,6 +1872,7 @@ class StereoApp:
         #: dense one's bad-2.0, are said while that pair is computed as given: not after
         #: Rectify, nor for another pair).
         self._scene_gt = (self.pair, scene.gt)
+        self._scene_narrow = (self.pair, scene_too_narrow(scene))
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
         self.homographies = None  # another rig
@@ -2568,6 +2573,11 @@ class StereoApp:
             gt = None
             if self._scene_gt[0] is self.pair and (calib is None or calib.rectified):
                 gt = self._scene_gt[1]
+            # the scene's range, not one typed in the field, too wide for its images
+            narrow = self._scene_narrow[1] if self._scene_narrow[0] is self.pair else None
+            narrow = narrow if chosen is None else None
+            if narrow is not None and left.shape[1] >= 2:
+                narrow += ", or " + ADVICE["range"]["page"].format(n=left.shape[1])
             method = self.state.method
             res = self.state.resolution
             width = None if res == "full" else int(res)
@@ -2605,6 +2615,16 @@ class StereoApp:
                         progress=progress,
                         gt=gt,
                     )
+                except ValueError as exc:
+                    # the scene's own range (evaluation.md's 16 px on a pair 8 px wide) was named
+                    # as one given: "disparity range 16 is not smaller than the image width 8"
+                    if narrow is None or d_max is None:
+                        raise
+                    from stereovision.depth import _range_too_wide
+
+                    if str(exc) != str(_range_too_wide(d_max, left.shape[1])):
+                        raise
+                    raise ValueError(narrow) from None
                 finally:
                     # A click is no frame loop: hand the extension's kept buffers and the C
                     # heap's free pages back (a 3600 x 3000 pair left the server at 11 GB).
@@ -2684,6 +2704,7 @@ class StereoApp:
             # its GT with it: a scene that failed to compute left its own, and the pair put
             # back lost its statistics' GT figures (bad-2.0, precision@1) from then on
             "_scene_gt": self._scene_gt,
+            "_scene_narrow": self._scene_narrow,
             # put back with the pair: a Capture says so over a scene or files, not over cameras
             "_other_on_show": self._other_on_show,
         }
