@@ -6963,13 +6963,21 @@ def test_fail_says_a_path_with_a_newline_escaped_on_its_one_line(tmp_path):
     pytest.importorskip("trame")
     from stereovision.gui import bundled_data_dir
 
-    app = _scene_app("test-fail-path-newline", [bundled_data_dir()])
+    app = _scene_app("test-fail-path-newline", [bundled_data_dir(), tmp_path])
     path = tmp_path / "my\ncloud.ply"
     app._fail(ValueError(f"not a PLY file: {path}\nsecond line"), path)
     assert app.state.error == f"not a PLY file: {tmp_path}/my\\ncloud.ply"
     plain = tmp_path / "cloud.ply"
     app._fail(ValueError(f"not a PLY file: {plain}"), plain)
     assert app.state.error == f"not a PLY file: {plain}"
+    # a Load of files so named was cut alike: "no such file: cones/no", "cannot decode .../my"
+    app.state.left_file, app.state.right_file = "cones/no\nne.png", "cones/right.png"
+    app.load_files()
+    assert app.state.error == "no such file: cones/no\\nne.png"
+    (tmp_path / "my\nleft.png").write_bytes(b"not an image")
+    app.state.left_file = str(tmp_path / "my\nleft.png")
+    app.load_files()
+    assert app.state.error == f"cannot decode {tmp_path}/my\\nleft.png as an image"
 
 
 def test_a_scene_put_back_after_another_failed_keeps_its_gt_figures(tmp_path):

@@ -31,7 +31,7 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -1806,18 +1806,27 @@ class StereoApp:
     def _on_save_dir(self, save_dir: str | None = None, **_: Any) -> None:
         self.state.save_dir_title = self._save_title(save_dir)
 
-    def _fail(self, exc: BaseException, path: Path | None = None, outlasts: bool = False) -> None:
+    def _fail(
+        self,
+        exc: BaseException,
+        path: Path | None = None,
+        outlasts: bool = False,
+        typed: Iterable[object] = (),
+    ) -> None:
         """Say ``exc`` on the page (its first line), ``path`` in it as the page shows paths
-        (:func:`short_paths`) when given. With ``outlasts`` (a camera's read or open, a click
-        refused: a Load, a Show, an Open, a Save), an error said while a pair computes stays on
-        the page after the computation's end (it cleared a missing file's "no such file", as
-        if the click had been taken)."""
+        (:func:`short_paths`) when given, ``path`` and the names ``typed`` in it escaped (a
+        newline in one cut the line there: :func:`first_line`). With ``outlasts`` (a camera's
+        read or open, a click refused: a Load, a Show, an Open, a Save), an error said while a
+        pair computes stays on the page after the computation's end (it cleared a missing
+        file's "no such file", as if the click had been taken)."""
         if isinstance(exc, BUG_ERRORS):  # caught as a RuntimeError by the handlers: a bug
             exc = _as_said(exc, "an action")
         said = short_paths(_message(exc), path) if path is not None else ""
         # shortened before first_line escapes a control character in the path (the replace
         # missed it then), and said with the path escaped: a newline in it cut the line there
-        msg = first_line(ValueError(said), [path]) if said.strip() else first_line(exc)
+        msg = (
+            first_line(ValueError(said), [path, *typed]) if said.strip() else first_line(exc, typed)
+        )
         log.info("gui error: %s", msg)
         with self.state:
             self.state.error = msg
@@ -2490,7 +2499,8 @@ class StereoApp:
             same = check_pair_files(left, right, lpath, rpath, names=labels)
             c, note = self._calib_for(left), ""
         except (ValueError, OSError) as exc:
-            self._fail(exc, outlasts=True)
+            # a file named with a newline: "cannot decode .../bad" for bad\n.png
+            self._fail(exc, outlasts=True, typed=(self.state.left_file, self.state.right_file))
             return
         self._choice += 1  # an open still under way must not replace these files
         self.pair = self.raw_pair = (left, right)

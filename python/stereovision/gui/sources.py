@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import escaped
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
     _camera_device,
@@ -226,7 +227,9 @@ class AllowedFolders:
         if not text or "\x00" in text:
             raise ValueError("empty or invalid path")
         p = expand_home(text)
-        said = mask_url_secrets(text)  # a stream URL typed: its password is not said
+        # a stream URL typed: its password is not said; a newline in a name typed, escaped (it
+        # cut the page's one-line error there: "no such file: a" for a\nb.png)
+        said = escaped(mask_url_secrets(text))
         if not p.is_absolute():
             if not self.roots:
                 raise ValueError(f"path outside the allowed folders: {said}")
@@ -267,7 +270,7 @@ class AllowedFolders:
             p = allowed[0] / p
         real = real_path(p)  # the existing part's links resolved, the rest as written
         if not any(real == r or real.is_relative_to(r) for r in allowed):
-            raise ValueError(f"folder outside the --data folders: {text}")
+            raise ValueError(f"folder outside the --data folders: {escaped(text)}")
         return real
 
     def contains(self, path: str | os.PathLike[str]) -> bool:
