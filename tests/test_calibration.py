@@ -1933,6 +1933,10 @@ def test_rectify_points_of_a_rectified_rig_are_a_copy() -> None:
 def test_ideal_refuses_an_infinite_baseline_by_name() -> None:
     with pytest.raises(ValueError, match=r"^baseline_m: expected a positive number of metres"):
         Calibration.ideal((640, 480), 90.0, float("inf"))
+    # |T| of a 1e-300 m baseline underflows to 0: it was "T: zero baseline", naming no argument
+    with pytest.raises(ValueError, match=r"^baseline_m: .* got 1e-300 \(too small to compute"):
+        Calibration.ideal((640, 480), 90.0, 1e-300)
+    assert Calibration.ideal((640, 480), 90.0, 1e-150).baseline_m == 1e-150
 
 
 def test_from_q_reads_a_negative_multiple_and_refuses_a_q31(tmp_path: Path) -> None:

@@ -603,6 +603,20 @@ def test_info_on_paper_refuses_a_baseline_past_1000_km(
     assert "farthest depth, at a disparity of 1 px: 640000000.00 m" in capsys.readouterr().out
 
 
+def test_info_on_paper_names_baseline_for_one_too_small_to_compute_with(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``info --baseline 1e-300`` said the library's "T: zero baseline (T = [-1e-300, ...])",
+    naming no option given: its square underflows, and it is now refused as --baseline."""
+    assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", "1e-300"]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.splitlines() == [
+        "stereovision: error: --baseline: expected a positive number of metres, got 1e-300 "
+        "(too small to compute with)"
+    ]
+
+
 @pytest.mark.parametrize("option", ["--forward", "--up", "--right"])
 @pytest.mark.parametrize("value", ["1e308", "-1000001", "nan", "inf"])
 def test_view_refuses_a_camera_move_past_its_limit_in_one_line(

@@ -20,6 +20,7 @@ import math
 import os
 import re
 import reprlib
+import sys
 from collections.abc import Iterable, Sequence
 from contextvars import ContextVar
 from dataclasses import dataclass, field
@@ -1777,6 +1778,13 @@ class Calibration:
         ):
             raise ValueError(
                 f"baseline_m: expected a positive number of metres, got {baseline_m!r}"
+            )
+        if float(baseline_m) ** 2 < sys.float_info.min:
+            # |T| squares it: below ~1.5e-154 m that underflows, and a 1e-300 m rig was refused
+            # as the calibration's "T: zero baseline", naming no argument given
+            raise ValueError(
+                f"baseline_m: expected a positive number of metres, got {baseline_m!r} "
+                "(too small to compute with)"
             )
         w, h = size
         f = w / (2 * math.tan(math.radians(hfov_deg) / 2))
