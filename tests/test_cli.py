@@ -365,6 +365,22 @@ def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path)
     assert "are the same image: every disparity comes out 0" in proc.stderr
 
 
+def test_depth_of_one_blank_frame_twice_says_no_disparity_comes_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two identical blank frames warned "every disparity comes out 0" before the matching,
+    yet none came out (density 0 %): the warning now says what the result holds."""
+    assert cv2.imwrite(str(tmp_path / "blank.png"), np.full((40, 64), 128, np.uint8))
+    img = str(tmp_path / "blank.png")
+    assert main(["depth", img, img, "--method", "fast", "-o", str(tmp_path / "o")]) == 0
+    out, err = capsys.readouterr()
+    assert "density 0.0 %" in out
+    assert err == (
+        f"stereovision: warning: {img} and {img} are the same image: no disparity comes out "
+        "(two views of the scene are needed)\n"
+    )
+
+
 def test_depth_on_a_pair_too_small_says_only_that(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -812,12 +812,6 @@ def cmd_depth(args: argparse.Namespace) -> int:
         _check_pair(left, right, None, max_disparity)
     elif calib is not None:  # a calibration for another image size, refused alone too
         _check_pair(left, right, calib, max_disparity)
-    if same:
-        warnings.warn(
-            f"{args.left} and {args.right} are the same image: every disparity comes out 0 "
-            "(two views of the scene are needed)",
-            stacklevel=1,
-        )
     counts: dict[str, int] = {}
     removed: list[Path] = []
     unfiltered: list[Any] = []
@@ -845,6 +839,13 @@ def cmd_depth(args: argparse.Namespace) -> int:
         removed=removed,
         unfiltered=unfiltered,
     )
+    if same:  # said of the result: a blank frame twice has no disparity at all, not 0 everywhere
+        found = "every disparity comes out 0" if res.density > 0 else "no disparity comes out"
+        warnings.warn(
+            f"{args.left} and {args.right} are the same image: {found} "
+            "(two views of the scene are needed)",
+            stacklevel=1,
+        )
     cloud = (
         f"{_depth_range(res.depth, unit)}, {len(res.points)} points"
         if res.depth is not None
