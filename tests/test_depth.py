@@ -1831,3 +1831,11 @@ def test_a_bad_range_or_method_is_said_in_one_short_line(call, name):
     assert "\n" not in msg
     assert "array of shape (4, 4) dtype float64" in msg
     assert (name if name != "method" else "unknown method") in msg
+
+
+def test_to_ply_of_an_empty_path_names_it() -> None:
+    """``to_ply('')`` said ": to_ply writes a .ply file ...", the path that was wrong not shown."""
+    img = np.tile(np.arange(32, dtype=np.uint8) * 8, (8, 1))
+    res = sv.depth_map(img, img, _rect_calib(32, 8), method="fast", max_disparity=8)
+    with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
+        res.to_ply("")

@@ -1805,3 +1805,17 @@ def test_rectifications_compare_and_hash_by_identity(tmp_path: Path) -> None:
     a, b = UncalibratedRectification.load(path), UncalibratedRectification.load(path)
     assert a == a and a != b and b not in [a]
     assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2
+
+
+def test_an_empty_rectification_path_is_named() -> None:
+    """``save('')`` said "cannot write .: it is a folder" and ``load('')`` "rectification file
+    not found: . is a folder": a folder no one named. Both now name the empty path."""
+    ident = np.eye(3)
+    rect = UncalibratedRectification(
+        ident, ident, (8, 8), (8, 8), np.zeros((3, 3)), 100, 0.0, 0.0, (0.0, 20.0), 32,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
+        rect.save("")
+    with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
+        UncalibratedRectification.load("")

@@ -1016,13 +1016,15 @@ class DepthResult:
         Raises
         ------
         ValueError
-            If the result has no calibration (no metric points to write).
+            If the result has no calibration (no metric points to write), or ``path`` is empty
+            or not a ``.ply`` file.
         """
         from stereovision.io import write_ply
 
         if self.depth is None:
             raise ValueError(NO_DEPTH.format(what="point cloud"))
-        as_path(path)
+        # '' was ": to_ply writes a .ply file", naming nothing
+        as_path(path, file=True)
         if Path(path).suffix.lower() != ".ply":
             raise ValueError(
                 f"{path}: to_ply writes a .ply file (export.write_pcd writes .pcd, "

@@ -566,7 +566,7 @@ class UncalibratedRectification:
         from stereovision._jsonout import json_ready
         from stereovision.io import atomic_write
 
-        as_path(path)
+        as_path(path, file=True)  # '' was "cannot write .: it is a folder"
         p = Path(path)
         # strict JSON, as the package's other JSON: a NaN or infinite figure was written as
         # the bare NaN / Infinity that jq and JavaScript refuse; it is null, read back as NaN
@@ -594,11 +594,12 @@ class UncalibratedRectification:
         FileNotFoundError
             If it does not exist (a link to nothing: its target named).
         ValueError
-            If it is not a regular file (a FIFO) or not such a file (the field named), or its
+            If ``path`` is empty, if it is not a regular file (a FIFO) or not such a file (the
+            field named), or its
             values cannot rectify a pair
             (NaN or singular homographies, sizes of 0 or less, an unknown model).
         """
-        as_path(path)
+        as_path(path, file=True)  # '' was "not found: . is a folder", a folder not named
         p = Path(path)
         if p.is_dir():  # "not found" alone, of a folder that is there (the type kept: API)
             inside = p / "rectification.json"
