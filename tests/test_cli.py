@@ -3859,7 +3859,31 @@ def test_rectify_keeps_a_16_bit_pair_at_16_bits(data_dir: Path, tmp_path: Path) 
         written = cv2.imread(str(out / name), cv2.IMREAD_UNCHANGED)
         assert written.dtype == np.uint16
         grey = cv2.imread(str(given), cv2.IMREAD_ANYDEPTH)
-        np.testing.assert_array_equal(written, np.dstack([grey] * 3))  # as imread's 3 channels
+        # one channel, as the file given (it was three equal ones, read_image's BGR)
+        np.testing.assert_array_equal(written, grey)
+
+
+def test_rectify_with_calib_writes_a_grey_pair_grey(tmp_path: Path) -> None:
+    """A grey pair rectified by a calibration was written as 3-channel PNGs (read_image's BGR,
+    three equal channels): each is now written with its file's one channel, the same values."""
+    from stereovision.calibration import Calibration
+
+    rng = np.random.default_rng(3)
+    pair = [tmp_path / "left.png", tmp_path / "right.png"]
+    for path in pair:
+        assert cv2.imwrite(str(path), rng.integers(0, 256, (48, 64), dtype=np.uint8))
+    k = np.array([[60.0, 0.0, 31.5], [0.0, 60.0, 23.5], [0.0, 0.0, 1.0]])
+    tilt = cv2.Rodrigues(np.array([0.0, 0.05, 0.02]))[0]
+    rig = Calibration(k, np.zeros(5), k.copy(), np.zeros(5), tilt, np.array([-0.1, 0.0, 0.0]),
+                      image_size=(64, 48), unit="m")  # fmt: skip
+    rig.save(tmp_path / "rig.yaml")
+    argv = ["rectify", *map(str, pair), "--calib", str(tmp_path / "rig.yaml")]
+    assert main([*argv, "-o", str(tmp_path / "rect")]) == 0
+    bgr = [cv2.imread(str(path)) for path in pair]
+    for name, want in zip(("left_rect.png", "right_rect.png"), rig.rectify(*bgr), strict=True):
+        written = cv2.imread(str(tmp_path / "rect" / name), cv2.IMREAD_UNCHANGED)
+        assert written.shape == (48, 64) and written.dtype == np.uint8
+        np.testing.assert_array_equal(written, want[..., 0])
 
 
 def test_rectify_suggests_a_depth_command_the_shell_reads_for_a_folder_with_a_space(

@@ -1250,6 +1250,20 @@ RECTIFY_OUTPUTS = (
 RECTIFY_MANIFEST = ".stereovision-rectify.json"
 
 
+def _as_file_channels(img: np.ndarray, path: str) -> np.ndarray:
+    """A rectified image with the channels of the file it came from: a grey file is read as
+    three equal channels (read_image's BGR), and was written back as a colour PNG (16-bit grey
+    in, 16-bit BGR out). The values are those of its first channel, the others' equal."""
+    from stereovision.io import _imdecode
+
+    if img.ndim != 3 or not (
+        np.array_equal(img[..., 0], img[..., 1]) and np.array_equal(img[..., 0], img[..., 2])
+    ):
+        return img
+    given = _imdecode(np.fromfile(path, np.uint8), cv2.IMREAD_UNCHANGED)
+    return img[..., 0] if given is not None and given.ndim == 2 else img
+
+
 def cmd_rectify(args: argparse.Namespace) -> int:
     """``stereovision rectify LEFT RIGHT -o DIR [--calib F] [--force]``: the rectified pair,
     and with no calibration the homographies found from the pair's features (a pair already
@@ -1335,8 +1349,8 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     with staged_outputs(out) as stage:
         staged: dict[str, Path] = {}
         for name, img in (
-            ("left_rect.png", lr),
-            ("right_rect.png", rr),
+            ("left_rect.png", _as_file_channels(lr, args.left)),
+            ("right_rect.png", _as_file_channels(rr, args.right)),
             ("check.png", draw_rectification_check(lr, rr, check)),
         ):
             staged[name] = stage / name
