@@ -3748,3 +3748,18 @@ def test_a_kitti_file_calibrates_the_grey_pairs_by_the_grey_cameras(tmp_path: Pa
         (tmp_path / name).write_bytes(data)
         got[job.name] = round(Calibration.from_file(tmp_path / name).baseline, 4)
     assert got == {"image_00/data/0": 0.5375, "image_02/data/0": 0.5347}
+
+
+def test_find_pairs_takes_a_middlebury_scene_of_im0_and_im1(tmp_path: Path) -> None:
+    """A folder of Middlebury 2014's / ETH3D's ``im0.png`` + ``im1.png`` was passed over without
+    a word (a/left.png + a/right.png and b/im0.png + b/im1.png: 1 pair, b unsaid): it is a
+    scene pair with its calib.txt; a folder holding both namings is one pair, left + right."""
+    _blank(tmp_path, "a/left.png", "a/right.png", "b/im0.png", "b/im1.png",
+           "c/left.png", "c/right.png", "c/im0.png", "c/im1.png")  # fmt: skip
+    (tmp_path / "b" / "calib.txt").write_text("x")
+    assert find_pairs(tmp_path) == [
+        PairJob("a", tmp_path / "a/left.png", tmp_path / "a/right.png", None),
+        PairJob("b", tmp_path / "b/im0.png", tmp_path / "b/im1.png", tmp_path / "b/calib.txt"),
+        PairJob("c", tmp_path / "c/left.png", tmp_path / "c/right.png", None),
+    ]
+    assert [(j.name, j.left.name) for j in find_pairs(tmp_path / "b")] == [("b", "im0.png")]

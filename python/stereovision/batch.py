@@ -212,11 +212,12 @@ def find_pairs(
     """Every pair under ``root``: scene folders, ``...left...`` / ``...right...`` image files and
     the same file names in sibling camera folders.
 
-    * A folder holding ``left.png`` and ``right.png`` (evaluation.md's scene layout) is one pair,
-      named by its path relative to ``root`` (``root``'s own name when ``root`` is the scene);
-      its ``calib.txt`` is used when present, else its ``Q.dat``. So is one holding ``left`` +
-      ``right`` of another suffix or case (``left.jpg`` + ``right.jpg``, ``LEFT.PNG`` +
-      ``RIGHT.PNG``), its ``Q.dat`` when a ``left.png`` or ``left.jpg`` sizes it.
+    * A folder holding ``left.png`` and ``right.png`` (evaluation.md's scene layout), or else
+      Middlebury's ``im0.png`` and ``im1.png`` (a Middlebury 2014 or ETH3D scene as shipped), is
+      one pair, named by its path relative to ``root`` (``root``'s own name when ``root`` is the
+      scene); its ``calib.txt`` is used when present, else its ``Q.dat``. So is one holding
+      ``left`` + ``right`` of another suffix or case (``left.jpg`` + ``right.jpg``, ``LEFT.PNG``
+      + ``RIGHT.PNG``), its ``Q.dat`` when a ``left.png`` or ``left.jpg`` sizes it.
     * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
       saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
       in its place; the pair is named by its folder and the file name without ``left`` (and
@@ -309,18 +310,23 @@ def _scan(
         rel = here.relative_to(r).as_posix()
         names = set(files)
         paired: set[str] = set()
-        if "left.png" in names and "right.png" in names:
-            # as load_scene: calib.txt, else OpenCV's Q (sized by the scene's left.png)
+        # Middlebury 2014's and ETH3D's im0.png + im1.png (as their archives ship a scene, its
+        # calib.txt beside them) too: such a folder was passed over without a word
+        for lname, rname in (("left.png", "right.png"), ("im0.png", "im1.png")):
+            if lname not in names or rname not in names:
+                continue
+            # as load_scene: calib.txt, else OpenCV's Q (sized by the scene's left image)
             scene_cal = next((here / n for n in _SCENE_CALIBS if n in names), None)
             found.append(
                 PairJob(
                     rel if rel != "." else r.resolve().name,
-                    here / "left.png",
-                    here / "right.png",
+                    here / lname,
+                    here / rname,
                     cal if cal is not None else scene_cal,
                 )
             )
-            paired |= {"left.png", "right.png"}
+            paired |= {lname, rname}
+            break
         images = [f for f in sorted(files) if Path(f).suffix.lower() in IMAGE_EXTS and f[0] != "."]
         for f in images:
             p = here / f
@@ -2616,7 +2622,8 @@ def add_cli(subparsers: Any) -> None:
         "batch",
         help="depth outputs of every pair under a folder, on Dask (local or a cluster)",
         description="Process every pair under INPUT into OUT/<name>/ (the files `stereovision "
-        "depth` writes): scene folders (left.png + right.png, with calib.txt or Q.dat), image "
+        "depth` writes): scene folders (left.png + right.png, or im0.png + im1.png as "
+        "Middlebury and ETH3D ship them, with calib.txt or Q.dat), image "
         "files named ...left.../...right... (seq/0001_left.png + seq/0001_right.png -> seq/0001), "
         "and images of the same name in sibling camera folders: left/ + right/, L/ + R/, KITTI's "
         "image_2/ + image_3/ (image_0/ + image_1/; a raw drive's image_02/ + image_03/, "
