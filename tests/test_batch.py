@@ -3763,3 +3763,32 @@ def test_find_pairs_takes_a_middlebury_scene_of_im0_and_im1(tmp_path: Path) -> N
         PairJob("c", tmp_path / "c/left.png", tmp_path / "c/right.png", None),
     ]
     assert [(j.name, j.left.name) for j in find_pairs(tmp_path / "b")] == [("b", "im0.png")]
+
+
+def test_batch_takes_method_fused_as_the_default_it_is(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--method fused`` after a run without ``--method`` (fused is the default) redid every
+    pair ("method: default -> fused"): the method is now recorded by its name, and a summary's
+    None (as batch recorded the default before) is read as it, so nothing done is redone."""
+    from stereovision.batch import _fingerprint, _recorded
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "s/left.png", "s/right.png")
+    (job,) = find_pairs(root)
+    (out / "s").mkdir(parents=True)
+    for f in DISPARITY_FILES:  # the done run's files
+        (out / "s" / f).write_text("done")
+    done = {"status": "done", "left": _recorded(job.left), "right": _recorded(job.right),
+            "calib": None, "options": {"method": None, "max_disparity": 16, "fill": None},
+            "fingerprint": _fingerprint(job), "outputs": sorted(DISPARITY_FILES)}  # fmt: skip
+    summary = {"version": 3, "pairs": {"s": done}, "input": str(root.resolve()),
+               "output": str(out.resolve())}  # fmt: skip
+    (out / SUMMARY_NAME).write_text(json.dumps(summary))
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    for method in (["--method", "fused"], []):
+        assert main([*args, *method]) == 0
+        said = capsys.readouterr()
+        assert said.out.startswith("0 processed, 1 skipped (done before), 0 failed in ")
+        assert "other options" not in said.err
+    assert (out / "s" / "disparity.pfm").read_text() == "done"  # not redone

@@ -91,6 +91,8 @@ _NAMES_SINCE_V2 = ("overview.png",)
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
 _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIBS = ("calib.txt", "Q.dat")
+#: depth_map's method when none is given, recorded by its name in the summary's options.
+_DEFAULT_METHOD = "fused"
 #: Sibling folders holding a rig's two cameras, left one first (matched without case): images
 #: of the same path under both are a pair (``left/0001.png`` + ``right/0001.png``; KITTI's
 #: ``image_2``/``image_3`` colour and ``image_0``/``image_1`` grey, its raw drives'
@@ -1376,8 +1378,17 @@ def _list_legacy_outputs(out: Path, pairs: dict[str, Any]) -> None:
                 entry["outputs"] = found
 
 
+def _recorded_options(entry: dict[str, Any]) -> Any:
+    """The options ``entry`` records, an earlier version's ``method`` None (the default, not
+    named) read as ``_DEFAULT_METHOD``, the name recorded now."""
+    options = entry.get("options")
+    if isinstance(options, dict) and "method" in options and options["method"] is None:
+        return {**options, "method": _DEFAULT_METHOD}
+    return options
+
+
 def _unchanged(entry: dict[str, Any] | None, fp: dict[str, Any], opts: dict[str, Any]) -> bool:
-    return entry is not None and entry.get("fingerprint") == fp and entry.get("options") == opts
+    return entry is not None and entry.get("fingerprint") == fp and _recorded_options(entry) == opts
 
 
 def _changes(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
@@ -1883,7 +1894,10 @@ def run_batch(
         summary = _Summary(out, log)
         # the input folder of the runs that wrote OUT before (None for a new OUT)
         earlier_input = summary.data.get("input") if summary.pairs else None
-        opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
+        # the method by its name: --method fused after a run without --method (the default)
+        # redid every pair, None and "fused" two options (an earlier None is read as it)
+        chosen = _DEFAULT_METHOD if method is None else method
+        opts: dict[str, Any] = {"method": chosen, "max_disparity": max_disparity, "fill": fill}
         if ground:  # only when asked: outputs of earlier runs without it stay valid
             opts.update(ground=True, grid=grid)
         if calib_unit is not None:  # as ground: only when given
@@ -1965,9 +1979,9 @@ def run_batch(
                 and entry.get("fingerprint") == fp
                 and (out / job.name / "disparity.pfm").is_file()
             ):
-                if entry.get("options") != opts:  # with other options: its outputs are replaced
+                if _recorded_options(entry) != opts:  # other options: its outputs are replaced
                     redone.append(job.name)
-                    changes.update(_changes(entry.get("options") or {}, opts))
+                    changes.update(_changes(_recorded_options(entry) or {}, opts))
                 else:  # as it was, but some of its outputs are gone: written again
                     incomplete.append((job.name, _outputs_missing(entry, out, job.name)))
             if entry is not None and isinstance(entry.get("outputs"), list):
