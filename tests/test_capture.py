@@ -2191,7 +2191,7 @@ def test_cli_capture_of_one_pair_says_it_in_the_singular(
     argv = ["capture", "--left", left, "--right", right, "--count", "1", "-o", str(out)]
     assert main(argv) == 0
     last = capsys.readouterr().out.splitlines()[-1]
-    assert last.startswith(f"1 pair saved in {out} (count reached); 1 pair read; delivered ")
+    assert last.startswith(f"1 pair saved in {out} (count reached); 1 pair read; sources: ")
 
 
 def test_a_source_that_ends_after_one_frame_says_it_in_the_singular(
@@ -5254,3 +5254,32 @@ def test_cli_capture_names_a_folder_with_a_newline_escaped_on_one_line(
     )
     assert lines[-1].startswith(f"2 pairs saved in {shown} (end of stream); 2 pairs read; ")
     assert len(lines) == 5 and (out / "right_0002.png").is_file()
+
+
+def test_cli_capture_says_its_sources_in_a_sentence_and_a_folder_with_a_newline_escaped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The summary read "1 pair read; delivered native size; left ...", describe()'s words put
+    after "delivered"; ``-o $'a\\nb'`` split the summary and the interrupt's line in two. The
+    sources are said as "sources: ...", and the folder escaped, as cli.py's lines name a path."""
+    from stereovision import capture as capture_module
+    from stereovision.cli import EXIT_INTERRUPTED, main
+
+    left = _write_sequence(tmp_path / "seq", "left", [_numbered(0)])
+    right = _write_sequence(tmp_path / "seq", "right", [_numbered(0)])
+    monkeypatch.chdir(tmp_path)
+    argv = ["capture", "--left", left, "--right", right, "--count", "1", "-o", "a\nb"]
+    assert main(argv) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.startswith("1 pair saved in a\\nb (count reached); 1 pair read; sources: native "
+                           f"size; left '{left}': ")  # fmt: skip
+    assert (tmp_path / "a\nb" / "left_0001.png").is_file()
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(capture_module, "capture", interrupted)
+    assert main(argv) == EXIT_INTERRUPTED
+    assert capsys.readouterr().err.splitlines() == [
+        "stereovision: interrupted: 0 pairs saved in a\\nb this run are kept; run again to add more"
+    ]

@@ -3589,6 +3589,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         bar.close()  # off the screen before the interrupt's words
         what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         n = saved[0]  # the pair being saved is saved whole, and said
+        # -o a<newline>b cut the line in two (escaped, as cli.py's lines name a path)
         print(
             f"stereovision: {what}: {_pairs(n)} saved in {escaped(args.output)} this run "
             f"{'is' if n == 1 else 'are'} kept; run "
@@ -3600,10 +3601,10 @@ def cmd_capture(args: argparse.Namespace) -> int:
         bar.close()  # off the screen before the last words (or the error)
         cam.close()
     sk = result.skew
-    # a folder named with a newline cut the line in two (escaped, as errors name it)
+    # "delivered native size; left ..." read as no sentence: describe() names the sources
     print(
         f"{_pairs(len(result.saved))} saved in {escaped(args.output)} ({result.ended}); "
-        f"{_pairs(result.frames_read)} read; delivered {cam.describe()}; "
+        f"{_pairs(result.frames_read)} read; sources: {cam.describe()}; "
         f"skew mean {sk['mean_ms']:.2f} ms, max {sk['max_ms']:.2f} ms"
     )
     return 0
