@@ -1603,23 +1603,25 @@ def test_a_temporal_mean_the_source_ends_before_the_count_is_said_unsaved(
     )
 
 
+@pytest.mark.parametrize("where", ["read_within", "temporal_average"])
 def test_a_temporal_mean_an_interrupt_cuts_is_said_unsaved(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str
 ) -> None:
-    """Ctrl-C while ``temporal=2`` awaits its 4th frame: the pair of frames 1-2 is saved, frame
-    3's unfinished mean was dropped without a word; a line says so before the interrupt goes
-    on (the CLI then says the pairs kept)."""
+    """Ctrl-C while ``temporal=2`` awaits its 4th frame (``read_within``), or averages it
+    (``temporal_average``, after 3cc84f4f): the pair of frames 1-2 is saved, frame 3's
+    unfinished mean was dropped without a word; a line says so before the interrupt goes on
+    (the CLI then says the pairs kept)."""
     lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "still", 5)
-    real = capmod.read_within
-    reads = []
+    real = getattr(capmod, where)
+    calls = []
 
-    def interrupted_4th(camera: Any, timeout: Any) -> Any:
-        reads.append(1)
-        if len(reads) == 4:
+    def interrupted_4th(*args: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 4:
             raise KeyboardInterrupt
-        return real(camera, timeout)
+        return real(*args)
 
-    monkeypatch.setattr(capmod, "read_within", interrupted_4th)
+    monkeypatch.setattr(capmod, where, interrupted_4th)
     lines: list[str] = []
     with StereoCamera(lpat, rpat) as cam, pytest.raises(KeyboardInterrupt):
         capture(cam, tmp_path / "pairs", temporal=2, log=lines.append)
@@ -5151,33 +5153,6 @@ def test_every_with_a_board_is_refused_before_any_read(tmp_path: Path) -> None:
         )
         cam.close()
     assert log == [] and not out.exists()
-
-
-def test_a_temporal_mean_an_interrupt_cuts_while_averaging_is_said_unsaved(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Ctrl-C while ``temporal=2`` averaged its 4th frame (not while it awaited it, which
-    3cc84f4f said): frame 3's unfinished mean was dropped without a word; it is said as when
-    the interrupt comes during the read."""
-    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "still", 4)
-    real = capmod.temporal_average
-    calls = []
-
-    def interrupted_4th(tf: Any, frame: Any) -> Any:
-        calls.append(1)
-        if len(calls) == 4:
-            raise KeyboardInterrupt
-        return real(tf, frame)
-
-    monkeypatch.setattr(capmod, "temporal_average", interrupted_4th)
-    lines: list[str] = []
-    with StereoCamera(lpat, rpat) as cam, pytest.raises(KeyboardInterrupt):
-        capture(cam, tmp_path / "pairs", temporal=2, log=lines.append)
-    assert len(lines) == 2 and lines[0].startswith("saved left_0001.png"), lines
-    assert lines[1] == (
-        "not saved: the last mean, of 1.0 frames of the 2 asked, was unfinished when the "
-        "capture was interrupted"
-    )
 
 
 def test_two_cameras_of_other_frame_rates_are_said(tmp_path: Path) -> None:
