@@ -1819,3 +1819,32 @@ def test_an_empty_rectification_path_is_named() -> None:
         rect.save("")
     with pytest.raises(ValueError, match=r"^path: expected a file name, got ''$"):
         UncalibratedRectification.load("")
+
+
+def test_a_pair_taken_at_different_exposures_is_rectified_from_its_features(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two cameras' own auto-exposures differ: with the right image two stops darker (its
+    brightest grey a quarter of the left's) SIFT's absolute contrast threshold found 13 matches
+    on cones and rectify_uncalibrated said "only 13 feature matches ... point the cameras at
+    something textured". The darker view is brought to the other's level for the features (530
+    matches); check() reads the pair alike. Pairs of one exposure (at most 1.08 apart measured
+    on the real pairs) are given to SIFT as they are."""
+    _features_once(monkeypatch)  # check() matches the pair rectify_uncalibrated matched
+    left, right = (
+        cv2.resize(
+            cv2.imread(str(data_dir / "middlebury2003/cones" / f), cv2.IMREAD_GRAYSCALE),
+            (150, 125),
+            interpolation=cv2.INTER_AREA,
+        )
+        for f in ("left.png", "right.png")
+    )
+    dark = right // 4
+    rect = rectify_uncalibrated(left, dark, model="projective")  # the features are the point
+    assert rect.matches >= 100 and rect.median_dy < 0.3  # as given (one exposure): 124, 0.07 px
+    check = rect.check(left, dark)
+    assert check.ok is True and check.matches >= 100
+    up, kept = uncalibrated._exposure_matched(left // 4, right)  # the left one darker
+    assert kept is right and abs(np.percentile(up, 99.5) - np.percentile(right, 99.5)) < 2
+    same = uncalibrated._exposure_matched(left, right)
+    assert same[0] is left and same[1] is right
