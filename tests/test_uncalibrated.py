@@ -1848,3 +1848,36 @@ def test_a_pair_taken_at_different_exposures_is_rectified_from_its_features(
     assert kept is right and abs(np.percentile(up, 99.5) - np.percentile(right, 99.5)) < 2
     same = uncalibrated._exposure_matched(left, right)
     assert same[0] is left and same[1] is right
+
+
+@pytest.mark.parametrize(
+    ("turn", "said"),
+    [
+        (cv2.ROTATE_180, "upside down against the left one"),
+        (cv2.ROTATE_90_COUNTERCLOCKWISE, "turned \\d+ degrees counter-clockwise"),
+        (cv2.ROTATE_90_CLOCKWISE, "turned \\d+ degrees clockwise"),
+    ],
+)
+def test_a_camera_mounted_upside_down_or_on_its_side_is_named(
+    data_dir: Path, turn: int, said: str
+) -> None:
+    """One camera of the rig mounted upside down (or on its side): its image turned 180 (90)
+    degrees against the other's was refused as 'the rectified right image would be mirrored:
+    are left and right swapped?', and swapping them does not help. The turn the matches show
+    is named, with the rotation that undoes it."""
+    left, right = (
+        cv2.resize(
+            cv2.imread(str(data_dir / "middlebury2003/cones" / f), cv2.IMREAD_GRAYSCALE),
+            (150, 125),
+            interpolation=cv2.INTER_AREA,
+        )[:, :125]
+        for f in ("left.png", "right.png")
+    )
+    with pytest.raises(ValueError, match=said) as err:
+        rectify_uncalibrated(left, cv2.rotate(right, turn), model="projective")
+    undo = {
+        cv2.ROTATE_180: "ROTATE_180",
+        cv2.ROTATE_90_COUNTERCLOCKWISE: "ROTATE_90_CLOCKWISE",
+        cv2.ROTATE_90_CLOCKWISE: "ROTATE_90_COUNTERCLOCKWISE",
+    }[turn]
+    assert f"turn it back first (cv2.rotate(right, cv2.{undo}))" in str(err.value)

@@ -146,6 +146,18 @@ def _apply(h: F64, pts: F64) -> F64:
     return out
 
 
+def _turn_deg(p1: F64, p2: F64) -> float | None:
+    """The in-plane turn (degrees, clockwise as shown: y points down) that takes the matches
+    ``p1`` onto ``p2`` (a similarity fitted by RANSAC), or None when none fits."""
+    try:
+        sim, _ = cv2.estimateAffinePartial2D(p1, p2)
+    except cv2.error:
+        return None
+    if sim is None:
+        return None
+    return math.degrees(math.atan2(float(sim[1, 0]), float(sim[0, 0])))
+
+
 def _midpoints(w: int, h: int) -> F64:
     """The middles of the top, right, bottom and left edges."""
     return np.array(
@@ -826,9 +838,10 @@ def rectify_uncalibrated(
         same view, or nearly all matches fitting one homography: a camera turned in place, a
         flat scene), an
         epipole inside the image (the cameras look along their baseline), homographies that
-        would stretch an image more than :data:`MAX_STRETCH` times, or left and right given the
+        would stretch an image more than :data:`MAX_STRETCH` times, left and right given the
         wrong way round (two cameras side by side, at most a fifth of whose matches lie further
-        right in the left image than in the right one).
+        right in the left image than in the right one), or the right image turned upside down
+        or on its side against the left one (a camera mounted so: the turn is named).
     """
     if model not in MODELS:
         raise ValueError(f"model: expected one of {', '.join(MODELS)}, got {model!r}")
@@ -943,6 +956,23 @@ def rectify_uncalibrated(
     h1, h2 = flip @ h1, flip @ h2
     o, ex_, _ = _apply(h2, axes)
     if ex_[0] <= o[0]:
+        # a camera mounted upside down or on its side (cones, right image turned 180 or 90
+        # degrees) ended here too, told to swap the images, which does not help
+        turn = _turn_deg(p1, p2)
+        if turn is not None and abs(turn) > 135:
+            raise ValueError(
+                f"the right image is upside down against the left one (turned {abs(turn):.0f} "
+                "degrees: a camera mounted upside down?): turn it back first "
+                "(cv2.rotate(right, cv2.ROTATE_180))"
+            )
+        if turn is not None and abs(turn) > 45:
+            way = "clockwise" if turn > 0 else "counter-clockwise"
+            undo = "COUNTERCLOCKWISE" if turn > 0 else "CLOCKWISE"
+            raise ValueError(
+                f"the right image is turned {abs(turn):.0f} degrees {way} "
+                "against the left one (a camera mounted on its side?): turn it back first "
+                f"(cv2.rotate(right, cv2.ROTATE_90_{undo}))"
+            )
         raise ValueError("the rectified right image would be mirrored: are left and right swapped?")
     h1, h2 = _shear(h1, w, h) @ h1, _shear(h2, w, h) @ h2
     corners = np.column_stack([_corners(w, h), np.ones(4)])
