@@ -1881,3 +1881,19 @@ def test_a_camera_mounted_upside_down_or_on_its_side_is_named(
         cv2.ROTATE_90_CLOCKWISE: "ROTATE_90_COUNTERCLOCKWISE",
     }[turn]
     assert f"turn it back first (cv2.rotate(right, cv2.{undo}))" in str(err.value)
+
+
+def test_a_right_image_of_the_left_ones_size_turned_is_not_told_to_be_resized() -> None:
+    """A camera mounted on its side gives a 40x30 image beside a 30x40 one: refused with 'needs
+    one size (resize one first)', which would squash the view; the turn is said instead. Other
+    sizes keep the advice to resize."""
+    with pytest.raises(ValueError) as err:
+        rectify_uncalibrated(np.zeros((30, 40), np.uint8), np.zeros((40, 30), np.uint8))
+    assert str(err.value) == (
+        "left is 40x30 px, right is 30x40 px: rectification without a calibration needs one "
+        "size (the right image is the left's turned 90 degrees, a camera mounted on its side?: "
+        "turn it back first, cv2.rotate(right, cv2.ROTATE_90_CLOCKWISE or "
+        "ROTATE_90_COUNTERCLOCKWISE))"
+    )
+    with pytest.raises(ValueError, match=r"right is 40x31 px: .* \(resize one first\)$"):
+        rectify_uncalibrated(np.zeros((30, 40), np.uint8), np.zeros((31, 40), np.uint8))

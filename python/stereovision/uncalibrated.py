@@ -858,9 +858,18 @@ def rectify_uncalibrated(
     # is stretched by one gain, as check_rectification stretches it
     gl, gr = _grey_pair(left, right)
     if gl.shape != gr.shape:
+        # a camera mounted on its side gives the other's size turned: resizing is no cure
+        turned = gl.shape == gr.shape[::-1]
         raise ValueError(
             f"left is {gl.shape[1]}x{gl.shape[0]} px, right is {gr.shape[1]}x{gr.shape[0]} px: "
-            "rectification without a calibration needs one size (resize one first)"
+            "rectification without a calibration needs one size "
+            + (
+                "(the right image is the left's turned 90 degrees, a camera mounted on its "
+                "side?: turn it back first, cv2.rotate(right, cv2.ROTATE_90_CLOCKWISE or "
+                "ROTATE_90_COUNTERCLOCKWISE))"
+                if turned
+                else "(resize one first)"
+            )
         )
     gl, gr = _exposure_matched(gl, gr)  # one view darker (its own auto-exposure): SIFT saw none
     h, w = gl.shape
