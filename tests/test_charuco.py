@@ -1451,3 +1451,30 @@ def test_resolve_reads_a_dark_uint16_board_at_its_own_range() -> None:
         assert auto.markers_seen(deep) == ("DICT_5X5_50", 21)
         found = auto.resolve(deep)
     assert found is not None and found.dictionary == "DICT_5X5_50"
+
+
+@pytest.mark.parametrize("printed", [True, False])
+def test_a_board_given_in_the_other_layout_is_told_to_give_the_layout(printed: bool) -> None:
+    """A 6x4 board (an even number of rows) printed in OpenCV's pre-4.6 layout and given
+    legacy=False (or the reverse) was not found, and the hint said 'shows 12 of its DICT_4X4
+    markers, but not as a 6x4-square board's: check the squares (columns x rows) and the
+    marker size', neither of which was wrong. The other layout is tried on the first image
+    and named (the CLI says it as --legacy / --no-legacy)."""
+    from stereovision.calibrate import _cli_words
+
+    k = np.array([[300.0, 0, 159.5], [0, 300, 119.5], [0, 0, 1]])
+    board = CharucoBoard("6x4", 0.04, 0.03, "DICT_4X4_50", legacy=printed)
+    view = render_charuco(
+        board, k, None, np.array([0.1, -0.2, 0.05]), np.array([-0.12, -0.08, 0.6]),
+        image_size=(320, 240), supersample=2, pixels_per_square=60,
+    )  # fmt: skip
+    with pytest.raises(ValueError) as err:
+        calibrate([view], [view], board=replace(board, legacy=not printed))
+    layout = "pre-4.6 (legacy)" if printed else "current (4.6 and later)"
+    said = (
+        f"left_images[0] shows the board in OpenCV's {layout} layout, not the one given: give "
+        f"legacy={printed} (or leave the layout out, to be found from the images)"
+    )
+    assert said in str(err.value)
+    flag = "--legacy" if printed else "--no-legacy"
+    assert f"give {flag} (or leave" in _cli_words(str(err.value))

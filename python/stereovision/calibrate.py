@@ -1245,6 +1245,19 @@ def _charuco_hint(board: CharucoBoard, gray: np.ndarray, name: str) -> str:
             f"{name} shows {count} markers of {family}, not of {board.dictionary}: give the "
             f"board's dictionary (e.g. dictionary='{seen}')"
         )
+    if board.legacy is not None and board.squares[1] % 2 == 0 and board.dictionary != "auto":
+        # OpenCV's other layout of an even number of rows (a board printed before 4.6 given
+        # legacy=False, or the reverse) was told to check its squares and marker size
+        from stereovision.charuco import find_charuco_corners
+
+        other = not board.legacy
+        if find_charuco_corners(gray, replace(board, legacy=other)) is not None:
+            return (
+                f"{name} shows the board in OpenCV's "
+                f"{'pre-4.6 (legacy)' if other else 'current (4.6 and later)'} layout, not the "
+                f"one given: give legacy={other} (or leave the layout out, to be found from "
+                "the images)"
+            )
     return (
         f"{name} shows {count} of its {family} markers, but not as a "
         f"{board.squares[0]}x{board.squares[1]}-square board's: check the squares (columns x "
