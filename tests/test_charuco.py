@@ -1478,3 +1478,16 @@ def test_a_board_given_in_the_other_layout_is_told_to_give_the_layout(printed: b
     assert said in str(err.value)
     flag = "--legacy" if printed else "--no-legacy"
     assert f"give {flag} (or leave" in _cli_words(str(err.value))
+
+
+def test_opencvs_dictionary_constant_is_its_dictionary() -> None:
+    """OpenCV's samples give the dictionary as its constant: ``dictionary=cv2.aruco.DICT_5X5_100``
+    (the integer 5) was refused as 'unknown ArUco dictionary 5'. Each predefined constant is
+    now its name; a bool, an integer no dictionary has, or a float is refused as before."""
+    for name in ("DICT_4X4_50", "DICT_5X5_100", "DICT_APRILTAG_36H11", "DICT_ARUCO_MIP_36H12"):
+        const = getattr(cv2.aruco, name)
+        assert CharucoBoard("6x5", 0.03, 0.022, const).dictionary == name
+        assert CharucoBoard("6x5", 0.03, 0.022, np.int64(const)).dictionary == name
+    for bad in (True, 99, -1, 5.0):
+        with pytest.raises(ValueError, match=r"^dictionary: unknown ArUco dictionary "):
+            CharucoBoard("6x5", 0.03, 0.022, bad)

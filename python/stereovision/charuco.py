@@ -77,13 +77,14 @@ AUTO_MIN_MARKERS = 2
 MAX_IMAGE_PIXELS = 250_000_000
 
 
-def dictionary_name(name: str) -> str:
+def dictionary_name(name: str | int) -> str:
     """Canonical OpenCV name of a predefined ArUco dictionary.
 
     Parameters
     ----------
-    name : str
-        ``"DICT_5X5_100"``, ``"5x5_100"``, ``"apriltag_36h11"`` ...
+    name : str or int
+        ``"DICT_5X5_100"``, ``"5x5_100"``, ``"apriltag_36h11"`` ..., or OpenCV's constant
+        (``cv2.aruco.DICT_5X5_100``).
 
     Returns
     -------
@@ -95,6 +96,13 @@ def dictionary_name(name: str) -> str:
     ValueError
         If no predefined dictionary has that name.
     """
+    if isinstance(name, (int, np.integer)) and not isinstance(name, (bool, np.timedelta64)):
+        # OpenCV's constant, as its samples pass it: cv2.aruco.DICT_5X5_100 (5) was "unknown
+        # ArUco dictionary 5"
+        for members in DICTIONARY_FAMILIES.values():
+            for known_name, _ in members:
+                if getattr(cv2.aruco, known_name) == name:
+                    return known_name
     key = str(name).strip().upper()
     if not key.startswith("DICT_"):
         key = "DICT_" + key
@@ -152,8 +160,9 @@ class CharucoBoard:
         Side of a square, in the calibration's unit.
     marker_size : float
         Side of a marker, same unit, smaller than ``square_size``.
-    dictionary : str
-        A predefined ArUco dictionary (``"DICT_5X5_100"``, ``"5X5_100"``, ...), or ``"auto"``:
+    dictionary : str or int
+        A predefined ArUco dictionary (``"DICT_5X5_100"``, ``"5X5_100"``, ...; or OpenCV's
+        constant, ``cv2.aruco.DICT_5X5_100``, kept as its name), or ``"auto"``:
         found from the first image that shows the board (the family that decodes most of the
         board's marker ids).
     legacy : bool or None
