@@ -939,7 +939,8 @@ def rectify_uncalibrated(
     if model == "quasi-euclidean" and not qe_median <= _QE_MAX_MEDIAN_PX:
         raise ValueError(
             f"two turned cameras do not fit the matches (median residual {qe_median:.2f} px, "
-            f"at most {_QE_MAX_MEDIAN_PX} px): use model='projective' or 'auto'"
+            f"at most {_QE_MAX_MEDIAN_PX} px): use model='projective' or 'auto' (--model "
+            "projective or auto)"  # the command line's words too, as the swap refusal's
         )
     if qe_median <= _QE_MAX_MEDIAN_PX:
         ahead = float(np.mean(p1[:, 0] > p2[:, 0]))
