@@ -1491,3 +1491,29 @@ def test_opencvs_dictionary_constant_is_its_dictionary() -> None:
     for bad in (True, 99, -1, 5.0):
         with pytest.raises(ValueError, match=r"^dictionary: unknown ArUco dictionary "):
             CharucoBoard("6x5", 0.03, 0.022, bad)
+
+
+def test_a_board_of_fewer_inner_corners_than_a_view_needs_is_refused(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A 3x3-square board (2x2 = 4 inner corners) was taken, printed by ``board``, and then
+    never found: find_charuco_corners wants MIN_CORNERS (6) corners of a view, so calibrate
+    found it in none of the images. It is refused where it is defined, naming the corners;
+    4x3 and 3x4 (6 corners) are boards as before."""
+    from stereovision import cli
+
+    with pytest.raises(ValueError) as err:
+        CharucoBoard("3x3", 0.05, 0.035, "DICT_4X4_50")
+    assert str(err.value) == (
+        "squares: a 3x3 board has 4 inner corners, and a view of it needs at least 6 (e.g. 4x3 "
+        "squares)"
+    )
+    assert CharucoBoard("4x3", 0.05, 0.035).n_corners == CharucoBoard("3x4", 0.05, 0.035).n_corners
+    out = tmp_path / "b.png"
+    code = cli.main(["board", "-o", str(out), "--board", "charuco", "--pattern", "3x3",
+                     "--square", "30", "--unit", "mm", "--marker", "22"])  # fmt: skip
+    assert code == 2 and not out.exists()
+    assert capsys.readouterr().err == (
+        "stereovision: error: --pattern: a 3x3 board has 4 inner corners, and a view of it "
+        "needs at least 6 (e.g. 4x3 squares)\n"
+    )

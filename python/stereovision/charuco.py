@@ -155,7 +155,8 @@ class CharucoBoard:
     Parameters
     ----------
     squares : tuple of int or str
-        ``(cols, rows)`` squares, or ``"7x5"``; each at least 3.
+        ``(cols, rows)`` squares, or ``"7x5"``; each at least 3, and at least
+        :data:`MIN_CORNERS` inner corners (not 3x3).
     square_size : float
         Side of a square, in the calibration's unit.
     marker_size : float
@@ -173,8 +174,8 @@ class CharucoBoard:
     ------
     ValueError
         If a size is not positive and finite, the marker does not fit in a square, there are too
-        few squares, the dictionary is unknown or too small for the board's markers, or
-        ``legacy`` is not True, False (0, 1) or None.
+        few squares (or inner corners), the dictionary is unknown or too small for the board's
+        markers, or ``legacy`` is not True, False (0, 1) or None.
     """
 
     squares: tuple[int, int]
@@ -196,6 +197,14 @@ class CharucoBoard:
             raise ValueError(
                 f"squares: expected a ChArUco board's squares as COLSxROWS, each at least 3 "
                 f"(e.g. 7x5), got {sq!r}"
+            )
+        corners = (vals[0] - 1) * (vals[1] - 1)
+        if corners < MIN_CORNERS:
+            # a 3x3 board's 4 corners are never a view (find_charuco_corners wants MIN_CORNERS):
+            # `board` printed it and calibrate found it in none of the images
+            raise ValueError(
+                f"squares: a {vals[0]}x{vals[1]} board has {corners} inner corners, and a view "
+                f"of it needs at least {MIN_CORNERS} (e.g. 4x3 squares)"
             )
         object.__setattr__(self, "squares", (vals[0], vals[1]))
         largest = max(n for members in DICTIONARY_FAMILIES.values() for _, n in members)
