@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import synthetic_scene as syn
 
-from stereovision import export
+from stereovision import _core, export
+from tests.reference import lzf_ref
 
 
 @pytest.fixture(scope="module")
@@ -1486,6 +1487,7 @@ def test_pcd_binary_compressed_as_pcl_writes_it(tmp_path):
     assert export.load_cloud(path)[0].shape == (n - n // 5, 3)
     # a literal 'A' and 12 more from one byte back (the overlapping copy of liblzf)
     assert export._lzf_decompress(b"\x00A\xe0\x03\x00", 13, path) == b"A" * 13
+    assert lzf_ref.lzf_decompress(b"\x00A\xe0\x03\x00", 13) == b"A" * 13
     sizes = np.array([2, len(planes)], "<u4").tobytes()
     for cut, word in (
         (body[:-1], "truncated"),
@@ -1495,6 +1497,84 @@ def test_pcd_binary_compressed_as_pcl_writes_it(tmp_path):
         path.write_bytes((head + "DATA binary_compressed\n").encode() + cut)
         with pytest.raises(ValueError, match=rf"^{word} PCD file .*c\.pcd"):
             export.read_pcd(path)
+
+
+def _terrace_planes(data_dir, rows, cols):
+    """A real organised cloud as PCL's binary_compressed stores it before LZF: the x, y, z and
+    packed rgb values of ETH3D terrace's ground-truth points (NaN in its holes), field by field."""
+    from stereovision.io import read_pfm
+
+    src = data_dir / "eth3d" / "terrace"
+    d = read_pfm(src / "gt_disp.pfm")[rows, cols].astype(np.float32)
+    bgr = cv2.imread(str(src / "left.png"))[rows, cols].astype(np.uint32)
+    f, cx, cy, baseline = 711.499, 376.135, 227.447, 0.0599432
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.where(np.isfinite(d) & (d > 0), f * baseline / d, np.nan).astype(np.float32)
+    ys, xs = np.mgrid[rows, cols]
+    x, y = ((xs - cx) * z / f).astype(np.float32), ((ys - cy) * z / f).astype(np.float32)
+    rgb = 0xFF000000 | bgr[..., 2] << 16 | bgr[..., 1] << 8 | bgr[..., 0]
+    return b"".join(a.astype("<f4").tobytes() for a in (x, y, z)) + rgb.astype("<u4").tobytes()
+
+
+def test_lzf_rust_decoder_matches_the_reference_on_a_real_cloud(data_dir, tmp_path):
+    """read_pcd's LZF decoder (Rust, _core.lzf_decompress) gives the bytes of the Python
+    reference (the decoder it replaced) on a real scene's cloud, and read_pcd its points."""
+    rows, cols = slice(200, 240), slice(80, 160)  # a quarter of its points without depth
+    planes = _terrace_planes(data_dir, rows, cols)
+    lzf = lzf_ref.lzf_compress(planes)
+    assert len(lzf) < len(planes) * 9 // 10  # back references, overlapping ones among them
+    assert _core.lzf_decompress(lzf, len(planes)) == planes
+    assert lzf_ref.lzf_decompress(lzf, len(planes)) == planes
+    h, w = 40, 80
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+        f"WIDTH {w}\nHEIGHT {h}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {w * h}\nDATA binary_compressed\n"
+    )
+    path = tmp_path / "terrace.pcd"
+    path.write_bytes(head.encode() + np.array([len(lzf), len(planes)], "<u4").tobytes() + lzf)
+    pts, cols_ = export.read_pcd(path)
+    want = np.frombuffer(planes, "<f4", count=3 * h * w).reshape(3, h, w).transpose(1, 2, 0)
+    np.testing.assert_array_equal(pts, want)
+    assert np.isnan(pts[..., 2]).any() and np.isfinite(pts[..., 2]).any()
+    bgr = cv2.imread(str(data_dir / "eth3d" / "terrace" / "left.png"))[rows, cols]
+    np.testing.assert_array_equal(cols_, bgr[..., ::-1])
+
+
+def test_lzf_damaged_streams_refused_as_the_reference_does(tmp_path):
+    """Every damaged or cut stream the reference refuses is a ValueError of the Rust decoder
+    too, and read_pcd's message names the file and what is wrong; a valid one decodes the same."""
+    plain = bytes(range(40)) * 3 + bytes(60)
+    good = lzf_ref.lzf_compress(plain)
+    path = tmp_path / "bad.pcd"
+    cases = [
+        (b"\x20\x05", 3, "a back reference (control byte at 0) reaches 6 bytes back, 0 bytes"),
+        (b"\x02abc", 2, "decompress to more than 2 bytes (control byte at 0)"),
+        (b"\x05abc", 6, "end inside a literal run of 6 bytes (control byte at 0)"),
+        (b"\x00A\xe0", 13, "end inside a back reference (control byte at 2)"),
+        (b"\x00A\xe0\x03", 13, "end inside a back reference (control byte at 2)"),
+        (b"\x00A", 3, "decompress to 1 bytes, expected 3"),
+        (good[:-1], len(plain), "end inside a back reference (control byte at 47)"),
+        (good, len(plain) + 1, "expected 181"),
+        (b"\x00A", 2**32 - 1, "2 bytes cannot decompress to 4294967295 bytes (at most 88 times"),
+    ]
+    for data, size, words in cases:
+        with pytest.raises(ValueError):
+            lzf_ref.lzf_decompress(data, size)
+        with pytest.raises(ValueError, match=re.escape(words)):
+            _core.lzf_decompress(data, size)
+        with pytest.raises(
+            ValueError,
+            match=rf"^damaged PCD file .*bad\.pcd: its compressed data does not decompress "
+            rf"\(corrupt LZF data: .*{re.escape(words)}",
+        ):
+            export._lzf_decompress(data, size, path)
+    # every cut of a valid stream: refused by both, or (cut between chunks) too short
+    for end in range(len(good)):
+        with pytest.raises(ValueError):
+            lzf_ref.lzf_decompress(good[:end], len(plain))
+        with pytest.raises(ValueError, match="corrupt LZF data"):
+            _core.lzf_decompress(good[:end], len(plain))
+    assert _core.lzf_decompress(good, len(plain)) == plain
 
 
 def test_read_npz_of_a_npy_file_is_named(tmp_path):

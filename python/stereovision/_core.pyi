@@ -27,6 +27,7 @@ __all__ = [
     "hopfield_match",
     "hopfield_match_u8",
     "kept_memory",
+    "lzf_decompress",
     "mcgm_curves",
     "mcgm_filter",
     "mcgm_log",
@@ -303,3 +304,11 @@ def kept_memory() -> tuple[tuple[int, int], int]:
     """``((blocks, bytes), pool_bytes)``: freed blocks of >= 128 KiB the allocator keeps (128 MiB
     at most), and the kernels' own pools: the Gabor planes' (256 MiB at most) and the census
     matcher's cost volume and row sums (256 MiB at most)."""
+
+# --- LZF decompression (rust/py/src/lzf.rs) ------------------------------------------------------
+
+def lzf_decompress(data: bytes, out_len: int) -> bytes:
+    """The ``out_len`` bytes the LZF stream ``data`` decompresses to (liblzf's
+    ``lzf_decompress``: PCL's ``binary_compressed`` PCD data). A damaged or cut stream, or one
+    that does not decompress to exactly ``out_len`` bytes, is a ``ValueError`` saying what is
+    wrong; an ``out_len`` more than 88 times ``len(data)`` is refused before any allocation."""

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import numpy.typing as npt
 
+from stereovision import _core
 from stereovision._validate import (
     NO_DEPTH,
     NOT_NUMBERS,
@@ -520,41 +521,14 @@ def read_pcd(
 
 def _lzf_decompress(data: bytes, size: int, path: Path) -> bytes:
     """LZF (liblzf's ``lzf_decompress``, which PCL's ``binary_compressed`` data is) of
-    ``data`` into ``size`` bytes; a damaged stream is a ValueError naming ``path``."""
-    out = bytearray()
-    i, n = 0, len(data)
-    damaged = f"damaged PCD file {path}: its compressed data does not decompress"
+    ``data`` into ``size`` bytes, in Rust; a damaged stream is a ValueError naming ``path``
+    and what is wrong with it."""
     try:
-        while i < n:
-            ctrl = data[i]
-            i += 1
-            if ctrl < 32:  # a literal run of ctrl + 1 bytes
-                run = data[i : i + ctrl + 1]
-                if len(run) != ctrl + 1:
-                    raise ValueError(damaged)
-                out += run
-                i += ctrl + 1
-                continue
-            length = ctrl >> 5  # a back reference: length + 2 bytes from back there
-            if length == 7:
-                length += data[i]
-                i += 1
-            start = len(out) - ((ctrl & 0x1F) << 8) - data[i] - 1
-            i += 1
-            length += 2
-            if start < 0:
-                raise ValueError(damaged)
-            chunk = out[start : start + length]
-            if len(chunk) < length:  # overlapping its own output: the bytes repeat
-                chunk = (chunk * (length // len(chunk) + 1))[:length]
-            out += chunk
-            if len(out) > size:
-                raise ValueError(damaged)
-    except IndexError:  # a back reference cut short
-        raise ValueError(damaged) from None
-    if len(out) != size:
-        raise ValueError(damaged)
-    return bytes(out)
+        return _core.lzf_decompress(data, size)
+    except ValueError as e:
+        raise ValueError(
+            f"damaged PCD file {path}: its compressed data does not decompress ({e})"
+        ) from None
 
 
 def _compressed_pcd_records(

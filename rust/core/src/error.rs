@@ -47,6 +47,12 @@ pub enum CoreError {
     /// process aborting).
     #[error("out of memory: {what} needs {} and the allocation failed", crate::alloc::human_bytes(*.bytes))]
     OutOfMemory { bytes: usize, what: &'static str },
+    /// Compressed data that does not decompress (a damaged or cut stream, see [`crate::lzf`]).
+    #[error("corrupt {format} data: {reason}")]
+    CorruptData {
+        format: &'static str,
+        reason: String,
+    },
 }
 
 /// Result alias used across the core.

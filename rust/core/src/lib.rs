@@ -9,7 +9,8 @@
 //! * [`fill`]: the evaluation's reference row fill of a map's holes;
 //! * [`edges`]: foreground fattened past depth edges (the fused dense map's edge step);
 //! * [`temporal`]: a still rig's frames averaged over time (less sensor noise);
-//! * [`triangulation`]: depth and its uncertainty from a rectified disparity map.
+//! * [`triangulation`]: depth and its uncertainty from a rectified disparity map;
+//! * [`lzf`]: LZF decompression of PCL's `binary_compressed` point clouds.
 //!
 //! Conventions (algorithms.md section 0): images are `f32` in `[0, 1]`, row-major `(H, W)`;
 //! `x` = column, `y` = row; disparity `d = x_left - x_right`, stored at left-image pixels,
@@ -20,6 +21,7 @@ pub mod edges;
 pub mod error;
 pub mod fill;
 pub mod image;
+pub mod lzf;
 pub mod matching;
 pub mod parallel;
 pub mod refine;

@@ -12,7 +12,8 @@ pub fn to_pyerr(err: CoreError) -> PyErr {
         | CoreError::SizeMismatch { .. }
         | CoreError::NonFinite { .. }
         | CoreError::InvalidParameter { .. }
-        | CoreError::TooLarge { .. } => PyValueError::new_err(err.to_string()),
+        | CoreError::TooLarge { .. }
+        | CoreError::CorruptData { .. } => PyValueError::new_err(err.to_string()),
         CoreError::OutOfMemory { .. } => PyMemoryError::new_err(err.to_string()),
     }
 }

@@ -13,6 +13,7 @@ mod errors;
 mod fill;
 mod gabor;
 mod hopfield;
+mod lzf;
 mod mcgm;
 mod params;
 mod refine;
@@ -75,6 +76,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     m.add_function(wrap_pyfunction!(temporal::temporal_grey_difference, m)?)?;
     m.add_function(wrap_pyfunction!(temporal::temporal_running_mean, m)?)?;
+    m.add_function(wrap_pyfunction!(lzf::lzf_decompress, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(kept_memory, m)?)?;
     Ok(())
