@@ -3792,3 +3792,46 @@ def test_batch_takes_method_fused_as_the_default_it_is(
         assert said.out.startswith("0 processed, 1 skipped (done before), 0 failed in ")
         assert "other options" not in said.err
     assert (out / "s" / "disparity.pfm").read_text() == "done"  # not redone
+
+
+def test_cli_batch_names_a_folder_with_a_newline_escaped_on_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """-o named with a newline: the last line, the missing outputs' line and the interrupted
+    line each name it escaped on one line (they printed it as it is: cut in two). run_batch
+    stands in: the point is the CLI's lines, not a cluster."""
+    import stereovision.batch as batch_mod
+
+    out = tmp_path / "o\nut"
+    shown = str(out).replace("\n", "\\n")
+    res = batch_mod.BatchResult(
+        processed=["seq/0000"], skipped=[], failed=[], pending=[], seconds=0.5,
+        summary_path=out / "summary.json", missing=["seq/0001"],
+    )  # fmt: skip
+    monkeypatch.setattr(batch_mod, "run_batch", lambda *a, **k: res)
+    assert main(["batch", str(tmp_path), "-o", str(out)]) == 1
+    said = capsys.readouterr().out.splitlines()
+    assert said == [
+        f"1 processed, 0 skipped (done before), 0 failed in 0.5 s; summary: {shown}/summary.json",
+        f"exit status 1: 1 pair(s) recorded as done have no outputs in {shown} any more (moved "
+        "or deleted during the run?); run again to redo them",
+    ]
+
+    def interrupted(*a: Any, **k: Any) -> None:
+        raise batch_mod.BatchInterrupted(res)
+
+    monkeypatch.setattr(batch_mod, "run_batch", interrupted)
+    assert main(["batch", str(tmp_path), "-o", str(out)]) == 130
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: interrupted: 1 of 1 pairs finished this run, in {shown} and recorded "
+        f"in {shown}/summary.json; run again to continue"
+    ]
+
+    def searching(*a: Any, **k: Any) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(batch_mod, "run_batch", searching)
+    assert main(["batch", str(tmp_path), "-o", str(out)]) == 130
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: interrupted; finished pairs are kept in {shown}, run again to continue"
+    ]

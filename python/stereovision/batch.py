@@ -2511,6 +2511,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     interrupted (Ctrl-C), 143 when terminated (SIGTERM): one line, the summary marked as
     interrupted."""
     from stereovision._interrupt import Terminated
+    from stereovision._validate import escaped
     from stereovision.cli import EXIT_INTERRUPTED, EXIT_TERMINATED
 
     # in the option's name, as --count and --max-pairs are (run_batch names its parameter)
@@ -2585,14 +2586,14 @@ def cmd_batch(args: argparse.Namespace) -> int:
             done = len(r.processed) + len(r.failed)
             print(
                 f"stereovision: {what}: {done} of {done + len(r.pending)} pairs finished "
-                f"this run, in {args.output} and recorded in {r.summary_path}; run again to "
-                "continue",
+                f"this run, in {escaped(str(args.output))} and recorded in "
+                f"{escaped(str(r.summary_path))}; run again to continue",
                 file=sys.stderr,
             )
         else:  # while the input was searched, or a second Ctrl-C
             print(
-                f"stereovision: {what}; finished pairs are kept in {args.output}, run again "
-                "to continue",
+                f"stereovision: {what}; finished pairs are kept in {escaped(str(args.output))}, "
+                "run again to continue",
                 file=sys.stderr,
             )
         return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
@@ -2605,9 +2606,11 @@ def cmd_batch(args: argparse.Namespace) -> int:
         else ""
     )
     alone = f" ({len(res.unpaired)} with an image missing)" if res.unpaired else ""
+    # a folder named with a newline cut these lines in two (escaped, as errors name it)
     print(
         f"{len(res.processed)} processed, {len(res.skipped)} skipped (done before){again}, "
-        f"{len(res.failed)} failed{alone} in {res.seconds:.1f} s; summary: {res.summary_path}"
+        f"{len(res.failed)} failed{alone} in {res.seconds:.1f} s; summary: "
+        f"{escaped(str(res.summary_path))}"
     )
     if res.failed_before and not res.failed:
         # the exit status counts every pair without outputs, this run's failures or earlier ones
@@ -2615,7 +2618,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
     if res.missing:
         print(
             f"exit status 1: {len(res.missing)} pair(s) recorded as done have no outputs in "
-            f"{args.output} any more (moved or deleted during the run?); run again to redo them"
+            f"{escaped(str(args.output))} any more (moved or deleted during the run?); run "
+            "again to redo them"
         )
     return 1 if res.failed or res.failed_before or res.missing else 0
 
