@@ -7210,3 +7210,30 @@ def test_a_click_refused_while_a_pair_computes_stays_said_after_it(tmp_path, mon
     for (status, error), (_, start) in zip(said, clicks, strict=False):
         assert status == "error" and error.startswith(start), (status, error)
     assert said[-1][0] == "error" and said[-1][1].endswith("disk full"), said[-1]
+
+
+def test_the_page_reads_a_16_bit_pair_at_its_16_bits_as_depth_does(tmp_path):
+    """A scene, a Load of files and a folder of pairs read 16-bit PNGs at their top 8 bits
+    (imread: a 12-bit pair matched from its 0-15 grey levels) where `depth`, `batch`, `eval` and
+    `view` keep 16. They are read as `depth` reads them now (read_image)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import FolderPairs
+    from stereovision.io import read_image
+
+    scene = tmp_path / "sc"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        img = cv2.imread(str(bundled_data_dir() / "cones" / name))[:24, :40]
+        cv2.imwrite(str(scene / name), np.rint(img * (4095 / 255)).astype(np.uint16))
+    want = read_image(scene / "left.png")
+    assert want.dtype == np.uint16 and want.max() > 255
+    app = _scene_app("test-16-bit-pair", [tmp_path])
+    app._load_scene(scene)
+    assert app.pair is not None and np.array_equal(app.pair[0], want)
+    app.pair = None
+    app._spawn = lambda coro: coro.close()  # the computation: not the point here
+    app.state.left_file, app.state.right_file = "sc/left.png", "sc/right.png"
+    app.load_files()
+    assert app.state.error == "" and app.pair is not None and np.array_equal(app.pair[0], want)
+    left, _ = FolderPairs(scene, "sc").read()
+    assert np.array_equal(left, want)

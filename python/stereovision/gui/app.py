@@ -1875,7 +1875,9 @@ class StereoApp:
         from stereovision.io import load_scene, scene_too_narrow
 
         scene_dir = self.folders.resolve(path) if Path(path) != self.demo_scene else Path(path)
-        scene = load_scene(scene_dir)
+        # a 16-bit pair as `depth`, `eval` and `view` read it: at its top 8 bits a 12-bit
+        # scene was matched from its 0-15 grey levels
+        scene = load_scene(scene_dir, full_bits=True)
         self.pair = self.raw_pair = (scene.left, scene.right)
         #: The scene's GT disparity and the pair it belongs to (a sparse method's precision, a
         #: dense one's bad-2.0, are said while that pair is computed as given: not after
@@ -2489,12 +2491,13 @@ class StereoApp:
         """Use the chosen left / right image files (calibration: ``--calib`` if its size fits;
         one that holds no size is sized by the first pair it is used with, and refuses files of
         another size: :meth:`_calib_for`)."""
-        from stereovision.io import check_pair_files, imread
+        from stereovision.io import check_pair_files, read_image
 
         try:  # an emptied field sends None
             lpath = self.folders.resolve(self.state.left_file or "")
             rpath = self.folders.resolve(self.state.right_file or "")
-            left, right = imread(lpath), imread(rpath)
+            # 16-bit files at their 16 bits, as `depth` reads them (imread kept the top 8)
+            left, right = read_image(lpath), read_image(rpath)
             labels = (self.folders.label(lpath), self.folders.label(rpath))
             same = check_pair_files(left, right, lpath, rpath, names=labels)
             c, note = self._calib_for(left), ""

@@ -642,12 +642,15 @@ class FolderPairs:
         return self.jobs[self.index] if self.index >= 0 else None
 
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
-        """The next pair (BGR), after the last one the first again."""
-        from stereovision.io import imread
+        """The next pair (BGR, a 16-bit pair at its 16 bits as ``batch`` reads it), after the
+        last one the first again."""
+        from stereovision.io import read_image
 
         self.index = (self.index + 1) % len(self.jobs)
         job = self.jobs[self.index]
-        return imread(job.left), imread(job.right)
+        # uint16 for a 16-bit pair, as a 16-bit sequence's frames are (_decode): the page
+        # matches such a pair as it is and shows it at 8 bits
+        return read_image(job.left), read_image(job.right)  # type: ignore[return-value]
 
     def describe(self) -> str:
         """``folder data/seq: pair 0002 (2 of 20)``."""
