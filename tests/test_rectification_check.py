@@ -1319,3 +1319,32 @@ def test_cli_check_fix_of_rectified_images_with_the_raw_rig_says_they_may_be_rec
         "rig's raw images: give the raw images\n"
     )
     assert fixed.is_file()
+
+
+def test_cli_check_json_without_fix_does_not_check_the_images_as_given(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A failing check --calib RIG --json, without --fix, checked the images as given too (a
+    second matching of the pair, as long as the first) for a 'rectified twice' note that its
+    JSON never holds. It checks them once now; without --json the note is still looked for."""
+    from stereovision import rectification_check
+
+    pair = [data_dir / "stereopi_rig/scene_photo" / f"{s}.png" for s in ("left", "right")]
+    rig = stereopi_calib(data_dir).save(tmp_path / "rig.yaml")
+    failing = RectificationCheck(100, 2.0, 3.0, 0.0, 0.0, 0.0, False, 0.5)
+    calls: list[tuple[object, ...]] = []
+
+    def check(*a: object, **k: object) -> RectificationCheck:
+        calls.append(a)
+        return failing
+
+    monkeypatch.setattr(rectification_check, "check_rectification", check)
+    args = ["check", *map(str, pair), "--calib", str(rig)]
+    assert sv.cli.main([*args, "--json"]) == 1
+    assert len(calls) == 1 and json.loads(capsys.readouterr().out)["ok"] is False
+    calls.clear()
+    assert sv.cli.main(args) == 1
+    assert len(calls) == 2  # the line may say the images are rectified already

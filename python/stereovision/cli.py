@@ -1109,7 +1109,15 @@ def cmd_check(args: argparse.Namespace) -> int:
     # its raw pair's rows went from 0.15 to 0.46 px). A drift of a rig whose raw rows agree
     # looks the same, so it is said, not refused.
     as_given = None
-    if res.ok is False and not res.swapped and calib is not None and not calib.rectified:
+    # --json without --fix never says it (its JSON is the check's): a second matching for nothing
+    said_twice = fix is not None or not args.json
+    if (
+        said_twice
+        and res.ok is False
+        and not res.swapped
+        and calib is not None
+        and not calib.rectified
+    ):
         as_given = check_rectification(raw_left, raw_right, tolerance=args.tolerance)
         if as_given.ok is not True or as_given.swapped:
             as_given = None
