@@ -3657,3 +3657,22 @@ def test_the_view_refuses_a_left_of_no_image_dtype(capfd: pytest.CaptureFixture[
     finally:
         server.close()
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_the_bag_line_names_a_folder_with_a_newline_escaped_on_one_line() -> None:
+    """--bag named with a newline: the bag line printed it as it is, cut in two ('ROS 2 bag
+    written to o' then 'ut (3 of the 3 pairs ...)'), where capture and batch escape -o."""
+    from types import SimpleNamespace
+
+    from stereovision.stream import _bag_line
+
+    def bag(frames: int, messages: int) -> Any:
+        return SimpleNamespace(path=Path("o\nut"), frames=frames, messages=messages)
+
+    assert _bag_line(bag(3, 12), 3) == (
+        "ROS 2 bag written to o\\nut (3 of the 3 pairs processed, 12 messages)"
+    )
+    assert _bag_line(bag(0, 0), 0) == "no ROS 2 bag written to o\\nut: no frame in it"
+    assert _bag_line(bag(0, 0), 2).startswith(
+        "no ROS 2 bag written to o\\nut: none of the 2 pairs processed; "
+    )

@@ -46,6 +46,7 @@ from stereovision._validate import (
     _shown,
     _unit_range_error,
     as_image_array,
+    escaped,
     finite_number,
     first_line,
     number_shown,
@@ -1832,11 +1833,13 @@ def _bag_line(bag: Any, pairs: int) -> str:
         f"the disk filled and SQLite undid the frames since the bag's last commit "
         f"({n_lost} frame{'' if n_lost == 1 else 's'} lost)"
     )
+    # a folder named with a newline cut the line in two (escaped, as errors name it)
+    where = escaped(str(bag.path))
     if not bag.messages:  # the folder was removed (it said "written to DIR (0 messages)")
         if not pairs:
-            return f"no ROS 2 bag written to {bag.path}: no frame in it"
+            return f"no ROS 2 bag written to {where}: no frame in it"
         return (
-            f"no ROS 2 bag written to {bag.path}: none of the {_counted(pairs, 'pair')} "
+            f"no ROS 2 bag written to {where}: none of the {_counted(pairs, 'pair')} "
             "processed; " + lost
         )
     # "1 pairs", "1 frames" read badly (as capture's counts, said in the singular since fd8a1f4)
@@ -1845,7 +1848,7 @@ def _bag_line(bag: Any, pairs: int) -> str:
         if frames <= pairs
         else _counted(frames, "frame")
     )
-    line = f"ROS 2 bag written to {bag.path} ({held}, {bag.messages} messages)"
+    line = f"ROS 2 bag written to {where} ({held}, {bag.messages} messages)"
     return line + "; " + lost if frames < pairs else line
 
 
