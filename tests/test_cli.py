@@ -3979,3 +3979,27 @@ def test_rectify_suggests_a_depth_command_on_one_line_for_a_folder_with_a_newlin
     )
     names = ("left_rect.png", "right_rect.png", "--calib", "calib_rect.yaml")
     assert said.stdout.split("\0")[:-1] == [n if n[0] == "-" else str(out / n) for n in names]
+
+
+def test_a_suggested_command_names_a_path_past_ascii_as_its_utf8_bytes() -> None:
+    """_shell_path ANSI-C quoted a C1 control (U+0085) as $'...\\x85...', which bash reads as
+    the byte 0x85, not the character (UTF-8 c2 85): another file; and U+2028 as \\u2028, the
+    character in a UTF-8 locale only. Both are their UTF-8 bytes now, read alike in any locale;
+    a name's own backslash before "x85" stays the name's."""
+    import os
+
+    from stereovision.cli import _shell_path
+
+    names = ["x\x85y", "a\u2028b", "c\\x85\nd"]
+    quoted = [_shell_path(Path(n)) for n in names]
+    assert quoted == ["$'x\\xc2\\x85y'", "$'a\\xe2\\x80\\xa8b'", "$'c\\\\x85\\nd'"]
+    bash = shutil.which("bash")
+    if bash is None:  # the quoting is checked above; bash reads it back
+        return
+    said = subprocess.run(
+        [bash, "-c", f"printf '%s\\0' {' '.join(quoted)}"],
+        capture_output=True,
+        check=True,
+        env={**os.environ, "LC_ALL": "C"},
+    )
+    assert said.stdout.split(b"\0")[:-1] == [n.encode("utf-8") for n in names]

@@ -1442,14 +1442,30 @@ def _shell_path(path: Path) -> str:
     space or another character the shell reads (``'my rect/left_rect.png'``), and a relative
     one that starts with ``-`` after ``./`` (else read as an option). One with a control
     character is ANSI-C quoted (``$'o\\nut/left_rect.png'``, as bash and zsh read it), its
-    characters escaped as :func:`escaped` shows them: quoted as it is, a newline cut the line."""
+    characters escaped as :func:`escaped` shows them (one past ASCII as its UTF-8 bytes): quoted
+    as it is, a newline cut the line."""
     text = str(path)
     if text.startswith("-"):
         text = f"./{text}"
     shown = escaped(text)
     if shown != text:  # "\n", "\x1b", "\u2028" and doubled backslashes: $'...' reads them so
+        # but a C1 control's "\x85" is read as the byte 0x85, not the character U+0085 (UTF-8
+        # C2 85): another file's name; and "\u2028" as the character only in a UTF-8 locale
+        # (in C, as "\u2028"): such a character as its UTF-8 bytes, read alike in any locale
+        shown = _WIDE_ESCAPE.sub(_utf8_bytes, shown)
         return "$'" + shown.replace("'", "\\'") + "'"
     return shlex.quote(text)
+
+
+#: An escape of a character past ASCII in :func:`escaped`'s text (``\x85``, ``\u2028``), not
+#: after a backslash of the name (doubled there)
+_WIDE_ESCAPE = re.compile(r"(?<!\\)((?:\\\\)*)\\(x[89][0-9a-f]|u[0-9a-f]{4})")
+
+
+def _utf8_bytes(m: re.Match[str]) -> str:
+    """:data:`_WIDE_ESCAPE`'s character as ``$'...'`` reads its UTF-8 bytes (``\\xc2\\x85``)."""
+    char = chr(int(m.group(2)[1:], 16))
+    return m.group(1) + "".join(f"\\x{b:02x}" for b in char.encode("utf-8"))
 
 
 def _stale_rectify_output(path: Path) -> bool:
