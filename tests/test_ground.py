@@ -2279,3 +2279,19 @@ def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: st
     assert fields["resolution"] == 0.05 and fields["origin"] == [0.0, -0.05, 0.0]
     if name == "map":
         assert text.startswith("image: map.png\n")
+
+
+def test_a_point_past_float_cells_is_outside_the_grid_without_an_overflow_warning() -> None:
+    """A finite point 1e308 m ahead (its cell index past float64: 1e308 / 0.5) was NumPy's
+    "RuntimeWarning: overflow encountered in divide" from ground.py (53cbe9d kept 1e30's cast
+    quiet); it is outside the grid without a word, as cell_of(1e308, 0) is."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    pts = _camera_points([(2.1, 0.6, 0.5)] * 3 + [(1e308, 0.0, 0.5), (0.0, -1e308, 0.5)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        grid = occupancy_grid(pts, plane, resolution=0.5, forward=(0, 4), lateral=(-2, 2))
+    want = np.full((8, 8), -1, np.int8)
+    want[5, 4] = 100
+    np.testing.assert_array_equal(grid.data, want)

@@ -1179,8 +1179,10 @@ def occupancy_grid(
     axes = floor_frame(plane)
     xyz = flat @ axes.T
     h = xyz[:, 2] + plane.height  # height above the floor
-    fj = np.floor((xyz[:, 0] - x0) / res)
-    fi = np.floor((xyz[:, 1] - y0) / res)
+    # a point 1e308 m away: its quotient inf (outside), not "overflow encountered in divide"
+    with np.errstate(over="ignore"):
+        fj = np.floor((xyz[:, 0] - x0) / res)
+        fi = np.floor((xyz[:, 1] - y0) / res)
     # the cells are counted as floats, cast once inside: a finite point past int64's range
     # (1e30 m away) was NumPy's "RuntimeWarning: invalid value encountered in cast"
     inside = (fj >= 0) & (fj < cols) & (fi >= 0) & (fi < rows)
