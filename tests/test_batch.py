@@ -3835,3 +3835,21 @@ def test_cli_batch_names_a_folder_with_a_newline_escaped_on_one_line(
     assert capsys.readouterr().err.splitlines() == [
         f"stereovision: interrupted; finished pairs are kept in {shown}, run again to continue"
     ]
+
+
+def test_a_middlebury_scene_with_a_q_dat_is_sized_by_its_im0(tmp_path: Path) -> None:
+    """A scene of im0.png + im1.png (6ba651a4) with a Q.dat and no left.png failed its pair
+    ('Q.dat does not give the image size and there is no left.png beside it'): its im0.png
+    now sizes the Q.dat, as a left.png does."""
+    from stereovision.batch import _task
+
+    scene = tmp_path / "s"
+    scene.mkdir()
+    for name in ("im0.png", "im1.png"):
+        cv2.imwrite(str(scene / name), np.zeros((30, 40), np.uint8))
+    (scene / "Q.dat").write_text("1 0 0 -20\n0 1 0 -15\n0 0 0 100\n0 0 10 0\n")
+    (job,) = find_pairs(scene)
+    assert job.calib == scene / "Q.dat"
+    name, data = _task(job, {})["calib"]
+    (tmp_path / name).write_bytes(data)
+    assert Calibration.from_file(tmp_path / name).image_size == (40, 30)

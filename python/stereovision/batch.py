@@ -1653,9 +1653,12 @@ def _task(
         key = (job.calib, _grey_kitti(job))
         calib = payloads.get(key)
         if calib is None:
-            calib = _calib_payload(
-                job.calib, opts.get("calib_unit"), opts.get("calib_size"), grey=key[1]
-            )
+            size = opts.get("calib_size")
+            if size is None and job.calib == job.left.parent / "Q.dat":
+                # a scene's Q.dat beside im0.png (no left.png to size it): the pair failed
+                # ("Q.dat does not give the image size"); its own left image sizes it
+                size = _calib_size(job.calib, [job])
+            calib = _calib_payload(job.calib, opts.get("calib_unit"), size, grey=key[1])
             payloads[key] = calib
     return {
         "name": job.name,
