@@ -1348,3 +1348,16 @@ def test_cli_check_json_without_fix_does_not_check_the_images_as_given(
     calls.clear()
     assert sv.cli.main(args) == 1
     assert len(calls) == 2  # the line may say the images are rectified already
+
+
+def test_a_rectified_pair_of_two_exposures_is_already_rectified(data_dir: Path) -> None:
+    """A rectified pair whose right camera exposed two stops darker (cones, right // 4) was
+    'cannot tell' (12 matches) to check_rectification, so already_rectified gave None and
+    rectify warped it; its views are brought to one exposure for the features, as f9e666ed
+    does for rectify_uncalibrated."""
+    from stereovision.rectification_check import already_rectified
+
+    left, right = _pair(data_dir, "middlebury2003/cones")
+    left, right = left[:200, :250], right[:200, :250] // 4
+    check = already_rectified(left, right)
+    assert check is not None and check.matches > 100 and check.median_dy < 0.5

@@ -285,6 +285,11 @@ def check_rectification(
         return RectificationCheck(
             0, nan, nan, nan, nan, nan, None, tol, identical=True, size=(w, h)
         )
+    from stereovision.uncalibrated import _exposure_matched
+
+    # two exposures (each camera its own auto-exposure): the darker view kept too few SIFT
+    # features, so a rectified pair was "cannot tell" and rectify warped it (as f9e666ed)
+    gl, gr = _exposure_matched(gl, gr)
     pl, dl = _features(gl)
     pr, dr = _features(gr)
     pairs = (
