@@ -2361,3 +2361,16 @@ def test_describe_refuses_depths_without_a_depth_step() -> None:
         with pytest.raises(ValueError, match=rf"^{said}$"):
             c.describe(bad)  # type: ignore[arg-type]
     assert "at 1 m " in c.describe()
+
+
+def test_from_file_refuses_an_empty_path_by_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Calibration.from_file('') was read as the current folder ('calibration path . is a
+    folder without left.yaml and right.yaml ...', or a calib.txt there read unasked), where
+    Calibration.load('') and the parsers name the empty path."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "calib.txt").write_text("x")
+    with pytest.raises(ValueError) as err:
+        Calibration.from_file("")
+    assert str(err.value) == "path: expected a file name, got ''"

@@ -1561,8 +1561,9 @@ class Calibration:
         TypeError
             If ``path`` is bytes: the library's paths are str or os.PathLike, as io's are.
         """
-        # pathlib's own TypeError for a bytes name named no argument
-        as_path(path)
+        # pathlib's own TypeError for a bytes name named no argument; '' (an unset variable)
+        # was read as the current folder: "calibration path . is a folder without ..."
+        as_path(path, file=True)
         if unit is not None:
             unit = known_unit(unit, UNIT_TO_METRES)
         calib = cls._read_any(path, image_size, unit)
