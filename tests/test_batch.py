@@ -960,9 +960,9 @@ def test_batch_reports_an_image_without_its_pair(
     assert main(["batch", str(root / "c"), "-o", str(tmp_path / "o2")]) == 2
     assert capsys.readouterr().err.strip() == (
         f"stereovision: error: no pair under {root / 'c'} (scene folders with left.png + "
-        "right.png, files named ...left... / ...right..., or the same file names in sibling "
-        "camera folders left/ + right/, L/ + R/, image_2/ + image_3/, image_02/ + image_03/, "
-        "cam0/ + cam1/); 2 "
+        "right.png or im0.png + im1.png, files named ...left... / ...right..., or the same file "
+        "names in sibling camera folders left/ + right/, L/ + R/, image_2/ + image_3/, "
+        "image_02/ + image_03/, cam0/ + cam1/); 2 "
         f"image(s) without the other of their pair, e.g. no x_right.png beside "
         f"{root / 'c/x_left.png'}"
     )

@@ -1880,10 +1880,10 @@ def run_batch(
             else ""
         )
         raise ValueError(
-            f"no pair under {input_dir} (scene folders with left.png + right.png, "
-            "files named ...left... / ...right..., or the same file names in sibling camera "
-            "folders left/ + right/, L/ + R/, image_2/ + image_3/, image_02/ + image_03/, "
-            f"cam0/ + cam1/){alone}"
+            f"no pair under {input_dir} (scene folders with left.png + right.png or "
+            "im0.png + im1.png, files named ...left... / ...right..., or the same file names in "
+            "sibling camera folders left/ + right/, L/ + R/, image_2/ + image_3/, "
+            f"image_02/ + image_03/, cam0/ + cam1/){alone}"
         )
     out = Path(output_dir)
     from stereovision.io import missing_folders
