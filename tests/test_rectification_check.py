@@ -1361,3 +1361,27 @@ def test_a_rectified_pair_of_two_exposures_is_already_rectified(data_dir: Path) 
     left, right = left[:200, :250], right[:200, :250] // 4
     check = already_rectified(left, right)
     assert check is not None and check.matches > 100 and check.median_dy < 0.5
+
+
+def test_a_right_image_turned_on_its_side_is_named_by_check_and_depth(tmp_path: Path) -> None:
+    """A right image of the left's size turned (a camera mounted on its side: 40x30 beside
+    30x40) was refused by check_rectification, rectify and depth as 'the two images of a pair
+    have one size' alone, where rectify_uncalibrated names the turn (64638868): rectify's
+    check runs first, so its hint was never reached."""
+    from stereovision.cli import _check_pair
+
+    said = (
+        "left is 40x30 px, right is 30x40 px: the two images of a pair have one size (the right "
+        "image is the left's size turned 90 degrees: a camera mounted on its side? turn it back "
+        "first)"
+    )
+    left, right = np.zeros((30, 40), np.uint8), np.zeros((40, 30), np.uint8)
+    with pytest.raises(ValueError) as err:
+        check_rectification(left, right)
+    assert str(err.value) == said
+    with pytest.raises(ValueError) as err:
+        _check_pair(left, right, None, None)
+    assert str(err.value) == said
+    with pytest.raises(ValueError) as err:  # other sizes as before
+        check_rectification(left, np.zeros((40, 40), np.uint8))
+    assert str(err.value).endswith("px: the two images of a pair have one size")

@@ -284,13 +284,12 @@ def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: 
         _rig_to_warp_by,
         _too_narrow,
     )
+    from stereovision.rectification_check import _two_sizes
 
     (h, w), (hr, wr) = np.shape(left)[:2], np.shape(right)[:2]
     if (h, w) != (hr, wr):
         # width x height, as check and rectify say it: NumPy's (375, 450, 3) read as 375 wide
-        raise ValueError(
-            f"left is {w}x{h} px, right is {wr}x{hr} px: the two images of a pair have one size"
-        )
+        raise ValueError(_two_sizes(w, h, wr, hr))
     _rig_to_warp_by(calib, w, h, max_disparity)  # a calibration for another image size
     if max_disparity is not None and max_disparity >= w:
         raise _range_too_wide(max_disparity, w)

@@ -272,9 +272,7 @@ def check_rectification(
     gl, gr = _grey_pair(left, right)
     if gl.shape != gr.shape:
         (hl, wl), (hr, wr) = gl.shape, gr.shape
-        raise ValueError(
-            f"left is {wl}x{hl} px, right is {wr}x{hr} px: the two images of a pair have one size"
-        )
+        raise ValueError(_two_sizes(wl, hl, wr, hr))
     h, w = gl.shape
     tol = float(tolerance)
     if gl.min() < gl.max() and np.array_equal(gl, gr):
@@ -300,6 +298,22 @@ def check_rectification(
     xl, yl = pl[pairs[:, 0]].T
     xr, yr = pr[pairs[:, 1]].T
     return _judge_rows(np.column_stack([xl, yl, xr, yr]), w, h, tol)
+
+
+def _two_sizes(wl: int, hl: int, wr: int, hr: int) -> str:
+    """The refusal of a pair of two sizes; one the other's turned is named as a camera mounted
+    on its side, as rectify_uncalibrated names it (rectify and depth said only "have one
+    size", rectify before rectify_uncalibrated could say more)."""
+    turned = (
+        " (the right image is the left's size turned 90 degrees: a camera mounted on its side? "
+        "turn it back first)"
+        if (wl, hl) == (hr, wr)
+        else ""
+    )
+    return (
+        f"left is {wl}x{hl} px, right is {wr}x{hr} px: the two images of a pair have one size"
+        f"{turned}"
+    )
 
 
 def _grey_pair(
