@@ -1936,7 +1936,8 @@ def test_ideal_refuses_an_infinite_baseline_by_name() -> None:
     # |T| of a 1e-300 m baseline underflows to 0: it was "T: zero baseline", naming no argument
     with pytest.raises(ValueError, match=r"^baseline_m: .* got 1e-300 \(too small to compute"):
         Calibration.ideal((640, 480), 90.0, 1e-300)
-    assert Calibration.ideal((640, 480), 90.0, 1e-150).baseline_m == 1e-150
+    with pytest.warns(UserWarning, match=r"^baseline 1e-150 m, shorter than any stereo rig"):
+        assert Calibration.ideal((640, 480), 90.0, 1e-150).baseline_m == 1e-150
 
 
 def test_from_q_reads_a_negative_multiple_and_refuses_a_q31(tmp_path: Path) -> None:
