@@ -1821,6 +1821,19 @@ def test_an_empty_rectification_path_is_named() -> None:
         UncalibratedRectification.load("")
 
 
+def _small_cones(data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Cones' grey pair at 150x125 (INTER_AREA): features enough, cheap to match."""
+    left, right = (
+        cv2.resize(
+            cv2.imread(str(data_dir / "middlebury2003/cones" / f), cv2.IMREAD_GRAYSCALE),
+            (150, 125),
+            interpolation=cv2.INTER_AREA,
+        )
+        for f in ("left.png", "right.png")
+    )
+    return left, right
+
+
 def test_a_pair_taken_at_different_exposures_is_rectified_from_its_features(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1831,14 +1844,7 @@ def test_a_pair_taken_at_different_exposures_is_rectified_from_its_features(
     matches); check() reads the pair alike. Pairs of one exposure (at most 1.08 apart measured
     on the real pairs) are given to SIFT as they are."""
     _features_once(monkeypatch)  # check() matches the pair rectify_uncalibrated matched
-    left, right = (
-        cv2.resize(
-            cv2.imread(str(data_dir / "middlebury2003/cones" / f), cv2.IMREAD_GRAYSCALE),
-            (150, 125),
-            interpolation=cv2.INTER_AREA,
-        )
-        for f in ("left.png", "right.png")
-    )
+    left, right = _small_cones(data_dir)
     dark = right // 4
     rect = rectify_uncalibrated(left, dark, model="projective")  # the features are the point
     assert rect.matches >= 100 and rect.median_dy < 0.3  # as given (one exposure): 124, 0.07 px
@@ -1907,14 +1913,7 @@ def test_model_quasi_euclidean_not_fitting_names_the_option_too(
     model='projective' or 'auto'', a keyword of the function (exit 2, one line); it names
     --model too, as the swap refusal does. (The fit is stubbed to not fitting on a small cones
     crop.)"""
-    left, right = (
-        cv2.resize(
-            cv2.imread(str(data_dir / "middlebury2003/cones" / f), cv2.IMREAD_GRAYSCALE),
-            (150, 125),
-            interpolation=cv2.INTER_AREA,
-        )
-        for f in ("left.png", "right.png")
-    )
+    left, right = _small_cones(data_dir)
     monkeypatch.setattr(
         uncalibrated, "_quasi_euclidean", lambda *args: (np.eye(3), np.eye(3), 2.62)
     )
