@@ -793,3 +793,22 @@ def test_bench_table_names_a_scene_with_a_newline_escaped() -> None:
     case = BenchCase("fam/o\nk", "SGBM-3WAY", "opencv", 60, 40, 16, 5, 2.0, 1.0, {})
     lines = format_table([case]).splitlines()
     assert len(lines) == 2 and lines[1].startswith("fam/o\\nk ")
+
+
+def test_bench_says_a_gt_with_known_pixels_at_0_px(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """As eval: a GT converted keeping KITTI's 0 = unknown was scored against its 0s silently."""
+    from stereovision.io import write_pfm
+
+    scene = syn.narrow_scene(tmp_path, 20, 60)
+    gt = np.full((20, 60), 2.0, np.float32)
+    gt[:, :6] = -1.0  # another converter's mark of unknown pixels
+    write_pfm(scene / "gt_disp.pfm", gt)
+    monkeypatch.setattr(stereovision.bench, "bench_scene", lambda scene, runs: [])
+    assert main(["bench", str(scene), "--json"]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: {scene}: gt_disp.pfm: 120 of its 1200 known pixels (10.0 %) are at 0 px "
+        "or below, scored as known disparities; if they mark unknown pixels (as 0 does in "
+        "KITTI's and Middlebury's PNGs), write them as +inf"
+    ]

@@ -750,3 +750,37 @@ def test_eval_reads_a_16_bit_scene_at_its_16_bits(
     assert main(["eval", str(tmp_path), "--json", "--no-opencv", "--method", "fast"]) == 0
     row = json.loads(capsys.readouterr().out)
     assert row["ours"]["bad_2.0"] < 10.0
+
+
+def test_eval_says_a_gt_with_known_pixels_at_0_px(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A GT converted keeping KITTI's (and Middlebury's PNGs') 0 = unknown was scored against its
+    0s without a word (a crop of KITTI 000005, half its pixels unknown: bad-2.0 55.1 % for
+    7.6 % with them +inf). eval says so on stderr; the figures are as before (0 px is known)."""
+    import stereovision.cli as cli
+    from stereovision.evaluate import dense_metrics
+    from stereovision.io import write_pfm
+
+    def scored(scene: Any, *_a: Any) -> dict[str, Any]:  # the GT as scored, not the matcher
+        return {"ours": dense_metrics(np.full(scene.gt.shape, 2.0), scene.gt).as_dict()}
+
+    monkeypatch.setattr(cli, "_eval_scene", scored)
+    scene = syn.narrow_scene(tmp_path, 20, 60)
+    gt = np.full((20, 60), 2.0, np.float32)
+    gt[:, :15] = 0.0
+    write_pfm(scene / "gt_disp.pfm", gt)
+    args = ["eval", str(scene), "--json", "--no-opencv"]
+    assert main(args) == 0
+    cap = capsys.readouterr()
+    assert json.loads(cap.out)["ours"]["n_gt"] == 1200
+    assert cap.err.splitlines() == [
+        f"stereovision: {scene}: gt_disp.pfm: 300 of its 1200 known pixels (25.0 %) are at 0 px "
+        "or below, scored as known disparities; if they mark unknown pixels (as 0 does in "
+        "KITTI's and Middlebury's PNGs), write them as +inf"
+    ]
+    gt[:, :15] = np.inf  # unknown as a gt_disp.pfm marks it: nothing to say
+    write_pfm(scene / "gt_disp.pfm", gt)
+    assert main(args) == 0
+    cap = capsys.readouterr()
+    assert json.loads(cap.out)["ours"]["n_gt"] == 900 and cap.err == ""

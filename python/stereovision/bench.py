@@ -391,6 +391,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     from stereovision import baselines
     from stereovision.cli import MAX_RUNS, scene_failed_line
+    from stereovision.evaluate import gt_at_zero_note
     from stereovision.io import load_scene, scene_names, scene_too_narrow
 
     _check_runs(args.runs, "--runs")
@@ -422,6 +423,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
             try:
                 scene = load_scene(d, full_bits=True)  # as `depth` reads a 16-bit pair
                 scene.name = names[d]
+                # as eval: a GT converted keeping KITTI's 0 = unknown was scored against its 0s
+                zero_note = gt_at_zero_note(scene.gt)
+                if zero_note is not None:
+                    tqdm.write(f"stereovision: {escaped(str(d))}: {zero_note}", file=sys.stderr)
                 narrow = scene_too_narrow(scene)
                 if narrow:
                     # as eval says it: "disparity range 16 is not smaller than the image width 8

@@ -1970,6 +1970,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from stereovision.baselines import bm_reference_refusal
+    from stereovision.evaluate import gt_at_zero_note
     from stereovision.io import (
         _no_scene_under,
         distinct_scenes,
@@ -2039,6 +2040,10 @@ def cmd_eval(args: argparse.Namespace) -> int:
                     tqdm.write(f"skipped {escaped(str(d))}: {why}", file=sys.stderr)
                     skipped += 1
                     continue
+                # a GT converted keeping KITTI's 0 = unknown was scored against its 0s silently
+                zero_note = gt_at_zero_note(scene.gt)
+                if zero_note is not None:
+                    tqdm.write(f"stereovision: {escaped(str(d))}: {zero_note}", file=sys.stderr)
                 narrow = scene_too_narrow(scene)
                 if narrow:
                     # the range is evaluation.md's, never the caller's: "disparity range 16 is not

@@ -244,6 +244,37 @@ def dense_metrics(
     )
 
 
+def gt_at_zero_note(gt: npt.NDArray[np.floating[Any]] | None) -> str | None:
+    """What ``eval`` and ``bench`` say of a scene's GT with known pixels at 0 px or below.
+
+    A ``gt_disp.pfm`` marks unknown pixels non-finite; KITTI's and Middlebury's PNGs mark them
+    0, and a GT converted keeping those 0s was scored against them without a word (a crop of
+    KITTI 000005, half its pixels unknown: bad-2.0 55.1 % for 7.6 %). They stay known (a 0 px
+    disparity is a point at infinity): this says so.
+
+    Parameters
+    ----------
+    gt : numpy.ndarray or None
+        GT disparity (px), non-finite = unknown; None for a scene without one.
+
+    Returns
+    -------
+    str or None
+        The note, or None when no known pixel is at 0 px or below (or there is no GT).
+    """
+    if gt is None:
+        return None
+    known = np.asarray(gt)[np.isfinite(gt)]
+    low = int(np.count_nonzero(known <= 0))
+    if low == 0:
+        return None
+    return (
+        f"gt_disp.pfm: {low} of its {known.size} known pixels ({_pct(low, known.size):.1f} %) "
+        "are at 0 px or below, scored as known disparities; if they mark unknown pixels (as 0 "
+        "does in KITTI's and Middlebury's PNGs), write them as +inf"
+    )
+
+
 # ---------------------------------------------------------------------------------------- depth
 
 
