@@ -7,6 +7,7 @@ import itertools
 import json
 import math
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -966,3 +967,31 @@ def test_gt_depths_warnings_are_at_the_callers_line() -> None:
         with pytest.warns(UserWarning, match=words) as rec:
             gt_depth(gt, cal)
         assert [r.filename for r in rec] == [__file__]
+
+
+def test_dense_metrics_warns_of_a_gt_that_reads_as_a_disparity_png() -> None:
+    """KITTI's GT PNG read with cv2.imread (d * 256, 0 = unknown) was scored as pixels, its
+    unknown pixels known: SGBM-3WAY on 000005 bad-2.0 99.9 % for 29.5 %, without a word. An
+    integer GT as wide as the map or wider, or holding 0s, is warned about at the caller's
+    line; the figures are as before, and a GT in pixels (float, NaN = unknown) gets none."""
+    d = np.full((4, 8), 3.0)
+    gt = np.zeros((4, 8), np.uint16)
+    gt[:2] = 3 * 256  # KITTI's 16-bit PNG: 3 px, the lower half unknown (0)
+    with pytest.warns(
+        UserWarning,
+        match=r"^gt: values up to 768 px, as wide as the map \(8 px\) "
+        r"or wider: no match lies that far; a disparity PNG \(KITTI's d \* 256, 0 = "
+        r"unknown\) reads as pixels with stereovision.export.read_disparity_png ",
+    ) as rec:
+        m = dense_metrics(d, gt)
+    assert [r.filename for r in rec] == [__file__] and m.bad[2.0] == 100.0 and m.n_gt == 32
+    with pytest.warns(UserWarning, match=r"^gt: an integer map with 16 pixels at 0, scored as "):
+        m = dense_metrics(d, gt // 256)  # the scale taken off, its 0s still known
+    assert m.bad[2.0] == 50.0 and m.n_gt == 32
+    as_pixels = np.where(gt > 0, gt / 256, np.nan)  # read_disparity_png's map
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = dense_metrics(d, as_pixels)
+        dense_metrics(d, np.full((4, 8), 7))  # integer, no 0, narrower than the map
+        dense_metrics(d, np.full((4, 8), 9.0))  # float: pixels, as wide as it may be
+    assert m.bad[2.0] == 0.0 and m.n_gt == 16
