@@ -995,3 +995,19 @@ def test_dense_metrics_warns_of_a_gt_that_reads_as_a_disparity_png() -> None:
         dense_metrics(d, np.full((4, 8), 7))  # integer, no 0, narrower than the map
         dense_metrics(d, np.full((4, 8), 9.0))  # float: pixels, as wide as it may be
     assert m.bad[2.0] == 0.0 and m.n_gt == 16
+
+
+def test_sparse_figures_warn_of_a_gt_that_reads_as_a_disparity_png() -> None:
+    """As dense_metrics: matches scored against KITTI's GT PNG as read (d * 256, 0 = unknown)
+    had a precision of about 0 without a word; sparse_metrics and count_at_precision warn at
+    the caller's line, their figures as before."""
+    gt = np.zeros((4, 8), np.uint16)
+    gt[:2] = 3 * 256
+    xl, yl, xr = np.array([5.0, 6.0]), np.array([0.0, 1.0]), np.array([2.0, 3.0])
+    with pytest.warns(UserWarning, match=r"^gt: values up to 768 px, as wide as the map") as rec:
+        assert sparse_metrics(xl, yl, xr, gt).count == 2
+        assert count_at_precision(xl, yl, xr, np.ones(2), gt, 50.0) == 0
+    assert [r.filename for r in rec] == [__file__] * 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sparse_metrics(xl, yl, xr, np.where(gt > 0, gt / 256, np.nan)).precision[0.5] == 100

@@ -252,10 +252,11 @@ def dense_metrics(
     )
 
 
-def _warn_if_png_gt(g: npt.NDArray[np.float64], integer: bool) -> None:
-    """Warn, at :func:`dense_metrics`' caller, of an integer GT map that reads as a disparity
-    PNG's: a disparity as wide as the map or wider (no match lies that far), or 0s (a PNG's
-    mark of unknown pixels; an integer map has no other). A float map is taken as pixels.
+def _warn_if_png_gt(g: npt.NDArray[np.float64], integer: bool, stacklevel: int = 4) -> None:
+    """Warn, at the caller of :func:`dense_metrics`, :func:`sparse_metrics` or
+    :func:`count_at_precision` (``stacklevel`` frames up), of an integer GT map that reads as
+    a disparity PNG's: a disparity as wide as the map or wider (no match lies that far), or 0s
+    (a PNG's mark of unknown pixels; an integer map has no other). A float map is pixels.
 
     KITTI's GT PNG read with ``cv2.imread`` (``d * 256``, 0 = unknown) was scored as pixels
     with its unknown pixels known: SGBM-3WAY on 000005 bad-2.0 99.9 % (29.5 % against the GT
@@ -279,7 +280,7 @@ def _warn_if_png_gt(g: npt.NDArray[np.float64], integer: bool) -> None:
         f"gt: {said}; a disparity PNG (KITTI's d * 256, 0 = unknown) reads as pixels with "
         "stereovision.export.read_disparity_png (unknown pixels NaN)",
         UserWarning,
-        stacklevel=4,  # this, dense_metrics, renamed_keyword's frame, the caller
+        stacklevel=stacklevel,  # 4: this, dense_metrics, renamed_keyword's frame, the caller
     )
 
 
@@ -764,8 +765,14 @@ def sparse_metrics(
     ValueError
         If ``xl``, ``yl``, ``xr`` are not 1-D arrays of real numbers of equal length or ``gt`` is
         not 2-D.
+
+    Warns
+    -----
+    UserWarning
+        As :func:`dense_metrics`, for an integer ``gt`` that reads as a disparity PNG's values.
     """
     g = _real_2d(gt, "gt")
+    _warn_if_png_gt(g, np.asarray(gt).dtype.kind in "iu", 3)  # no renamed_keyword frame
     arrs = [_coordinates(a, n) for a, n in ((xl, "xl"), (yl, "yl"), (xr, "xr"))]
     if any(a.ndim != 1 for a in arrs) or len({a.shape for a in arrs}) != 1:
         raise ValueError(
@@ -830,6 +837,11 @@ def count_at_precision(
     ------
     ValueError
         As :func:`sparse_metrics`, or if ``score`` has another length.
+
+    Warns
+    -----
+    UserWarning
+        As :func:`dense_metrics`, for an integer ``gt`` that reads as a disparity PNG's values.
     """
     # a target of NaN or above 100 % counted 0 matches, one below 0 all of them, a tolerance of 0,
     # -1 or NaN none, without a word ("1" was NumPy's UFuncTypeError)
@@ -840,6 +852,7 @@ def count_at_precision(
             f"tolerance: expected a positive finite number of pixels, got {number_shown(tolerance)}"
         )
     g = _real_2d(gt, "gt")
+    _warn_if_png_gt(g, np.asarray(gt).dtype.kind in "iu")
     x, y, x2, s = (
         _coordinates(a, n) for a, n in ((xl, "xl"), (yl, "yl"), (xr, "xr"), (score, "score"))
     )
