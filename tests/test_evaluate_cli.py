@@ -784,3 +784,33 @@ def test_eval_says_a_gt_with_known_pixels_at_0_px(
     assert main(args) == 0
     cap = capsys.readouterr()
     assert json.loads(cap.out)["ours"]["n_gt"] == 900 and cap.err == ""
+
+
+def test_eval_of_a_scene_whose_gt_kept_middleburys_name_says_to_rename_it(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A scene of left.png + right.png whose GT kept Middlebury's (and ETH3D's) name, disp0GT.pfm
+    or disp0.pfm, was 'no ground truth (gt_disp.pfm)' without a word on the file beside them;
+    the line now says to rename it (alone: the one-line error; among scenes: its skipped
+    line). A scene without either is said as before."""
+    scene = syn.narrow_scene(tmp_path, 20, 40)
+    (scene / "gt_disp.pfm").rename(scene / "disp0GT.pfm")
+    proc = _eval(capfd, str(scene), "--no-opencv")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"stereovision: error: {scene}: no ground truth (gt_disp.pfm) to evaluate against; it "
+        "holds Middlebury's disp0GT.pfm: rename it gt_disp.pfm"
+    ]
+    (scene / "disp0GT.pfm").rename(scene / "disp0.pfm")
+    other = tmp_path / "other"
+    other.mkdir()
+    syn.narrow_scene(other, 20, 40)
+    (other / "tiny" / "gt_disp.pfm").unlink()
+    proc = _eval(capfd, str(tmp_path), "--no-opencv")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"skipped {other / 'tiny'}: no ground truth (gt_disp.pfm)",
+        f"skipped {scene}: no ground truth (gt_disp.pfm); it holds Middlebury's disp0.pfm: "
+        "rename it gt_disp.pfm",
+        "stereovision: error: none of the 2 scenes has ground truth to evaluate against",
+    ]

@@ -2034,10 +2034,18 @@ def cmd_eval(args: argparse.Namespace) -> int:
                     if np.isfinite(scene.gt).any()
                     else "no ground truth: gt_disp.pfm has no known (finite) pixel"
                 )
+                # a scene whose images were renamed but whose GT kept Middlebury's (and ETH3D's)
+                # name was "no ground truth" without a word on the file beside them
+                named = [n for n in ("disp0GT.pfm", "disp0.pfm") if (d / n).is_file()]
+                hint = (
+                    f"; it holds Middlebury's {named[0]}: rename it gt_disp.pfm"
+                    if scene.gt is None and named
+                    else ""
+                )
                 if why is not None:
                     if len(dirs) == 1:
-                        raise CliError(f"{d}: {why} to evaluate against")
-                    tqdm.write(f"skipped {escaped(str(d))}: {why}", file=sys.stderr)
+                        raise CliError(f"{d}: {why} to evaluate against{hint}")
+                    tqdm.write(f"skipped {escaped(str(d))}: {why}{hint}", file=sys.stderr)
                     skipped += 1
                     continue
                 # a GT converted keeping KITTI's 0 = unknown was scored against its 0s silently
