@@ -812,3 +812,21 @@ def test_bench_says_a_gt_with_known_pixels_at_0_px(
         "or below, scored as known disparities; if they mark unknown pixels (as 0 does in "
         "KITTI's and Middlebury's PNGs), write them as +inf"
     ]
+
+
+def test_bench_of_a_scene_whose_gt_kept_middleburys_name_says_to_rename_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """As eval: a scene whose GT kept Middlebury's name (disp0GT.pfm) was benched with '-' for
+    every figure without a word on the GT beside its images; a scene without GT is not said."""
+    scene = syn.narrow_scene(tmp_path, 20, 40)
+    (scene / "gt_disp.pfm").rename(scene / "disp0GT.pfm")
+    monkeypatch.setattr(stereovision.bench, "bench_scene", lambda scene, runs: [])
+    assert main(["bench", str(scene), "--json"]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: {scene}: no ground truth (gt_disp.pfm), times only; it holds "
+        "Middlebury's disp0GT.pfm: rename it gt_disp.pfm"
+    ]
+    (scene / "disp0GT.pfm").unlink()
+    assert main(["bench", str(scene), "--json"]) == 0
+    assert capsys.readouterr().err == ""

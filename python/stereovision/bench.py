@@ -390,7 +390,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from stereovision import baselines
-    from stereovision.cli import MAX_RUNS, scene_failed_line
+    from stereovision.cli import MAX_RUNS, middlebury_gt_hint, scene_failed_line
     from stereovision.evaluate import gt_at_zero_note
     from stereovision.io import load_scene, scene_names, scene_too_narrow
 
@@ -423,6 +423,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
             try:
                 scene = load_scene(d, full_bits=True)  # as `depth` reads a 16-bit pair
                 scene.name = names[d]
+                # as eval: a GT left under Middlebury's name gave '-' for every figure, unsaid
+                hint = middlebury_gt_hint(d) if scene.gt is None else ""
+                if hint:
+                    tqdm.write(
+                        f"stereovision: {escaped(str(d))}: no ground truth (gt_disp.pfm), times "
+                        f"only{hint}",
+                        file=sys.stderr,
+                    )
                 # as eval: a GT converted keeping KITTI's 0 = unknown was scored against its 0s
                 zero_note = gt_at_zero_note(scene.gt)
                 if zero_note is not None:

@@ -1864,6 +1864,15 @@ def _eval_time_line(row: dict[str, Any]) -> str:
     return line
 
 
+def middlebury_gt_hint(folder: Path) -> str:
+    """What ``eval`` and ``bench`` add to the words of a scene without ``gt_disp.pfm`` whose
+    GT kept Middlebury's (and ETH3D's) name, ``disp0GT.pfm`` or ``disp0.pfm`` (its images
+    renamed, its GT not): ``"; it holds Middlebury's disp0GT.pfm: rename it gt_disp.pfm"``,
+    or ``""`` (it was "no ground truth" without a word on the file beside them)."""
+    named = [n for n in ("disp0GT.pfm", "disp0.pfm") if (folder / n).is_file()]
+    return f"; it holds Middlebury's {named[0]}: rename it gt_disp.pfm" if named else ""
+
+
 def scene_failed_line(folder: Path, error: BaseException) -> str:
     """The line saying one damaged scene of many (``eval``, ``bench``) failed, its folder named
     once: a message that names it already (a scene too narrow for its range, load_scene's
@@ -2034,14 +2043,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
                     if np.isfinite(scene.gt).any()
                     else "no ground truth: gt_disp.pfm has no known (finite) pixel"
                 )
-                # a scene whose images were renamed but whose GT kept Middlebury's (and ETH3D's)
-                # name was "no ground truth" without a word on the file beside them
-                named = [n for n in ("disp0GT.pfm", "disp0.pfm") if (d / n).is_file()]
-                hint = (
-                    f"; it holds Middlebury's {named[0]}: rename it gt_disp.pfm"
-                    if scene.gt is None and named
-                    else ""
-                )
+                hint = middlebury_gt_hint(d) if scene.gt is None else ""
                 if why is not None:
                     if len(dirs) == 1:
                         raise CliError(f"{d}: {why} to evaluate against{hint}")
