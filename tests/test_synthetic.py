@@ -372,3 +372,44 @@ def test_the_ray_cache_is_bounded_by_bytes_least_recently_used_first(
     monkeypatch.setattr(synthetic, "_RAYS_MAX_BYTES", 1000)
     pixel_rays(cams[2], D, (20, 10), 1)  # larger than the bound: kept alone
     assert [key[0] for key in synthetic._RAYS] == [cams[2].tobytes()]
+
+
+def test_the_ray_cache_is_safe_when_another_thread_renders_meanwhile(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The cache was a bare module dict used by the GUI's and batch threads: another thread
+    filling it between one call's store and its lookup evicted that call's rays (KeyError),
+    and an eviction during another's byte sum was 'dictionary changed size during iteration'.
+    Here a second thread renders nine other cameras the moment the first stores its rays."""
+    import threading
+
+    from stereovision import synthetic
+
+    errors: list[BaseException] = []
+    others = [np.array([[60.0 + i, 0.0, 2.0], [0.0, 60.0, 1.5], [0.0, 0.0, 1.0]]) for i in range(9)]
+
+    def fill() -> None:
+        try:
+            for k in others:
+                pixel_rays(k, D, (4, 3), 1)
+        except BaseException as exc:  # reported by the main thread
+            errors.append(exc)
+
+    class Cache(dict):  # type: ignore[type-arg]
+        thread: threading.Thread | None = None
+
+        def __setitem__(self, key: object, value: object) -> None:
+            super().__setitem__(key, value)
+            if Cache.thread is None and threading.current_thread() is threading.main_thread():
+                Cache.thread = threading.Thread(target=fill)
+                Cache.thread.start()
+                Cache.thread.join(0.05)  # waits on the lock once there is one
+
+    monkeypatch.setattr(synthetic, "_RAYS", Cache())
+    cam = np.array([[100.0, 0.0, 2.0], [0.0, 100.0, 1.5], [0.0, 0.0, 1.0]])
+    rays = pixel_rays(cam, D, (4, 3), 1)
+    assert Cache.thread is not None
+    Cache.thread.join()
+    assert errors == []
+    np.testing.assert_allclose(rays[1, 2], [0.0, -0.005], atol=1e-12)  # (2 - cx, 1 - cy) / f
+    assert [key[0] for key in synthetic._RAYS] == [k.tobytes() for k in others]  # the oldest out

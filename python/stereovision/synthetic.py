@@ -10,6 +10,7 @@ rig are rendered this way, so that a test knows the exact geometry behind every 
 from __future__ import annotations
 
 import math
+import threading
 from typing import Any
 
 import cv2
@@ -28,6 +29,10 @@ _RAYS: dict[tuple[Any, ...], F64] = {}
 #: are kept even when larger). Nine cameras were kept whatever their size: three 1080p ones
 #: at supersample 3 held 896 MB after their renders. 256 MiB, as the SGM cost volume's bound.
 _RAYS_MAX_BYTES = 256 << 20
+#: Guards :data:`_RAYS`: renders from several threads (the GUI's, a batch's) raced on it, and one
+#: thread's eviction left another's lookup a KeyError or its byte sum "dictionary changed size
+#: during iteration" (8 threads of 200 small renders each: up to 16 of them failed).
+_RAYS_LOCK = threading.Lock()
 
 
 def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pinhole") -> F64:
@@ -43,41 +48,47 @@ def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pin
         ``(h * ss, w * ss, 2)`` float64; NaN where the model has no ray in front of the camera.
     """
     key = (K.tobytes(), D.tobytes(), size, ss, model)
-    if key in _RAYS:
-        _RAYS[key] = _RAYS.pop(key)  # the most recently used last
+    with _RAYS_LOCK:
+        cached = _RAYS.pop(key, None)
+        if cached is not None:
+            _RAYS[key] = cached  # the most recently used last
+            return cached
+    # computed unlocked (OpenCV releases the GIL: threads of other cameras go on); two threads
+    # of one camera compute the same rays, and the last one's are kept
+    w, h = size
+    xs = (np.arange(w * ss) + 0.5) / ss - 0.5
+    ys = (np.arange(h * ss) + 0.5) / ss - 0.5
+    gx, gy = np.meshgrid(xs, ys)
+    pts = np.stack([gx.ravel(), gy.ravel()], axis=1).reshape(-1, 1, 2)
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+    if model == "fisheye":
+        und = cv2.fisheye.undistortPoints(pts, K, D, criteria=crit)
     else:
-        w, h = size
-        xs = (np.arange(w * ss) + 0.5) / ss - 0.5
-        ys = (np.arange(h * ss) + 0.5) / ss - 0.5
-        gx, gy = np.meshgrid(xs, ys)
-        pts = np.stack([gx.ravel(), gy.ravel()], axis=1).reshape(-1, 1, 2)
-        crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
-        if model == "fisheye":
-            und = cv2.fisheye.undistortPoints(pts, K, D, criteria=crit)
-        else:
-            und = cv2.undistortPoints(pts, K, D, R=None, P=None, criteria=crit)
-        rays = np.asarray(und, np.float64).reshape(h * ss, w * ss, 2)
-        if model == "fisheye":
-            # Past 90 degrees off axis there is no ray with z = 1: OpenCV returns a mirrored ray
-            # (tan < 0) or its -1e6 sentinel there. The limit is on the ray's angle theta, not
-            # on the distorted theta_d = r / f (the two differ by the k1..k4 polynomial: the
-            # old theta_d cut left out rays in front for k1 > 0 and kept mirrored ones behind
-            # for k1 < 0), so each ray is projected back and kept where it lands on its pixel.
-            theta = np.arctan(np.hypot(rays[..., 0], rays[..., 1]))
-            back = cv2.fisheye.distortPoints(und.reshape(-1, 1, 2), K, D)
-            off = np.hypot(*(np.asarray(back, np.float64).reshape(-1, 2) - pts[:, 0]).T)
-            bad = (theta >= np.pi / 2 * 0.999) | (off.reshape(theta.shape) > 0.01)
-            if bad.any():
-                # OpenCV clamps theta_d at 90 degrees: for k1 > 0 the rays in front beyond
-                # r = f pi / 2 came back wrong and were cut (f 300 px, k 0.1, -0.02, 0.005,
-                # -0.001: 243808 pixels of a 2000 x 1500 image seeing the background)
-                rays[bad] = _fisheye_rays(pts[bad.ravel(), 0], K, D)
+        und = cv2.undistortPoints(pts, K, D, R=None, P=None, criteria=crit)
+    rays = np.asarray(und, np.float64).reshape(h * ss, w * ss, 2)
+    if model == "fisheye":
+        # Past 90 degrees off axis there is no ray with z = 1: OpenCV returns a mirrored ray
+        # (tan < 0) or its -1e6 sentinel there. The limit is on the ray's angle theta, not
+        # on the distorted theta_d = r / f (the two differ by the k1..k4 polynomial: the
+        # old theta_d cut left out rays in front for k1 > 0 and kept mirrored ones behind
+        # for k1 < 0), so each ray is projected back and kept where it lands on its pixel.
+        theta = np.arctan(np.hypot(rays[..., 0], rays[..., 1]))
+        back = cv2.fisheye.distortPoints(und.reshape(-1, 1, 2), K, D)
+        off = np.hypot(*(np.asarray(back, np.float64).reshape(-1, 2) - pts[:, 0]).T)
+        bad = (theta >= np.pi / 2 * 0.999) | (off.reshape(theta.shape) > 0.01)
+        if bad.any():
+            # OpenCV clamps theta_d at 90 degrees: for k1 > 0 the rays in front beyond
+            # r = f pi / 2 came back wrong and were cut (f 300 px, k 0.1, -0.02, 0.005,
+            # -0.001: 243808 pixels of a 2000 x 1500 image seeing the background)
+            rays[bad] = _fisheye_rays(pts[bad.ravel(), 0], K, D)
+    with _RAYS_LOCK:
+        _RAYS.pop(key, None)  # another thread's rays of this camera
         # the least recently used first, until the rest and these fit (or none is left)
         kept = sum(r.nbytes for r in _RAYS.values())
         while _RAYS and (len(_RAYS) > 8 or kept + rays.nbytes > _RAYS_MAX_BYTES):
             kept -= _RAYS.pop(next(iter(_RAYS))).nbytes
         _RAYS[key] = rays
-    return _RAYS[key]
+    return rays
 
 
 def _fisheye_rays(px: F64, K: F64, D: F64) -> F64:
