@@ -2281,3 +2281,33 @@ def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: st
     assert fields["resolution"] == 0.05 and fields["origin"] == [0.0, -0.05, 0.0]
     if name == "map":
         assert text.startswith("image: map.png\n")
+
+
+@pytest.mark.parametrize(
+    ("normal", "height", "says"),
+    [
+        ([0.0, -2.0, 0.0], 1.0, "normal: expected a unit vector (finite, of length 1), got "
+         "[0.0, -2.0, 0.0] of length 2: pass normal / np.linalg.norm(normal)"),
+        ([0.0, -1.0, -0.1], 1.0, "normal: expected a unit vector (finite, of length 1), got "
+         "[0.0, -1.0, -0.1] of length 1.00499: pass normal / np.linalg.norm(normal)"),
+        ([0.0, 0.0, 0.0], 1.0, "normal: expected a unit vector (finite, of length 1), got "
+         "[0.0, 0.0, 0.0] of length 0"),
+        ([math.nan, -1.0, 0.0], 1.0, "normal: expected a unit vector (finite, of length 1), got "
+         "[nan, -1.0, 0.0] of length nan"),
+        ([0.0, -1.0, 0.0], math.nan, "height: expected a number of metres, got nan"),
+    ],
+)  # fmt: skip
+def test_a_hand_made_plane_of_no_unit_normal_or_a_nan_height_is_refused(
+    normal: list[float], height: float, says: str
+) -> None:
+    """A plane made by hand (a mount's tilt, an IMU's up) took any normal: [0, -2, 0] said
+    'camera 1.000 m above it' of a floor 0.5 m under the camera and doubled every height, a
+    tilt not normalised ([0, -1, -0.1]) put heights 0.5 % off, zeros made every point the
+    camera's height ('roll +180.00 deg') and a NaN every height NaN, as a NaN height did."""
+    with pytest.raises(ValueError) as exc:
+        GroundPlane(normal, height, (0.0, 0.0, 0.0), np.zeros((2, 2), bool), 1.0, 0.0)
+    assert str(exc.value) == says
+    # a float32 unit normal and a JSON-rounded one are unit vectors
+    tilt = np.array([0.0, -math.cos(0.1), -math.sin(0.1)])
+    for n in (tilt.astype(np.float32), [round(v, 4) for v in tilt]):
+        GroundPlane(n, 1.0, (0.0, 0.0, 0.0), np.zeros((2, 2), bool), 1.0, 0.0)

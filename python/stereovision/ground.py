@@ -183,11 +183,23 @@ class GroundPlane:
         normal = raw.astype(np.float64, copy=False)  # a fitted plane's: the same array
         if normal.shape != (3,):
             raise ValueError(f"normal: expected 3 numbers, got shape {normal.shape}")
+        # a normal of another length scaled every height by it, without a word ([0, -2, 0]:
+        # 'camera 1.000 m above it' of a floor 0.5 m under it, a point 1 m above it 2 m), and
+        # zeros or a NaN gave heights of the camera's alone or NaN, 'roll +180.00' or '+nan'
+        length = float(np.linalg.norm(normal)) if np.isfinite(normal).all() else math.nan
+        if not abs(length - 1.0) <= 1e-3:
+            hint = ": pass normal / np.linalg.norm(normal)" if length > 0 else ""
+            raise ValueError(
+                f"normal: expected a unit vector (finite, of length 1), got "
+                f"{reprlib.repr(self.normal)} of length {length:g}{hint}"
+            )
         object.__setattr__(self, "normal", normal)
         # a height of "1.5" or None built, then repr and every use failed in Python's words
         # ("unsupported operand type(s) for /: 'str' and 'float'"), naming no field
         for name in ("height", "inlier_share", "rms_px", "below_share"):
             _number(getattr(self, name), name)
+        if math.isnan(_number(self.height, "height")):  # every height NaN, without a word
+            raise ValueError(f"height: expected a number of metres, got {self.height!r}")
         try:
             coef = _real_array(self.disparity_plane)
         except ValueError:  # ragged
