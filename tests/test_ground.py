@@ -2311,3 +2311,39 @@ def test_a_hand_made_plane_of_no_unit_normal_or_a_nan_height_is_refused(
     tilt = np.array([0.0, -math.cos(0.1), -math.sin(0.1)])
     for n in (tilt.astype(np.float32), [round(v, 4) for v in tilt]):
         GroundPlane(n, 1.0, (0.0, 0.0, 0.0), np.zeros((2, 2), bool), 1.0, 0.0)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("resolution", 0.0, "resolution: expected a positive finite number, got 0.0"),
+        ("resolution", math.nan, "resolution: expected a positive finite number, got nan"),
+        ("origin", None, "origin: expected (x, y) in metres, got None"),
+        ("origin", (math.nan, 0.0), "origin: expected (x, y) in metres, got (nan, 0.0)"),
+        ("data", np.zeros((0, 3), np.int8), "data: expected (rows, cols) integer cells, got "
+         "int8 of shape (0, 3)"),
+        ("data", np.zeros((2, 2), bool), "data: expected (rows, cols) integer cells, got "
+         "bool of shape (2, 2)"),
+        ("data", None, "data: expected (rows, cols) integer cells, got None"),
+        ("data", np.full((2, 2), 50, np.int8), "data: expected cells of -1 (unknown), 0 (free) "
+         "or 100 (occupied), got 50"),
+    ],
+)  # fmt: skip
+def test_a_hand_made_grid_of_bad_fields_is_refused_naming_the_field(
+    field: str, value: object, says: str
+) -> None:
+    """OccupancyGrid made by hand (or with dataclasses.replace) took any field: a resolution
+    of 0 built, then cell_of was ZeroDivisionError and save wrote 'resolution: 0.0' into
+    map.yaml; an origin of None was "'NoneType' object is not subscriptable" in repr, no cells
+    OpenCV's "!_img.empty()" from save, and a cell of 50 was drawn as unknown."""
+    from stereovision.ground import OccupancyGrid
+
+    fields = {"data": np.array([[0, 100], [-1, -1]], np.int8), "resolution": 0.05,
+              "origin": (0.0, -0.05)}  # fmt: skip
+    with pytest.raises(ValueError) as exc:
+        OccupancyGrid(**{**fields, field: value})  # type: ignore[arg-type]
+    assert str(exc.value) == says
+    # cells as a list of ints, numbers as NumPy's: the grid they say
+    grid = OccupancyGrid([[0, 100], [-1, -1]], np.float32(0.25), [np.int64(1), 2])  # type: ignore[arg-type]
+    assert grid.data.dtype == np.int8 and grid.data.tolist() == [[0, 100], [-1, -1]]
+    assert (grid.resolution, grid.origin, grid.cell_of(1.3, 2.6)) == (0.25, (1.0, 2.0), (2, 1))

@@ -937,16 +937,44 @@ class OccupancyGrid:
     Attributes
     ----------
     data : numpy.ndarray
-        ``(rows, cols)`` int8: -1 unknown, 0 free (floor seen), 100 occupied.
+        ``(rows, cols)`` int8: -1 unknown, 0 free (floor seen), 100 occupied (integers of
+        another type are taken as int8; other values, no cells, bools are refused).
     resolution : float
-        Cell side (metres).
+        Cell side (metres, positive).
     origin : tuple of float
-        ``(x, y)`` of cell ``(0, 0)``'s corner (metres).
+        ``(x, y)`` of cell ``(0, 0)``'s corner (metres, finite).
     """
 
     data: npt.NDArray[np.int8]
     resolution: float
     origin: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        # a grid made by hand (or with dataclasses.replace) took anything: a resolution of 0
+        # built, then cell_of was ZeroDivisionError and save wrote 'resolution: 0.0' (-0.1 and
+        # NaN too), a list of cells was AttributeError "'list' object has no attribute
+        # 'shape'", an origin of None "'NoneType' object is not subscriptable", and no cells
+        # OpenCV's "!_img.empty()" from save; each is refused naming the field
+        from stereovision._validate import positive_finite
+
+        raw = _real_array(self.data)
+        cells = None if raw is None or raw.dtype.kind not in "iu" else raw
+        if cells is None or cells.ndim != 2 or cells.size == 0:
+            shown = reprlib.repr(self.data) if raw is None else f"{raw.dtype} of shape {raw.shape}"
+            raise ValueError(f"data: expected (rows, cols) integer cells, got {shown}")
+        odd = cells[(cells != UNKNOWN) & (cells != FREE) & (cells != OCCUPIED)]
+        if odd.size:  # image() drew any other value as unknown
+            raise ValueError(
+                f"data: expected cells of -1 (unknown), 0 (free) or 100 (occupied), "
+                f"got {odd.flat[0]}"
+            )
+        if cells.dtype != np.int8:  # occupancy_grid's: the same array
+            object.__setattr__(self, "data", cells.astype(np.int8))
+        object.__setattr__(self, "resolution", positive_finite(self.resolution, "resolution"))
+        x0, y0 = _pair(self.origin, "origin", "(x, y) in metres")
+        if not (math.isfinite(x0) and math.isfinite(y0)):
+            raise ValueError(f"origin: expected (x, y) in metres, got {self.origin!r}")
+        object.__setattr__(self, "origin", (x0, y0))
 
     def __repr__(self) -> str:
         # A summary, not the (rows, cols) cells the dataclass repr printed.
