@@ -3,6 +3,7 @@ a ramp, so each pixel's value is the texture coordinate its centre sees."""
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -413,3 +414,25 @@ def test_the_ray_cache_is_safe_when_another_thread_renders_meanwhile(
     assert errors == []
     np.testing.assert_allclose(rays[1, 2], [0.0, -0.005], atol=1e-12)  # (2 - cx, 1 - cy) / f
     assert [key[0] for key in synthetic._RAYS] == [k.tobytes() for k in others]  # the oldest out
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"texture": np.zeros((2, 32767), np.uint8)}, "texture: expected at most 32766 pixels a "
+         "side (OpenCV's remap), got shape (2, 32767): shrink it and scale units_per_pixel up"),
+        ({"image_size": (4096, 2), "supersample": 8}, "supersample: 8 samples a side of a 4096 x "
+         "2 image are 32768 x 16, past OpenCV's remap's 32766 a side: use a lower supersample"),
+    ],
+)  # fmt: skip
+def test_a_texture_or_picture_past_remaps_sides_is_named(kw: dict, message: str) -> None:
+    """cv2.remap takes fewer than SHRT_MAX (32767) pixels a side: a long texture (a 40 m
+    corridor at 1 mm a pixel) or a big picture's supersampling was its assertion 'dst.cols <
+    SHRT_MAX && ... in function remap', naming no argument, the picture's only after all its
+    rays were traced. Each is refused up front; 32766 pixels render."""
+    args = {"texture": np.zeros((4, 4), np.uint8), "image_size": (8, 6), "supersample": 1, **kw}
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}"):
+        render_plane(args.pop("texture"), 0.01, K, D, np.zeros(3), [0.0, 0.0, 1.0], **args)
+    out = render_plane(np.zeros((2, 32766), np.uint8), 0.01, K, D, np.zeros(3), [0, 0, 1.0],
+                       image_size=(8, 6), supersample=1)  # fmt: skip
+    assert out.shape == (6, 8)

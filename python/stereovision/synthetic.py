@@ -33,6 +33,9 @@ _RAYS_MAX_BYTES = 256 << 20
 #: thread's eviction left another's lookup a KeyError or its byte sum "dictionary changed size
 #: during iteration" (8 threads of 200 small renders each: up to 16 of them failed).
 _RAYS_LOCK = threading.Lock()
+#: Most pixels a side of the texture and of the supersampled picture (cv2.remap's
+#: ``SHRT_MAX - 1``).
+_REMAP_MAX_SIDE = 32766
 
 
 def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pinhole") -> F64:
@@ -225,7 +228,7 @@ def render_plane(
     image_size : tuple of int
         ``(width, height)``.
     supersample : int
-        Samples per pixel side (1 to 8).
+        Samples per pixel side (1 to 8; at most 32766 samples a side in all).
     background : float
         Value off the plane (NaN for a float texture; within an integer texture's range).
     model : str
@@ -242,7 +245,8 @@ def render_plane(
     Raises
     ------
     ValueError
-        For a bad size, supersampling or model; a ``units_per_pixel`` that is not a positive
+        For a bad size, supersampling or model, or a supersampled picture or a texture over
+        32766 pixels a side (OpenCV's remap); a ``units_per_pixel`` that is not a positive
         number, a ``background`` that is no number or not a value of an integer texture, an
         ``origin_px`` that is not two finite numbers; a texture that is empty, not ``(H, W)``
         or ``(H, W, C)`` with 1 to 4 channels, or not of integers or floats (bool, complex);
@@ -260,12 +264,24 @@ def render_plane(
             f"image_size: expected (width, height) in pixels, got {image_size!r}"
         ) from None
     ss = int_in_range(supersample, "supersample", 1, 8)
+    # cv2.remap's sides are below SHRT_MAX: past them its assertion named no argument, and
+    # only after every supersampled pixel's rays (10000 x 8000 at 4: 20 GB of them)
+    if max(w, h) * ss > _REMAP_MAX_SIDE:
+        raise ValueError(
+            f"supersample: {ss} samples a side of a {w} x {h} image are {w * ss} x {h * ss}, "
+            f"past OpenCV's remap's {_REMAP_MAX_SIDE} a side: use a lower supersample"
+        )
     tex = np.asarray(texture)
     # OpenCV's and NumPy's own errors named no argument ("!_src.empty() in function 'remap'",
     # "Singular matrix"), and a 1-D texture was drawn as one column
     if tex.size == 0 or not (tex.ndim == 2 or (tex.ndim == 3 and 1 <= tex.shape[2] <= 4)):
         raise ValueError(
             f"texture: expected a non-empty (H, W) or (H, W, 1-4) image, got shape {tex.shape}"
+        )
+    if max(tex.shape[:2]) > _REMAP_MAX_SIDE:  # a long strip: a 40 m corridor at 1 mm a pixel
+        raise ValueError(
+            f"texture: expected at most {_REMAP_MAX_SIDE} pixels a side (OpenCV's remap), got "
+            f"shape {tex.shape}: shrink it and scale units_per_pixel up as much"
         )
     # remap works in float32: a bool texture (a mask) came back as any value over 0, True at
     # every blended edge and on the background (74 % True of a half-True board), and a complex
