@@ -2347,3 +2347,34 @@ def test_a_hand_made_grid_of_bad_fields_is_refused_naming_the_field(
     grid = OccupancyGrid([[0, 100], [-1, -1]], np.float32(0.25), [np.int64(1), 2])  # type: ignore[arg-type]
     assert grid.data.dtype == np.int8 and grid.data.tolist() == [[0, 100], [-1, -1]]
     assert (grid.resolution, grid.origin, grid.cell_of(1.3, 2.6)) == (0.25, (1.0, 2.0), (2, 1))
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("angle_increment", 0.0, "angle_increment: expected a positive finite number, got 0.0"),
+        ("angle_increment", math.nan, "angle_increment: expected a positive finite number, "
+         "got nan"),
+        ("angle_min", None, "angle_min: expected a number, got None"),
+        ("angle_max", "inf", "angle_min, angle_max: expected finite radians, got -0.5, inf"),
+        ("range_min", 30.0, "range_min, range_max: expected 0 <= range_min < range_max, got "
+         "30.0, 20.0"),
+    ],
+)  # fmt: skip
+def test_a_hand_made_scan_of_bad_angles_or_ranges_is_refused_naming_the_field(
+    field: str, value: object, says: str
+) -> None:
+    """LaserScan made by hand took any angle or range limit: an increment of 0 put every beam
+    at angle_min (all three endpoints on one ray), NaN made every endpoint NaN, and an angle
+    of None was Python's "must be real number, not NoneType" from repr. Refused by name;
+    as_dict's "inf" is read back as infinity."""
+    from stereovision.ground import LaserScan
+
+    fields = {"angle_min": -0.5, "angle_max": 0.5, "angle_increment": 0.5, "range_min": 0.0,
+              "range_max": 20.0, "ranges": np.float32([1.0, 2.0, 3.0])}  # fmt: skip
+    with pytest.raises(ValueError) as exc:
+        LaserScan(**{**fields, field: value})  # type: ignore[arg-type]
+    assert str(exc.value) == says
+    scan = LaserScan(**{**fields, "range_max": "inf", "angle_min": np.float32(-0.5)})  # type: ignore[arg-type]
+    assert (scan.range_max, type(scan.angle_min)) == (math.inf, float)
+    np.testing.assert_allclose(scan.endpoints()[:, 1], [-0.479426, 0.0, 1.438277], atol=1e-6)

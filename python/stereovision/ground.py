@@ -1274,6 +1274,7 @@ class LaserScan:
         # a scan rebuilt from scan.json (as_dict: the ranges a list, NaN as null and +-inf as
         # "inf" / "-inf") failed in repr and endpoints with NumPy's "ufunc 'isfinite' not
         # supported for the input types", and as_dict with float()'s "not 'NoneType'"
+        self._check_fields()
         r = self.ranges
         if isinstance(r, np.ndarray) and r.dtype == np.float32 and r.ndim == 1:
             return  # laser_scan's: the same array
@@ -1292,6 +1293,30 @@ class LaserScan:
                 f"as_dict writes them), got {reprlib.repr(self.ranges)}"
             )
         object.__setattr__(self, "ranges", ranges.astype(np.float32))
+
+    def _check_fields(self) -> None:
+        """The angles and range limits as floats, after a ``ValueError`` naming the field: a
+        scan made by hand with an increment of 0 put every beam at ``angle_min`` (NaN: every
+        endpoint NaN), without a word, and an angle of None or ``"a"`` was Python's "must be
+        real number, not NoneType" from repr. ``"inf"`` / ``"-inf"`` are read as
+        :meth:`as_dict` writes them."""
+        values = {}
+        for name in ("angle_min", "angle_max", "angle_increment", "range_min", "range_max"):
+            v = getattr(self, name)
+            v = {"inf": math.inf, "-inf": -math.inf}.get(v, v) if isinstance(v, str) else v
+            values[name] = _number(v, name)
+        a0, a1, inc = values["angle_min"], values["angle_max"], values["angle_increment"]
+        if not (math.isfinite(a0) and math.isfinite(a1)):
+            raise ValueError(f"angle_min, angle_max: expected finite radians, got {a0!r}, {a1!r}")
+        if not (math.isfinite(inc) and inc > 0):
+            raise ValueError(f"angle_increment: expected a positive finite number, got {inc!r}")
+        r0, r1 = values["range_min"], values["range_max"]
+        if not (r0 >= 0 and r1 > r0):
+            raise ValueError(
+                f"range_min, range_max: expected 0 <= range_min < range_max, got {r0!r}, {r1!r}"
+            )
+        for name, v in values.items():
+            object.__setattr__(self, name, v)
 
     def __repr__(self) -> str:
         # A summary, not the (n,) ranges the dataclass repr printed.
