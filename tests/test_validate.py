@@ -1488,3 +1488,21 @@ def test_first_line_matches_a_part_with_a_control_character_at_an_end_as_a_whole
     assert first_line(ValueError("not found: 'scans/\nb':\nhint"), ["scans/\nb"]) == (
         "not found: 'scans/\\nb':"
     )
+
+
+def test_a_name_byte_that_is_not_utf8_is_shown_escaped_and_prints_in_strict_utf8() -> None:
+    """A file name's byte that is not UTF-8 (0xE9 of a Latin-1 ``café``) is a lone surrogate
+    once os.fsdecode'd; escaped() left it as it was, so a line naming it raised
+    UnicodeEncodeError on a UTF-8 standard output outside the C locale (``depth -o café``: the
+    files written, then 'stereovision: error: 'utf-8' codec can't encode character '\\udce9''
+    and exit 2). It is shown as Python names it, ``\\udce9``."""
+    import os
+
+    from stereovision._validate import escaped, first_line
+
+    name = os.fsdecode(b"scans/caf\xe9.png")
+    assert escaped(name) == "scans/caf\\udce9.png"
+    assert escaped(name).encode("utf-8") == b"scans/caf\\udce9.png"
+    assert first_line(FileNotFoundError(f"image file not found: {name}"), [name]) == (
+        "image file not found: scans/caf\\udce9.png"
+    )

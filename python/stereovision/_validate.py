@@ -1317,19 +1317,22 @@ def _message(exc: BaseException) -> str:
 
 
 #: The characters a one-line message does not show as they are: C0 and C1 controls (a
-#: newline, a tab, ESC that starts a sequence rewriting the terminal) and the line and
-#: paragraph separators ``str.splitlines`` also cuts at.
-_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+#: newline, a tab, ESC that starts a sequence rewriting the terminal), the line and
+#: paragraph separators ``str.splitlines`` also cuts at, and lone surrogates (a file name's
+#: byte that is not UTF-8, as :func:`os.fsdecode` gives it): a UTF-8 standard output not in
+#: the C locale cannot encode one, so printing the line raised UnicodeEncodeError.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
 
 
 def _escape_one(m: re.Match[str]) -> str:
-    return repr(m.group())[1:-1]  # "\n", "\t", "\x1b", "\u2028"
+    return repr(m.group())[1:-1]  # "\n", "\t", "\x1b", "\u2028", "\udce9"
 
 
 def escaped(text: str) -> str:
     """``text`` as a one-line message shows a path: as it is, unless it holds a control
-    character (:data:`_CONTROL`), then with those escaped as Python writes them and its
-    backslashes doubled (so that ``a\\nb`` is not read as ``a``, newline, ``b``).
+    character or a lone surrogate (:data:`_CONTROL`), then with those escaped as Python writes
+    them (``\\udce9`` for a name's byte 0xE9 that is not UTF-8) and its backslashes doubled
+    (so that ``a\\nb`` is not read as ``a``, newline, ``b``).
 
     Parameters
     ----------
