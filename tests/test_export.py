@@ -1119,6 +1119,28 @@ def test_load_cloud_of_a_folder_and_an_upper_case_ply(tmp_path):
         export.load_cloud(tmp_path / "SCAN.PLY")
 
 
+def test_cloud_readers_name_a_link_whose_target_moved_or_loops(tmp_path):
+    """read_pcd, read_npz and load_cloud said only "PCD file not found: cloud.pcd" of a link
+    whose target moved (a cloud linked in from a folder since moved), a name ls lists; they
+    name its target now, as io's readers do, and a loop of links as one."""
+    (tmp_path / "cloud.pcd").symlink_to(tmp_path / "moved" / "cloud.pcd")
+    (tmp_path / "a.ply").symlink_to("b.ply")
+    (tmp_path / "b.ply").symlink_to("a.ply")
+    for read, what in (
+        (export.read_pcd, "PCD file"),
+        (export.read_npz, "npz file"),
+        (export.load_cloud, "point cloud file"),
+    ):
+        with pytest.raises(FileNotFoundError) as exc:
+            read(tmp_path / "cloud.pcd")
+        assert str(exc.value) == (
+            f"{what} not found: {tmp_path}/cloud.pcd (a link to {tmp_path}/moved/cloud.pcd, "
+            "which does not exist)"
+        )
+        with pytest.raises(FileNotFoundError, match=r"a\.ply \(a link to b\.ply, one of a loop"):
+            read(tmp_path / "a.ply")
+
+
 def test_voxel_downsample_keeps_white_and_drops_partly_nan_points():
     pts = np.array([[0.01, 0.01, 0.01], [0.02, 0.02, 0.02], [np.nan, 0.01, 0.01]])
     cols = np.array([[255.0, 255, 255], [255, 253, 0], [0, 0, 0]])

@@ -53,6 +53,7 @@ from stereovision._validate import require as _require_type
 from stereovision.depth import DepthResult
 from stereovision.io import (
     _ascii_table,
+    _broken_link,
     _through_links,
     _writable_destination,
     atomic_write,
@@ -102,6 +103,23 @@ _METRIC_FORMATS = ("ply", "pcd", "depth16")
 _PCD_MAGIC = (b"# .PCD", b"VERSION")
 _PLY_MAGIC = b"ply"
 _ZIP_MAGIC = b"PK\x03\x04"
+
+
+def _cloud_file(path: PathLike, what: str) -> Path:
+    """``path`` as a file to read, else refused: ``"WHAT not found: P"``, or ``"not a file:
+    P"`` for a folder (it was "not found", as if the path were wrong) or a FIFO.
+
+    A link whose target moved (a cloud linked in from a folder since moved) was "not found"
+    alone, of a name ``ls`` lists: its target is named, as :mod:`stereovision.io`'s readers
+    name it (``(a link to X, which does not exist)``).
+    """
+    p = as_path(path, file=True)
+    if not p.exists():
+        gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+        raise FileNotFoundError(f"{what} not found: {p}{gone}")
+    if not p.is_file():
+        raise ValueError(f"not a file: {p}")
+    return p
 
 
 def _require_metric(result: DepthResult) -> None:
@@ -396,11 +414,7 @@ def read_pcd(
         Not a PCD file, unsupported fields / compression, truncated data, ``WIDTH`` x
         ``HEIGHT`` other than ``POINTS``, or a folder.
     """
-    p = as_path(path, file=True)
-    if not p.exists():
-        raise FileNotFoundError(f"PCD file not found: {p}")
-    if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
-        raise ValueError(f"not a file: {p}")
+    p = _cloud_file(path, "PCD file")
     raw = p.read_bytes()
     if not raw.startswith(_PCD_MAGIC):
         raise ValueError(f"not a PCD file: {p}")
@@ -642,11 +656,7 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     ValueError
         If the file is not an ``.npz`` bundle with ``depth`` and ``K``, or is a folder.
     """
-    p = as_path(path, file=True)
-    if not p.exists():
-        raise FileNotFoundError(f"npz file not found: {p}")
-    if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
-        raise ValueError(f"not a file: {p}")
+    p = _cloud_file(path, "npz file")
     try:
         loaded = np.load(p, allow_pickle=False)
         if not isinstance(loaded, np.lib.npyio.NpzFile):  # a .npy file: one array, no bundle
@@ -723,11 +733,7 @@ def load_cloud(
         Not a PLY / PCD / NPZ file (``"not a PLY file: ..."`` for a ``.ply`` that is not one), or
         a cloud without any finite point (``"empty point cloud: ..."``).
     """
-    p = as_path(path, file=True)
-    if not p.exists():
-        raise FileNotFoundError(f"point cloud file not found: {p}")
-    if not p.is_file():
-        raise ValueError(f"not a file: {p}")
+    p = _cloud_file(path, "point cloud file")
     with open(p, "rb") as fh:
         head = fh.read(8)
     cols: npt.NDArray[np.uint8] | None
