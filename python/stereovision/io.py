@@ -1304,6 +1304,9 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     -------
     numpy.ndarray
         ``(H, W)`` (``Pf``) or ``(H, W, 3)`` (``PF``) native-endian ``float32``, row 0 = top.
+        A ``PF`` file's channels come in the file's order, **RGB** (the format's), not the BGR
+        of :func:`imread` and ``cv2.imread`` (which flips a PFM's itself): ``img[..., ::-1]``
+        gives OpenCV's order.
 
     Raises
     ------
@@ -1370,7 +1373,9 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
         Destination file.
     arr : array_like
         ``(H, W)`` (written as ``Pf``) or ``(H, W, 3)`` (``PF``) real array, cast to
-        ``float32``. NaN and inf are written as they are, bit for bit.
+        ``float32``. NaN and inf are written as they are, bit for bit. A ``PF`` file's
+        channels are **RGB** (the format's, as :func:`read_pfm` gives them back): flip an
+        OpenCV BGR image first, ``img[..., ::-1]`` (``cv2.imwrite`` flips it itself).
     little_endian : bool
         Byte order of the data (scale ``-1`` when True, ``+1`` otherwise).
 
