@@ -1968,3 +1968,29 @@ def test_png_writers_name_swapped_arguments_and_a_file_name_for_the_map(result, 
         with pytest.raises(ValueError, match=r"a 16-bit depth image is written as \.png"):
             export.write_depth_png(tmp_path / "d.jpg", np.full((2, 2), 1500.0))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_read_pcd_says_a_coordinate_beyond_float32_in_words(tmp_path):
+    """A PCD coordinate beyond float32's range (ASCII 1e39, a SIZE 8 double's) became inf with
+    only NumPy's "overflow encountered in cast", naming no file; it is still inf (no point),
+    said once naming the file."""
+    import warnings
+
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE {s} {s} {s}\nTYPE F F F\nCOUNT 1 1 1\n"
+        "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA {mode}\n"
+    )
+    (tmp_path / "a.pcd").write_text(head.format(s=4, mode="ascii") + "1e39 0 1\n1.5 2 3\n")
+    (tmp_path / "b.pcd").write_bytes(
+        head.format(s=8, mode="binary").encode()
+        + np.array([(1e39, 0, 1), (1.5, 2, 3)], "<f8").tobytes()
+    )
+    for name in ("a.pcd", "b.pcd"):
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            pts, _ = export.read_pcd(tmp_path / name)
+        assert [str(w.message) for w in said] == [
+            f"PCD file {tmp_path / name}: 1 point(s) with a coordinate beyond float32's range "
+            "(e.g. 1e+39) read as inf (no point)"
+        ]
+        assert np.isinf(pts[0, 0, 0]) and pts[0, 1].tolist() == [1.5, 2, 3]

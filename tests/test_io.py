@@ -2859,3 +2859,30 @@ def test_load_scene_full_bits_keeps_a_16_bit_pair_and_reads_8_bits_alike(tmp_pat
     assert load_scene(tmp_path / "s16").left.max() == deep.max() >> 8  # default: the top 8 bits
     eight = load_scene(tmp_path / "s8")
     assert np.array_equal(load_scene(tmp_path / "s8", full_bits=True).left, eight.left)
+
+
+def test_read_ply_says_a_coordinate_beyond_float32_in_words(tmp_path: Path) -> None:
+    """A coordinate beyond float32's range (an ASCII float's or a double's 1e39) became inf
+    (no point) with only NumPy's "overflow encountered in cast", naming no file (twice for an
+    ASCII file; the CLI's view printed it as its warning). It is still inf, said once, naming
+    the file and the points; other coordinates read as before."""
+    import warnings
+
+    props = "property {t} x\nproperty {t} y\nproperty {t} z\n"
+    (tmp_path / "a.ply").write_bytes(
+        _ply("ascii", props.format(t="float"), 2) + b"1e39 0 1\n1.1 2 3\n"
+    )
+    rec = np.array([(-1e300, 0, 1), (1.1, 2, 3)], "<f8")
+    (tmp_path / "b.ply").write_bytes(
+        _ply("binary_little_endian", props.format(t="double"), 2) + rec.tobytes()
+    )
+    for name, big in (("a.ply", "1e+39"), ("b.ply", "-1e+300")):
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            pts, _ = read_ply(tmp_path / name)
+        assert [str(w.message) for w in said] == [
+            f"PLY file {tmp_path / name}: 1 point(s) with a coordinate beyond float32's range "
+            f"(e.g. {big}) read as inf (no point)"
+        ]
+        assert said[0].filename == __file__
+        assert np.isinf(pts[0, 0]) and pts[1].tolist() == [np.float32(1.1), 2, 3]

@@ -54,6 +54,7 @@ from stereovision.depth import DepthResult
 from stereovision.io import (
     _ascii_table,
     _broken_link,
+    _float32_coordinates,
     _through_links,
     _writable_destination,
     atomic_write,
@@ -511,7 +512,11 @@ def read_pcd(
             )
         if table.shape[0] != n:
             raise ValueError(f"PCD file {p}: expected {n} points, got {table.shape[0]}")
-        rec = np.empty(n, dtype=dtype)
+        # x, y and z as their text's float64: a 1e39 was made inf in the cast to a float field,
+        # said by nothing but NumPy's "overflow encountered in cast" (_float32_coordinates)
+        rec = np.empty(
+            n, dtype=[(f, "<f8") if f in ("x", "y", "z") else (f, dtype[f]) for f in fields]
+        )
         start = 0
         for i, name in enumerate(fields):
             col = table[:, start] if counts[i] == 1 else table[:, start : start + counts[i]]
@@ -527,7 +532,7 @@ def read_pcd(
         raise ValueError(
             f"PCD file {p}: unsupported DATA {mode!r} (ascii, binary or binary_compressed)"
         )
-    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=-1).astype(np.float32)
+    pts = _float32_coordinates(np.stack([rec["x"], rec["y"], rec["z"]], axis=-1), p, "PCD")
     cols = None if colour is None else _unpack_rgb(np.asarray(rec[colour]))
     shape = (height, width)
     return pts.reshape(*shape, 3), None if cols is None else cols.reshape(*shape, 3)

@@ -1686,7 +1686,16 @@ def read_ply(
     names = [n for n, _ in props]
     if not {"x", "y", "z"} <= set(names):
         raise ValueError(f"PLY file {p}: vertex has properties {names}, expected x, y, z")
-    dtype = np.dtype([(n, order + _PLY_TYPES[t]) for n, t in props])
+    # an ASCII file's float x, y, z as their text's float64: a 1e39 was made inf in the cast to
+    # float, said by nothing but NumPy's "overflow encountered in cast" (_float32_coordinates)
+    dtype = np.dtype(
+        [
+            (n, "f8")
+            if order == "=" and n in ("x", "y", "z") and _PLY_TYPES[t][0] == "f"
+            else (n, order + _PLY_TYPES[t])
+            for n, t in props
+        ]
+    )
     start = nl + 1
     if order == "=":
         # an element's row is a line, whatever its properties
@@ -1709,7 +1718,7 @@ def read_ply(
                 f"truncated PLY file {p}: expected {count} vertices of {dtype.itemsize} bytes"
             )
         rec = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
-    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float32, copy=False)
+    pts = _float32_coordinates(np.stack([rec["x"], rec["y"], rec["z"]], axis=1), p, "PLY")
     cols: npt.NDArray[np.uint8] | None = None
     prefix = next(
         (q for q in ("", "diffuse_") if {f"{q}red", f"{q}green", f"{q}blue"} <= set(names)), None
@@ -1731,6 +1740,28 @@ def read_ply(
             rgb = np.rint(np.clip(wide, 0, top) * (255.0 / top))
         cols = rgb.astype(np.uint8)
     return pts, cols
+
+
+def _float32_coordinates(xyz: npt.NDArray[Any], path: Path, kind: str) -> npt.NDArray[np.float32]:
+    """A cloud's ``(N, 3)`` coordinates, as read (a double PLY's or PCD's), as ``float32``.
+
+    A finite coordinate beyond float32's range (``1e39``) becomes inf in the cast, no point,
+    as before; it is said in one warning naming the file (``read_ply``'s and
+    ``export.read_pcd``'s), where NumPy's "overflow encountered in cast" named nothing.
+    """
+    with np.errstate(over="ignore"):
+        pts = xyz.astype(np.float32, copy=False)
+    if xyz.dtype.kind == "f" and xyz.dtype.itemsize > 4:
+        with np.errstate(invalid="ignore"):
+            lost = np.isfinite(xyz) & ~np.isfinite(pts)
+        if lost.any():
+            from stereovision._validate import source_warning
+
+            source_warning(
+                f"{kind} file {path}: {int(lost.any(axis=1).sum())} point(s) with a coordinate "
+                f"beyond float32's range (e.g. {float(xyz[lost][0])!r}) read as inf (no point)"
+            )
+    return pts
 
 
 def _ascii_table(
