@@ -659,18 +659,36 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     FileNotFoundError
         Missing file.
     ValueError
-        If the file is not an ``.npz`` bundle with ``depth`` and ``K``, or is a folder.
+        If the file is not an ``.npz`` bundle with ``depth`` and ``K``, is a folder, or a
+        member holds Python objects (``np.savez(..., meta={...})`` pickles them: not loaded,
+        a pickle can run code).
     """
     p = _cloud_file(path, "npz file")
     try:
         loaded = np.load(p, allow_pickle=False)
         if not isinstance(loaded, np.lib.npyio.NpzFile):  # a .npy file: one array, no bundle
             raise ValueError
+        data: dict[str, Any] = {}
+        pickled: list[str] = []
         with loaded as z:
-            data: dict[str, Any] = {k: z[k] for k in z.files}
+            for k in z.files:
+                try:
+                    data[k] = z[k]
+                except ValueError as exc:
+                    if "allow_pickle" not in str(exc):
+                        raise
+                    pickled.append(k)
     except (zipfile.BadZipFile, zlib.error, EOFError, ValueError, OSError):
         # zlib.error / EOFError: a bundle whose compressed members are damaged or cut.
         raise ValueError(f"not an .npz bundle (or a damaged one): {p}") from None
+    if pickled:
+        # a member of Python objects (np.savez(..., meta={...})) is a pickle, refused unloaded
+        # (loading one can run code), as before, but the whole file was said to be "not an .npz
+        # bundle (or a damaged one)", sending the user after a damaged download
+        raise ValueError(
+            f"{p}: its {pickled[0]!r} holds Python objects (a pickle, not loaded: loading one can "
+            "run code); save the bundle with numeric arrays only"
+        )
     if "depth" not in data or "K" not in data:
         raise ValueError(f"{p}: not a stereovision depth bundle (needs depth and K)")
     for key, value in list(data.items()):
