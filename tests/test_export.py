@@ -2009,3 +2009,14 @@ def test_read_npz_names_a_pickled_member_not_a_damaged_file(tmp_path):
             f"{tmp_path / 'm.npz'}: its 'meta' holds Python objects (a pickle, not loaded: "
             "loading one can run code); save the bundle with numeric arrays only"
         )
+
+
+def test_voxel_downsample_takes_float_colours_0_to_1_as_open3d_gives_them():
+    """Open3D's colours (np.asarray(pcd.colors)) are floats 0-1: taken as 0-255 they averaged to
+    0 or 1, a black cloud ([[1, 0, 0]] for orange), without a word. Floats all within 0-1 are
+    scaled to 0-255 (as read_ply and write_mesh_ply take them); any above 1, 0-255 as before."""
+    pts = np.array([[0.01, 0.01, 0.01], [0.02, 0.02, 0.02], [1.0, 1.0, 1.0]])
+    rgb = np.array([[1.0, 0.5, 0.0], [1.0, 0.5, 0.0], [0.2, 0.4, 0.6]])
+    for cols in (rgb, rgb.astype(np.float32), rgb * 255):
+        _down, dc = export.voxel_downsample(pts, cols, voxel=0.1)
+        assert dc is not None and dc.tolist() == [[255, 128, 0], [51, 102, 153]]

@@ -810,7 +810,9 @@ def voxel_downsample(
     points : array_like
         ``(N, 3)`` points (metres); non-finite rows are dropped.
     colors : array_like, optional
-        ``(N, 3)`` uint8 colours of the points.
+        ``(N, 3)`` colours of the points: ``uint8`` (or other integers) 0-255, or floats 0-1
+        (Open3D's and pyvista's colours; taken as 0-255 when any is above 1, as
+        :func:`stereovision.io.read_ply` takes them). Returned as ``uint8`` 0-255.
     voxel : float
         Cube side, in the points' unit.
 
@@ -872,6 +874,10 @@ def voxel_downsample(
                     f"colors: expected colours 0-255, got {int(bad.any(axis=1).sum())} point(s) "
                     "with values outside (or NaN)"
                 )
+            if cols.dtype.kind == "f" and cols.size and float(cols.max()) <= 1.0:
+                # Open3D's colours (np.asarray(pcd.colors)) are 0-1 floats: taken as 0-255 they
+                # averaged to 0 or 1, a black cloud, without a word
+                cols = cols * 255.0
     keep = np.isfinite(pts).all(axis=1)
     pts = pts[keep]
     if cols is not None:
