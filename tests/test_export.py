@@ -2020,3 +2020,25 @@ def test_voxel_downsample_takes_float_colours_0_to_1_as_open3d_gives_them():
     for cols in (rgb, rgb.astype(np.float32), rgb * 255):
         _down, dc = export.voxel_downsample(pts, cols, voxel=0.1)
         assert dc is not None and dc.tolist() == [[255, 128, 0], [51, 102, 153]]
+
+
+def test_an_ascii_pcd_or_ply_with_a_byte_order_mark_is_read(tmp_path):
+    """An ASCII cloud saved by a Windows editor opens with a UTF-8 byte-order mark: read_pcd
+    said 'not a PCD file', load_cloud 'not a point cloud file (PLY, PCD or NPZ)' (and of a
+    .ply 'not a PLY file'); both read it as without the mark."""
+    pcd = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+        "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 4294901760\n4 5 6 4278255360\n"
+    )
+    ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+    ply += "property float z\nend_header\n7 8 9\n"
+    (tmp_path / "c.pcd").write_bytes(b"\xef\xbb\xbf" + pcd.encode())
+    (tmp_path / "c.ply").write_bytes(b"\xef\xbb\xbf" + ply.encode())
+    pts, cols = export.read_pcd(tmp_path / "c.pcd")
+    assert pts.tolist() == [[[1, 2, 3], [4, 5, 6]]] and cols.tolist() == [
+        [[255, 0, 0], [0, 255, 0]]
+    ]
+    pts, cols = export.load_cloud(tmp_path / "c.pcd")
+    assert pts.tolist() == [[1, 2, 3], [4, 5, 6]] and cols.tolist() == [[255, 0, 0], [0, 255, 0]]
+    pts, cols = export.load_cloud(tmp_path / "c.ply")
+    assert pts.tolist() == [[7, 8, 9]] and cols is None

@@ -2886,3 +2886,13 @@ def test_read_ply_says_a_coordinate_beyond_float32_in_words(tmp_path: Path) -> N
         ]
         assert said[0].filename == __file__
         assert np.isinf(pts[0, 0]) and pts[1].tolist() == [np.float32(1.1), 2, 3]
+
+
+def test_read_ply_of_an_ascii_cloud_with_a_byte_order_mark(tmp_path: Path) -> None:
+    """An ASCII PLY saved by a Windows editor opens with a UTF-8 byte-order mark (and CRLF):
+    it was 'not a PLY file'; it reads as without the mark."""
+    body = _ply("ascii", "property float x\nproperty float y\nproperty float z\n", 2)
+    body += b"1 2 3\n4 5 6.5\n"
+    (tmp_path / "b.ply").write_bytes(b"\xef\xbb\xbf" + body.replace(b"\n", b"\r\n"))
+    pts, cols = read_ply(tmp_path / "b.ply")
+    assert pts.tolist() == [[1, 2, 3], [4, 5, 6.5]] and cols is None

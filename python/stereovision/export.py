@@ -52,6 +52,7 @@ from stereovision._validate import require as _require_type
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.depth import DepthResult
 from stereovision.io import (
+    _UTF8_BOM,
     _ascii_table,
     _broken_link,
     _float32_coordinates,
@@ -416,7 +417,9 @@ def read_pcd(
         ``HEIGHT`` other than ``POINTS``, or a folder.
     """
     p = _cloud_file(path, "PCD file")
-    raw = p.read_bytes()
+    # an ASCII cloud saved by a Windows editor opens with a UTF-8 byte-order mark: it was "not a
+    # PCD file"
+    raw = p.read_bytes().removeprefix(_UTF8_BOM)
     if not raw.startswith(_PCD_MAGIC):
         raise ValueError(f"not a PCD file: {p}")
     meta: dict[str, list[str]] = {}
@@ -758,7 +761,7 @@ def load_cloud(
     """
     p = _cloud_file(path, "point cloud file")
     with open(p, "rb") as fh:
-        head = fh.read(8)
+        head = fh.read(len(_UTF8_BOM) + 8).removeprefix(_UTF8_BOM)  # a BOM: as read_ply's
     cols: npt.NDArray[np.uint8] | None
     if head.startswith(_PLY_MAGIC):
         pts, cols = read_ply(p)

@@ -1439,6 +1439,9 @@ _PLY_TYPES: dict[str, str] = {
 }
 
 
+#: The UTF-8 byte-order mark a Windows editor puts before a text file's first line.
+_UTF8_BOM = b"\xef\xbb\xbf"
+
 #: Comment of :func:`write_ply`'s header: the units and frame of the project's clouds.
 PLY_CLOUD_COMMENT = "stereovision point cloud (metres, X right, Y down, Z forward)"
 
@@ -1562,7 +1565,8 @@ def read_ply(
     ``diffuse_red, diffuse_green, diffuse_blue``).
 
     Reads the files :func:`write_ply` writes and other ASCII or binary (little- or big-endian)
-    PLY files with a ``vertex`` element of scalar properties (elements after it are ignored,
+    PLY files (a UTF-8 byte-order mark before ``ply`` allowed) with a ``vertex`` element of
+    scalar properties (elements after it are ignored,
     the rows of those before it, MeshLab's ``camera``, skipped: in a binary file only elements
     of scalar properties). Colours of a floating-point type are taken as 0-1 (as some tools
     write them) and scaled to 0-255, or as 0-255 when any of them is above 1. Colours of a
@@ -1590,7 +1594,9 @@ def read_ply(
         are also reported as ValueError.
     """
     p = _existing_file(path, "PLY file")
-    raw = p.read_bytes()
+    # an ASCII cloud saved by a Windows editor opens with a UTF-8 byte-order mark: it was "not a
+    # PLY file"
+    raw = p.read_bytes().removeprefix(_UTF8_BOM)
     # the first line is "ply" (a CR, trailing blanks kept): "plyfoo" was read as a PLY file
     magic = re.match(rb"ply[ \t\r]*\n", raw) is not None
     # the line that is "end_header", not the first "end_header" (a comment may hold one)
