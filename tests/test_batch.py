@@ -962,7 +962,7 @@ def test_batch_reports_an_image_without_its_pair(
         f"stereovision: error: no pair under {root / 'c'} (scene folders with left.png + "
         "right.png or im0.png + im1.png, files named ...left... / ...right..., or the same file "
         "names in sibling camera folders left/ + right/, L/ + R/, image_2/ + image_3/, "
-        "image_02/ + image_03/, cam0/ + cam1/); 2 "
+        "image_02/ + image_03/, cam0/ + cam1/, image_left/ + image_right/); 2 "
         f"image(s) without the other of their pair, e.g. no x_right.png beside "
         f"{root / 'c/x_left.png'}"
     )
@@ -1705,6 +1705,30 @@ def test_a_kitti_raw_drive_is_two_rigs_of_camera_folders(tmp_path: Path) -> None
         for left, right in (("image_00", "image_01"), ("image_02", "image_03"))
         for f in frames
     ]
+
+
+def test_a_tartanair_trajectory_is_camera_folders_paired_by_number(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """TartanAir's own layout (P000/image_left/000000_left.png + image_right/000000_right.png)
+    was no pair: every image 'unpaired' (no 000000_right.png beside 000000_left.png). The two
+    folders are camera folders, their images paired by number; --calib (its fixed calibration,
+    a calib.txt as the shared scene's) calibrates them, as any camera folders' pairs."""
+    from stereovision.batch import _scan
+
+    traj = tmp_path / "oldtown" / "Easy" / "P000"
+    frames = ("000000", "000001")
+    _blank(traj, *(f"image_{s}/{f}_{s}.png" for s in ("left", "right") for f in frames))
+    (traj / "pose_left.txt").write_text("0 0 0 0 0 0 1\n")
+    jobs, unpaired, _ = _scan(tmp_path / "oldtown")
+    assert unpaired == []
+    assert [(j.name, j.left, j.right, j.calib) for j in jobs] == [
+        (f"Easy/P000/{f}", traj / f"image_left/{f}_left.png", traj / f"image_right/{f}_right.png",
+         None)
+        for f in frames
+    ]  # fmt: skip
+    cal = data_dir / "tartanair/oldtown_easy_p000_001116/calib.txt"
+    assert {j.calib for j in find_pairs(tmp_path / "oldtown", calib=cal)} == {cal}
 
 
 def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(

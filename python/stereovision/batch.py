@@ -97,7 +97,8 @@ _DEFAULT_METHOD = "fused"
 #: of the same path under both are a pair (``left/0001.png`` + ``right/0001.png``; KITTI's
 #: ``image_2``/``image_3`` colour and ``image_0``/``image_1`` grey, its raw drives'
 #: ``image_02/data``/``image_03/data`` and ``image_00/data``/``image_01/data``; EuRoC's
-#: ``cam0/data`` + ``cam1/data``).
+#: ``cam0/data`` + ``cam1/data``; TartanAir's ``image_left/000000_left.png`` +
+#: ``image_right/000000_right.png``).
 CAMERA_FOLDERS = (
     ("left", "right"),
     ("l", "r"),
@@ -108,6 +109,9 @@ CAMERA_FOLDERS = (
     ("image_02", "image_03"),
     ("image_00", "image_01"),
     ("cam0", "cam1"),
+    # TartanAir's trajectories (P000/image_left/000000_left.png + image_right/000000_right.png,
+    # paired by number): each image was "unpaired" (no 000000_right.png beside it)
+    ("image_left", "image_right"),
 )
 _GONE = "its outputs were gone at the end of the run (the output folder moved or deleted?)"
 
@@ -228,19 +232,21 @@ def find_pairs(
     * Two sibling camera folders (:data:`CAMERA_FOLDERS`: ``left/`` + ``right/``, ``L/`` +
       ``R/``, KITTI's ``image_2/`` + ``image_3/`` and ``image_0/`` + ``image_1/`` (a raw
       drive's ``image_02/`` + ``image_03/`` and ``image_00/`` + ``image_01/``), EuRoC's
-      ``cam0/`` + ``cam1/``): the images of the same path under both (any depth) are a pair,
-      named by the parent folder and that path without the extension (``seq/0001`` for
-      ``seq/left/0001.png``, ``mav0/data/1403...`` for ``mav0/cam0/data/1403....png``); when
-      one folder holds several such rigs, the name keeps the left camera's folder
-      (``00/image_2/000000``). Images with ``left`` or ``right`` in their names are paired by
-      name as above; the images left over (and those named so without the other beside them)
-      by the number in their names, in the same sub-folder, the names otherwise the same
-      but for ``left`` / ``right`` and a number after the frame's glued to a word, which a
-      camera's names share (its index; ``seq/left/left_0001.png`` +
-      ``seq/right/right_0001.png`` -> ``seq/0001``, ``pair01_cam0.png`` + ``pair01_cam1.png``;
-      not ``000000_10.png`` + ``000000_11.png``); an image without the other is not a pair
-      (reported as above). Only
-      ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
+      ``cam0/`` + ``cam1/``, TartanAir's ``image_left/`` + ``image_right/``): the images of
+      the same path under both (any depth) are a pair, named by the parent folder and that
+      path without the extension (``seq/0001`` for ``seq/left/0001.png``,
+      ``mav0/data/1403...`` for ``mav0/cam0/data/1403....png``); when one folder holds
+      several such rigs, the name keeps the left camera's folder (``00/image_2/000000``);
+      TartanAir's ``P000/image_left/000000_left.png`` is ``P000/000000``. Images with
+      ``left`` or ``right`` in their names are paired by name as above; the images left over
+      (and those named so without the other beside them) by the number in their names, in the
+      same sub-folder, the names otherwise the same but for ``left`` / ``right`` and a number
+      after the frame's glued to a word, which a camera's names share (its index;
+      ``seq/left/left_0001.png`` + ``seq/right/right_0001.png`` -> ``seq/0001``,
+      ``pair01_cam0.png`` + ``pair01_cam1.png``; not ``000000_10.png`` + ``000000_11.png``); an
+      image without the other is not a pair (reported as above). Only ``calib`` applies to
+      these pairs (no ``calib.txt`` is looked for; the package holds no dataset's own
+      calibration: give TartanAir's, fx = fy = 320 px, baseline 0.25 m, as ``calib``).
 
     Folders linked into ``root`` from elsewhere are searched too, each once, their pairs named
     by the link; a link to a folder under ``root`` (an alias) or holding it (a loop) is not.
@@ -1883,7 +1889,7 @@ def run_batch(
             f"no pair under {input_dir} (scene folders with left.png + right.png or "
             "im0.png + im1.png, files named ...left... / ...right..., or the same file names in "
             "sibling camera folders left/ + right/, L/ + R/, image_2/ + image_3/, "
-            f"image_02/ + image_03/, cam0/ + cam1/){alone}"
+            f"image_02/ + image_03/, cam0/ + cam1/, image_left/ + image_right/){alone}"
         )
     out = Path(output_dir)
     from stereovision.io import missing_folders
@@ -2648,7 +2654,8 @@ def add_cli(subparsers: Any) -> None:
         "files named ...left.../...right... (seq/0001_left.png + seq/0001_right.png -> seq/0001), "
         "and images of the same name in sibling camera folders: left/ + right/, L/ + R/, KITTI's "
         "image_2/ + image_3/ (image_0/ + image_1/; a raw drive's image_02/ + image_03/, "
-        "image_00/ + image_01/), EuRoC's cam0/ + cam1/ (seq/left/0001.png + "
+        "image_00/ + image_01/), EuRoC's cam0/ + cam1/, TartanAir's image_left/ + "
+        "image_right/ (seq/left/0001.png + "
         "seq/right/0001.png -> seq/0001; mav0/cam0/data/1.png -> mav0/data/1). An image "
         "without the other of its pair is a failed pair. Pairs are recorded in OUT/summary.json; a "
         "re-run skips finished pairs. Exit status 1 when a pair failed (its error is in the "
