@@ -3789,6 +3789,29 @@ def test_find_pairs_takes_a_middlebury_scene_of_im0_and_im1(tmp_path: Path) -> N
     assert [(j.name, j.left.name) for j in find_pairs(tmp_path / "b")] == [("b", "im0.png")]
 
 
+def test_a_lone_im0_or_im1_is_reported_as_a_half_scene(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A Middlebury 2014 / ETH3D scene folder of im0.png without its im1.png was left out without
+    a word (no pair, no 'unpaired image'), where a left.png alone is reported: it is now a half
+    pair named as the scene, either way round; camera folders' im0.png are theirs as before."""
+    from stereovision.batch import _scan
+
+    _blank(tmp_path, "a/im0.png", "a/im1.png", "b/im0.png", "c/im1.png",
+           "d/left/im0.png", "d/right/im0.png", "d/left/x/im0.png")  # fmt: skip
+    jobs, unpaired, _ = _scan(tmp_path)
+    assert [j.name for j in jobs] == ["a", "d/im0"]
+    assert [(u.name, u.present, u.missing, u.side) for u in unpaired] == [
+        ("b", tmp_path / "b/im0.png", tmp_path / "b/im1.png", "left"),
+        ("c", tmp_path / "c/im1.png", tmp_path / "c/im0.png", "right"),
+        ("d/x/im0", tmp_path / "d/left/x/im0.png", tmp_path / "d/right/x/im0.png", "left"),
+    ]
+    assert main(["batch", str(tmp_path / "b"), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(f"; 1 image(s) without the other of their pair, e.g. no im1.png beside "
+                        f"{tmp_path / 'b/im0.png'}")  # fmt: skip
+
+
 def test_batch_takes_method_fused_as_the_default_it_is(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -223,7 +223,9 @@ def find_pairs(
       one pair, named by its path relative to ``root`` (``root``'s own name when ``root`` is the
       scene); its ``calib.txt`` is used when present, else its ``Q.dat``. So is one holding
       ``left`` + ``right`` of another suffix or case (``left.jpg`` + ``right.jpg``, ``LEFT.PNG``
-      + ``RIGHT.PNG``), its ``Q.dat`` when a ``left.png`` or ``left.jpg`` sizes it.
+      + ``RIGHT.PNG``), its ``Q.dat`` when a ``left.png`` or ``left.jpg`` sizes it. An
+      ``im0.png`` without its ``im1.png`` (or the other way round) is not a pair (reported
+      as below).
     * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
       saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
       in its place; the pair is named by its folder and the file name without ``left`` (and
@@ -310,6 +312,7 @@ def _scan(
     cam_found: list[PairJob] = []  # in sibling camera folders
     cam_unpaired: list[_Unpaired] = []
     cam_taken: set[Path] = set()  # named images paired across camera folders, by number
+    cam_images: set[Path] = set()  # every image of a camera folder's pair or half pair
     skip = _output_below(r, output)
     for d, _dirs, files, listed in _walk(r, skip):
         dirs = sorted(_dirs)
@@ -335,6 +338,14 @@ def _scan(
             )
             paired |= {lname, rname}
             break
+        else:
+            # an im0.png without its im1.png (or the other way round) is a half scene, as a
+            # left.png alone is: it was left out without a word
+            halves = (("im0.png", "im1.png", "left"), ("im1.png", "im0.png", "right"))
+            for present, missing, side in halves:
+                if present in names and missing not in names and here / present not in cam_images:
+                    name = rel if rel != "." else r.resolve().name
+                    unpaired.append(_Unpaired(name, here / present, here / missing, side))
         images = [f for f in sorted(files) if Path(f).suffix.lower() in IMAGE_EXTS and f[0] != "."]
         for f in images:
             p = here / f
@@ -375,6 +386,8 @@ def _scan(
             cam_found += pairs
             cam_unpaired += alone
             cam_taken |= by_number
+            cam_images |= {x for j in pairs for x in (j.left, j.right)}
+            cam_images |= {u.present for u in alone}
     # after the other layouts' pairs, so that those keep their names in a clash (the sort is
     # stable): camera folders' images were not pairs before
     found += cam_found
