@@ -1523,6 +1523,31 @@ def test_info_on_a_scene_folder_reads_its_calibration(
     )
 
 
+def test_info_says_the_size_it_gives_a_q_dat_sets_the_field_of_view(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``info Q.dat --size 100x100`` (a Q.dat of TartanAir's 640x480 rig, 90 degrees across)
+    said "field of view 10.5 x 13.2 degrees" without a word: a Q.dat holds no size, the field
+    of view is --size's. Now said, and a principal point outside the size given is named."""
+    q = tmp_path / "Q.dat"
+    q.write_text("1 0 0 -320\n0 1 0 -240\n0 0 0 320\n0 0 4 0\n")
+    assert main(["info", str(q), "--size", "100x100"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == "field of view 10.5 x 13.2 degrees"
+    assert lines[-1] == (
+        "image size 100x100 from --size (the file holds none): the field of view is for it; the "
+        "principal point (320.0, 240.0) px lies outside a 100x100 image: is it the rig's image "
+        "size?"
+    )
+    assert main(["info", str(q), "--size", "640x480"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == "field of view 90.0 x 73.7 degrees"
+    assert (
+        lines[-1]
+        == "image size 640x480 from --size (the file holds none): the field of view is for it"
+    )
+
+
 def test_info_on_an_image_list_says_it_is_not_a_calibration(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

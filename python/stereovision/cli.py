@@ -1514,6 +1514,22 @@ def _paper_baseline_words(text: str, baseline: float) -> str:
 MAX_PAPER_BASELINE_M = 1e6
 
 
+def _given_size_note(calib: Any) -> str:
+    """``info CALIB --size WxH``'s line for a calibration that holds no image size: the field
+    of view is the size given's (the depths are not), and a principal point outside that size
+    is named (the rig's images are another size)."""
+    w, h = calib.image_size
+    rc = calib if calib.rectified else calib.rectified_calibration()
+    cx, cy = float(rc.K1[0, 2]), float(rc.K1[1, 2])
+    note = f"image size {w}x{h} from --size (the file holds none): the field of view is for it"
+    if not (0 <= cx <= w - 1 and 0 <= cy <= h - 1):
+        note += (
+            f"; the principal point ({cx:.1f}, {cy:.1f}) px lies outside a {w}x{h} image: "
+            "is it the rig's image size?"
+        )
+    return note
+
+
 def cmd_info(args: argparse.Namespace) -> int:
     """``stereovision info CALIB``: what the rig can measure; ``info BAG``: what a recording
     holds (its topics, the stereo pair found) and, from its ``camera_info``, what its rig can
@@ -1556,17 +1572,18 @@ def cmd_info(args: argparse.Namespace) -> int:
     if not is_bag(args.calib):
         if topics != (None, None):
             raise CliError("--left-topic and --right-topic are for a bag")
+        from stereovision.calibration import _sizeless
         from stereovision.capture import parse_size
 
         # --size with a calibration: the image size of one that holds none (stereo_calib
         # output, a Q.dat alone), a check of the size of one that does
-        calib = load_calibration(
-            args.calib,
-            args.calib_unit,
-            size=parse_size(args.size, "--size"),
-            size_words="--size WxH",
-        )
+        size = parse_size(args.size, "--size")
+        calib = load_calibration(args.calib, args.calib_unit, size=size, size_words="--size WxH")
         print(calib.describe())
+        if size is not None and _sizeless(args.calib):
+            # the field of view is --size's alone: a Q.dat of a 640x480 rig given 100x100 said
+            # "field of view 10.5 x 13.2 degrees" for its 90 degree cameras, without a word
+            print(_given_size_note(calib))
         return 0
     if args.size is not None or args.calib_unit is not None:
         raise CliError("--size and --calib-unit are for a calibration file, not a bag")
