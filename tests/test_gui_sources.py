@@ -982,6 +982,24 @@ def test_folder_pairs_keep_and_no_pairs(tmp_path: Path) -> None:
         FolderPairs(tmp_path / "empty", "e")
 
 
+def test_folder_pairs_read_is_annotated_with_the_uint16_it_returns(tmp_path: Path) -> None:
+    """FolderPairs.read returns a 16-bit pair at its 16 bits (uint16) but was annotated as
+    uint8 arrays (a type: ignore hid it), as the page's StereoSource.read was: both say uint16."""
+    import typing
+
+    from stereovision.gui.sources import StereoSource
+
+    scene = tmp_path / "sc"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        cv2.imwrite(str(scene / name), np.full((4, 5, 3), 4095, np.uint16))
+    left, right = FolderPairs(scene, "sc").read()
+    assert left.dtype == right.dtype == np.uint16 and int(left.max()) == 4095
+    for read in (FolderPairs.read, StereoSource.read):
+        said = str(typing.get_type_hints(read)["return"])
+        assert "uint16" in said and "uint8" in said, said
+
+
 def test_folder_pairs_keep_checks_a_scenes_calibration_too(tmp_path: Path) -> None:
     # a scene whose calib.txt is a link out of the allowed folders is dropped whole: its
     # calibration would be read from outside them

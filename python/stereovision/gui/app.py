@@ -57,6 +57,7 @@ from stereovision.gui.sources import (
     IMAGE_SUFFIXES,
     AllowedFolders,
     FolderPairs,
+    Frame,
     StereoSource,
     display_path,
     expand_home,
@@ -1283,8 +1284,8 @@ def _source_name(src: int | str) -> str:
 class _Frames:
     """A pair read from a source (:func:`_read_pair`), not yet on show."""
 
-    left: npt.NDArray[np.uint8]
-    right: npt.NDArray[np.uint8]
+    left: Frame
+    right: Frame
     #: A folder pair's scene calib.txt, read (None: the page's ``--calib`` applies).
     calib: Any = None
     #: The folder pair's label (``folder data/seq: pair 0002 (2 of 20)``; "" for cameras).

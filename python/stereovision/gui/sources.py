@@ -57,6 +57,10 @@ VIDEO_SUFFIXES = frozenset({".avi", ".mp4", ".mkv", ".mov", ".webm"})
 #: At most this many files / scenes are listed per kind (a huge folder must not stall the page).
 MAX_LISTED = 500
 
+#: A source's frame: BGR, ``uint16`` for a 16-bit image file or sequence (kept at its 16 bits,
+#: as ``batch`` and ``capture`` read it), else ``uint8``.
+Frame = npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
+
 
 def display_path(
     path: str | os.PathLike[str], cwd: Path | None = None, home: Path | None = None
@@ -355,8 +359,8 @@ class AllowedFolders:
 class StereoSource(Protocol):
     """A pair of synchronised image sources."""
 
-    def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
-        """Grab a new (left, right) BGR pair."""
+    def read(self) -> tuple[Frame, Frame]:
+        """Grab a new (left, right) BGR pair (:data:`Frame`)."""
         ...
 
     def close(self) -> None:
@@ -641,16 +645,16 @@ class FolderPairs:
         """The :class:`~stereovision.batch.PairJob` last read (None before the first read)."""
         return self.jobs[self.index] if self.index >= 0 else None
 
-    def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
-        """The next pair (BGR, a 16-bit pair at its 16 bits as ``batch`` reads it), after the
-        last one the first again."""
+    def read(self) -> tuple[Frame, Frame]:
+        """The next pair (BGR, a 16-bit pair at its 16 bits as ``batch`` reads it: ``uint16``,
+        else ``uint8``), after the last one the first again."""
         from stereovision.io import read_image
 
         self.index = (self.index + 1) % len(self.jobs)
         job = self.jobs[self.index]
         # uint16 for a 16-bit pair, as a 16-bit sequence's frames are (_decode): the page
         # matches such a pair as it is and shows it at 8 bits
-        return read_image(job.left), read_image(job.right)  # type: ignore[return-value]
+        return read_image(job.left), read_image(job.right)
 
     def describe(self) -> str:
         """``folder data/seq: pair 0002 (2 of 20)``."""
