@@ -1039,6 +1039,18 @@ def test_the_max_disparity_field_is_applied_and_checked():
     _run(app, spawned.pop)
     assert f"disparities 0–{auto}\xa0px" in app.state.stats
     assert parse_max_disparity(None, 10) is None
+    # A refused value stayed in the field over a new pair, its error gone at the computation's
+    # end, the pair at another range: the field now shows the range in use (empty: automatic)
+    app.state.max_disp = "600"
+    app.apply_max_disparity()
+    assert app.state.error == "max disparity 600 px is not smaller than the pair's width 450 px"
+    app._load_scene(bundled_data_dir() / "cones")  # a new pair
+    _run(app, app.recompute)
+    assert (app.state.error, app.state.max_disp) == ("", "")
+    assert f"disparities 0–{auto}\xa0px" in app.state.stats
+    app.chosen_max_disparity, app._max_disp_refused = 32, "refused"  # a range typed before
+    app._max_disp_back()
+    assert app.state.max_disp == "32" and app._max_disp_refused is None
 
 
 def test_the_max_disparity_field_is_searched_as_typed():

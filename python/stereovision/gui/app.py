@@ -2656,6 +2656,7 @@ class StereoApp:
                     return  # superseded: the newer request computes (and reports) its own pair
                 self._failed_meanwhile = None  # the computation's error replaces it
                 self._fail(exc)
+                self._max_disp_back()
                 page, self._page_before = self._page_before, None
                 if page is not None:
                     with self.state:
@@ -2863,6 +2864,18 @@ class StereoApp:
         self._done()
         if self.pair is not None:
             self._spawn(self.recompute())
+
+    def _max_disp_back(self) -> None:
+        """The max-disparity field back to the range in use (empty: automatic) once its
+        refusal has left the page: a computation's end cleared "max disparity 300 px is not
+        smaller than the pair's width 160 px" while the field kept 300 over a new pair computed
+        at its automatic range. A refusal still on the page (said during the computation) keeps
+        its value, as a refused Load keeps the names typed."""
+        if self._max_disp_refused is None or self.state.error == self._max_disp_refused:
+            return
+        chosen = self.chosen_max_disparity
+        self.state.max_disp = "" if chosen is None else str(chosen)
+        self._max_disp_refused = None
 
     def _view_on_show(self, label: str, pending: str) -> ViewData | None:
         """The pair on show for a button that works on its results (Find floor, Save), or
@@ -3281,6 +3294,7 @@ class StereoApp:
             self._failed_meanwhile = None
             st.status = self._status_with_reads(None) or ("error" if kept else "ready")
             st.error = kept or ""
+            self._max_disp_back()
             st.floor_label = st.img_floor = ""  # a new depth map: its floor is not found yet
             st.save_label = ""
             st.computations += 1
