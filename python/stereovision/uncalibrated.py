@@ -925,10 +925,15 @@ def rectify_uncalibrated(
         if abs(e[2]) > 1e-12:
             ex, ey = e[0] / e[2], e[1] / e[2]
             if 0 <= ex <= w - 1 and 0 <= ey <= h - 1:
+                # or a nearly flat scene: OpenCV's chessboard pair 03, side by side (its
+                # calibration's epipole at x = -43235), was said to look along its baseline,
+                # F placed by the few matches off the board's plane (59 % on it)
                 raise ValueError(
                     f"the {name} image's epipole lies at ({ex:.0f}, {ey:.0f}), in the image: "
-                    "the cameras look along their baseline (one in front of the other), and no "
-                    "homography rectifies such a pair"
+                    "the cameras look along their baseline (one in front of the other), or the "
+                    f"scene is too flat to place it ({100 * share:.0f} % of the {len(p1)} "
+                    "matches fit one homography: a board held up to the cameras); no homography "
+                    "rectifies the pair from these matches"
                 )
     # Two cameras side by side, turned a little (five angles, two focal lengths); Hartley's
     # homographies of F when that does not fit.
