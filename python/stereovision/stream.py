@@ -1635,6 +1635,15 @@ def cmd_stream(args: argparse.Namespace) -> int:
                     f"{cam.topics[side]}: disparity only (--calib RIG for depth)",
                     file=log,
                 )
+            elif not args.bag and args.ground_every is None:
+                # no camera_info at all: disparity only, without a word (as info says it);
+                # --bag and --ground-every are refused below for it, in their own words
+                print(
+                    "calibration: none; the bag holds no camera_info beside "
+                    f"{cam.topics['left']} and {cam.topics['right']}: disparity only "
+                    "(--calib RIG for depth)",
+                    file=log,
+                )
     bag = None
     report: StreamReport | None = None  # None after the try: an error or interrupt is raised
     close_error: str | None = None  # the bag could not be finished (a full disk)
