@@ -2271,6 +2271,59 @@ def test_a_grab_thread_left_behind_leaves_the_callers_temporal_filter_alone(
         cam.close()
 
 
+@PIPELINED
+def test_a_second_ctrl_c_while_the_grab_thread_finishes_its_read_keeps_the_summary() -> None:
+    """Ctrl-C, then Ctrl-C again while the stream waited for the grab thread's read (a slow
+    camera in low light, a hung one: up to GRAB_JOIN_TIMEOUT s): the second interrupt raised
+    out of run_stream, the summary of the pairs done lost (the CLI said 'interrupted' alone).
+    The wait stops there: the summary of the pair done, ended "interrupted", and a warning that
+    the thread is left behind (Python 3.11's is_alive() said False after the cut join)."""
+    import signal
+
+    import stereovision.stream as streammod
+
+    release = threading.Event()
+
+    class SlowRig(_FakeRig):
+        def read(self) -> Any:
+            if self.count == 2:  # the read ahead of pair 2 waits for its frame
+                release.wait(10.0)
+            return super().read()
+
+    def ctrl_c_during_the_join() -> None:
+        grab = next(t for t in threading.enumerate() if isinstance(t, streammod._Producer))
+        grab.stop.wait(5.0)  # the stream ended: run_stream now waits for the thread
+        time.sleep(0.05)
+        signal.pthread_kill(threading.main_thread().ident or 0, signal.SIGINT)
+
+    again = threading.Thread(target=ctrl_c_during_the_join, daemon=True)
+    done: list[int] = []
+
+    def on_result(left: np.ndarray, res: Any) -> None:
+        done.append(1)
+        if len(done) == 2:
+            again.start()
+            raise KeyboardInterrupt  # the first Ctrl-C
+
+    try:
+        t0 = time.perf_counter()
+        with pytest.warns(UserWarning) as said:
+            try:
+                rep = run_stream(SlowRig([_frame(i) for i in range(4)]), max_disparity=16,
+                                 check=False, on_result=on_result, read_timeout=None)  # fmt: skip
+            except KeyboardInterrupt:  # (not to stop the test session)
+                pytest.fail("the second Ctrl-C raised out of run_stream: the summary lost")
+        assert time.perf_counter() - t0 < 3.0
+        assert (rep.frames, rep.ended, rep.error) == (1, "interrupted", None)
+        assert [str(w.message) for w in said] == [
+            "the grab thread is still inside a read of SlowRig, interrupted while waiting for "
+            "it: it is left behind; the pair it reads, if any, is dropped"
+        ]
+    finally:
+        release.set()
+        again.join(5.0)
+
+
 def test_a_bag_without_a_calibration_is_refused(
     videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -777,6 +777,9 @@ class _Producer(threading.Thread):
         self.slots = threading.Semaphore(QUEUE_SIZE)
         #: set when the stream ends; the source checks it too, after each read
         self.stop = stop
+        #: set when :meth:`run` returns (is_alive() after a join cut by Ctrl-C said False on
+        #: Python 3.11, the thread still inside a read)
+        self.finished = threading.Event()
 
     def _acquire(self) -> bool:
         while not self.stop.is_set():
@@ -785,6 +788,12 @@ class _Producer(threading.Thread):
         return False
 
     def run(self) -> None:
+        try:
+            self._run()
+        finally:
+            self.finished.set()
+
+    def _run(self) -> None:
         # the source's own warnings (a StereoCamera's resized frames), raised in this thread,
         # pointed at threading.py: held here, each goes to the consumer before its pair
         held: list[tuple[str, type[Warning]]] = []
@@ -1240,8 +1249,25 @@ def run_stream(
     finally:
         if producer is not None:
             producer.stop.set()
-            producer.join(timeout=GRAB_JOIN_TIMEOUT)
-            if producer.is_alive():
+            again = False
+            try:
+                producer.join(timeout=GRAB_JOIN_TIMEOUT)
+            except KeyboardInterrupt as exc:
+                # Ctrl-C (SIGTERM) again while the grab thread finished its read (a slow or hung
+                # camera: up to GRAB_JOIN_TIMEOUT s): it raised out of here, and the summary of
+                # the pairs done was lost. The wait stops; the run ends as interrupted.
+                again = True
+                if error is None:
+                    ended = "terminated" if isinstance(exc, Terminated) else "interrupted"
+            if again and not producer.finished.is_set():
+                warnings.warn(
+                    f"the grab thread is still inside a read of {_camera_name(camera)}, "
+                    "interrupted while waiting for it: it is left behind; the pair it reads, "
+                    "if any, is dropped",
+                    UserWarning,
+                    stacklevel=2,
+                )
+            elif producer.is_alive():
                 # it returned silently: the stream seemed stopped while a thread was still
                 # inside the camera (which a close then leaves to that read to release)
                 warnings.warn(
