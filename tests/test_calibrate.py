@@ -996,7 +996,7 @@ def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:
         parse_pattern("2x5", "--pattern")
     with pytest.raises(TypeError, match=r"pattern: expected inner corners as \(cols, rows\)"):
         parse_pattern(9)  # type: ignore[arg-type]
-    for bad_pair in ((9.5, 6), (9, 6.0), (True, 6)):
+    for bad_pair in ((9.5, 6), (9, 6.5), (True, 6)):
         with pytest.raises(TypeError, match=r"pattern: corner counts must be integers"):
             parse_pattern(bad_pair)  # type: ignore[arg-type]
     assert parse_pattern((np.int64(9), np.int32(6))) == (9, 6)
@@ -2836,3 +2836,23 @@ def test_render_chessboard_refuses_a_pose_or_distortion_not_of_opencvs_lengths()
         render_chessboard(K, None, [0.0, 0.0, 0.0], [np.nan, 0.0, 12.0], **size)
     with pytest.raises(ValueError, match=r"^tvec: expected 3 numbers \(finite\), got shape \(2,\)"):
         render_chessboard(K, None, [0.0, 0.0, 0.0], [0.0, 12.0], **size)
+
+
+def test_whole_number_floats_are_a_pattern_and_a_charuco_boards_squares() -> None:
+    """parse_pattern took Python or NumPy integers alone: (9.0, 6.0) read from a config or an
+    array was 'corner counts must be integers', and CharucoBoard((10.0, 7.0), ...) 'squares:
+    expected a ChArUco board's squares as COLSxROWS ...', where every other count goes by
+    whole_value (3.0 is 3). A fraction is still refused, not truncated."""
+    from fractions import Fraction
+
+    from stereovision.charuco import CharucoBoard
+
+    assert parse_pattern((9.0, 6.0)) == (9, 6)
+    assert parse_pattern(np.array([9.0, 6.0])) == (9, 6)  # type: ignore[arg-type]
+    assert parse_pattern((Fraction(9), np.float32(6))) == (9, 6)  # type: ignore[arg-type]
+    assert all(type(v) is int for v in parse_pattern((9.0, 6.0)))
+    assert CharucoBoard((10.0, 7.0), 0.03, 0.02).squares == (10, 7)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^pattern: corner counts must be integers, got 6\.5"):
+        parse_pattern((9, 6.5))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^squares: expected a ChArUco board's squares"):
+        CharucoBoard((10.5, 7), 0.03, 0.02)  # type: ignore[arg-type]

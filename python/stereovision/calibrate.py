@@ -59,7 +59,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path, escaped, whole_value
+from stereovision._validate import as_path, escaped, whole_value
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
@@ -244,7 +244,8 @@ def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int
     Parameters
     ----------
     text : str or sequence of int
-        ``"COLSxROWS"`` or ``(cols, rows)`` (Python or NumPy integers).
+        ``"COLSxROWS"`` or ``(cols, rows)`` (Python or NumPy integers, or whole numbers of
+        another type: ``(9.0, 6.0)``).
     name : str
         How the caller calls it, for the messages (the CLI's ``"--pattern"``).
 
@@ -284,13 +285,16 @@ def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int
             raise ValueError(
                 f"{name}: expected inner corners as (cols, rows), got {len(items)} values {text!r}"
             )
-        for v in items:
-            if not isinstance(v, (int, np.integer)) or isinstance(v, NOT_NUMBERS):
+        # whole_value, every count's rule: (9.0, 6.0) read from a config or an array is 9x6
+        # (it was refused as no integer); 9.5 is still refused, not truncated
+        wholes = [whole_value(v) for v in items]
+        for v, whole in zip(items, wholes, strict=True):
+            if whole is None:
                 raise TypeError(
                     f"{name}: corner counts must be integers, got {v!r} "
                     f"({type(v).__name__}) in {text!r}"
                 )
-        vals = [int(v) for v in items]
+        vals = [int(v) for v in wholes if v is not None]
     if min(vals) < MIN_PATTERN_CORNERS:
         raise ValueError(
             f"{name}: {vals[0]}x{vals[1]} inner corners; a chessboard needs at least "
