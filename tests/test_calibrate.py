@@ -694,6 +694,35 @@ def test_squares_counted_along_one_side_are_named(monkeypatch: pytest.MonkeyPatc
     assert "shows a board" not in str(err.value)
 
 
+def test_a_row_of_corners_missed_is_named(monkeypatch: pytest.MonkeyPatch) -> None:
+    """pattern=(9, 5) or (8, 6) for a 9x6 board (a row or column of corners missed; OpenCV finds
+    no 9x5 on its left01.jpg) was 'found in both images of only 0 of 1 pairs ... board not
+    found in either image' with no hint, the hint trying fewer corners only. One more along
+    either side is tried after them and named. A stand-in finder keeps it fast."""
+    seen: list[tuple[int, int]] = []
+
+    def finder(image: Any, pattern: tuple[int, int] = (9, 6)) -> Any:
+        seen.append(tuple(pattern))
+        return np.zeros((54, 2)) if tuple(pattern) == (9, 6) else None
+
+    monkeypatch.setattr(calmod, "find_corners", finder)
+    img = np.zeros((48, 64), np.uint8)
+    for pattern in ((9, 5), (8, 6)):
+        with pytest.raises(ValueError) as err:
+            calibrate([img], [img], pattern=pattern, square_size=1.0)
+        text = str(err.value)
+        assert text.startswith(f"the chessboard {pattern[0]}x{pattern[1]} inner corners was found")
+        assert (
+            "left_images[0] shows a board of 9x6 inner corners: count the points where four "
+            "squares meet along a row and along a column (pattern=(9, 6))"
+        ) in text
+        assert _cli_words(text).count("(--pattern 9x6)") == 1
+    assert seen[-5:] == [(7, 5), (7, 6), (8, 5), (8, 7), (9, 6)]  # fewer, then one more
+    with pytest.raises(ValueError) as err:  # 9x6 is one more than 8x5 both ways: no hint
+        calibrate([img], [img], pattern=(8, 5), square_size=1.0)
+    assert "shows a board" not in str(err.value)
+
+
 # ------------------------------------------------------------------------ mis-paired images
 
 

@@ -1429,16 +1429,21 @@ def _check_pairing(
     )
 
 
-def _squares_counted(gray: np.ndarray, pat: tuple[int, int]) -> tuple[int, int] | None:
-    """The inner corners of the board ``gray`` shows when ``pat`` counted its squares.
+def _squares_counted(gray: np.ndarray, pat: tuple[int, int]) -> tuple[tuple[int, int], bool] | None:
+    """The inner corners of the board ``gray`` shows when ``pat`` counted its squares, or
+    missed a row or column of its corners.
 
     Both ways first (10x7 for 9x6), then one way alone (10x6 or 9x7: the squares counted along
-    one side, the corners along the other); the first pattern found, or None (a pattern
-    under 3x3 is none).
+    one side, the corners along the other), then one more along either side (9x5 for 9x6: a row
+    of corners missed, which OpenCV does not find on OpenCV's left01.jpg); the first pattern
+    found and whether it is one fewer, or None (a pattern under 3x3 is none).
     """
     for fewer in ((pat[0] - 1, pat[1] - 1), (pat[0] - 1, pat[1]), (pat[0], pat[1] - 1)):
         if min(fewer) >= MIN_PATTERN_CORNERS and find_corners(gray, fewer) is not None:
-            return fewer
+            return fewer, True
+    for more in ((pat[0], pat[1] + 1), (pat[0] + 1, pat[1])):
+        if max(more) <= MAX_PATTERN_CORNERS and find_corners(gray, more) is not None:
+            return more, False
     return None
 
 
@@ -1762,12 +1767,19 @@ def calibrate(
         and first_gray is not None
         and len(used) < MIN_PAIRS
         and all(c is None for c in (*corners_l, *corners_r))
-        and (fewer := _squares_counted(first_gray, pat)) is not None
-    ):  # the squares counted (10x7) for the inner corners (9x6): the most common slip
+        and (counted := _squares_counted(first_gray, pat)) is not None
+    ):  # the squares counted (10x7) for the inner corners (9x6), the most common slip, or a
+        # row of corners missed (9x5)
+        (cols, rows), fewer = counted
         board_hint = (
-            f"{first_name} shows a board of {fewer[0]}x{fewer[1]} inner corners: the "
-            "pattern counts the points where four squares meet, one fewer each way than the "
-            f"squares (pattern=({fewer[0]}, {fewer[1]}))"
+            f"{first_name} shows a board of {cols}x{rows} inner corners: "
+            + (
+                "the pattern counts the points where four squares meet, one fewer each way than "
+                "the squares"
+                if fewer
+                else "count the points where four squares meet along a row and along a column"
+            )
+            + f" (pattern=({cols}, {rows}))"
         )
     if board is not None and not board.resolved:
         squares = f"{board.squares[0]}x{board.squares[1]}"
