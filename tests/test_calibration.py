@@ -1360,6 +1360,36 @@ def test_scaled_to_a_different_aspect_scales_x_and_y_apart() -> None:
     assert wide.K1[0, 1] == 2.0 * 4.0
 
 
+def test_scaled_to_a_size_turned_is_said_swapped(data_dir: Path) -> None:
+    """scaled_to(frame.shape[:2]) (height, width) for a 320x240 rig run at 160x120 scaled by
+    0.375 and 0.667, a calibration of no camera, without a word (depth_map then said the
+    calibration's 120x160 turned); the calibration's size turned is refused as swapped, and
+    from_file's image_size turned no longer advises that scaled_to. Another aspect ratio not
+    turned is still scaled (test_scaled_to_a_different_aspect_scales_x_and_y_apart)."""
+    c = raw_calib()
+    frame = np.zeros((120, 160), np.uint8)
+    with pytest.raises(ValueError) as err:
+        c.scaled_to(frame.shape[:2])  # type: ignore[arg-type]
+    assert str(err.value) == (
+        "image_size: 120x160 is the calibration's 320x240 turned: width and height swapped? "
+        "image_size is (width, height): (160, 120) (an image's shape[1::-1], not its shape[:2])"
+    )
+    with pytest.raises(ValueError, match=r"^image_size: 240x320 is the calibration's 320x240"):
+        c.scaled_to((240, 320))
+    assert c.scaled_to(frame.shape[1::-1]).image_size == (160, 120)  # type: ignore[arg-type]
+    assert c.scaled_to((160, 160)).image_size == (160, 160)  # not turned: scaled, as before
+    square = raw_calib(image_size=(240, 240))
+    assert square.scaled_to((120, 120)).image_size == (120, 120)
+    calib_txt = data_dir / "eth3d" / "playground" / "calib.txt"
+    if calib_txt.is_file():
+        with pytest.raises(ValueError) as err:
+            Calibration.from_file(calib_txt, image_size=(490, 941))
+        assert str(err.value) == (
+            f"{calib_txt} is a calibration of 941x490 images, not of the image_size (490, 941) "
+            "given: width and height swapped? image_size is (width, height)"
+        )
+
+
 def test_saved_yaml_holds_opencvs_shapes_and_every_field(tmp_path: Path) -> None:
     """The YAML is for OpenCV readers in any language: T a 3x1 column and D1/D2 rows, as
     OpenCV's stereo_calib writes them (a mutation audit found T written as a row unseen: this

@@ -374,6 +374,18 @@ def _pixels(value: object, what: str) -> int:
     return round(v)
 
 
+def _resize_advice(size: tuple[int, int], given: tuple[int, int]) -> str:
+    """What to do when a file's calibration of ``size`` is given another ``image_size``: leave
+    it out or scale the calibration, or, for ``size`` turned (``frame.shape[:2]`` given),
+    swap the two, which :meth:`Calibration.scaled_to` refuses to scale to."""
+    if not same_aspect(size, given) and same_aspect(size, (given[1], given[0])):
+        return "width and height swapped? image_size is (width, height)"
+    return (
+        f"leave image_size out, or resize the calibration with .scaled_to({given}) if the "
+        "images were resized"
+    )
+
+
 def _check_alpha(alpha: object, *, any_finite: bool = False) -> None:
     """A ``ValueError`` naming ``alpha`` unless it is a real number in ``[0, 1]`` (any finite
     one with ``any_finite``: :meth:`Calibration.rectified_calibration` passes OpenCV's -1, a
@@ -1117,11 +1129,22 @@ class Calibration:
         Raises
         ------
         ValueError
-            If ``image_size`` is not two positive integers.
+            If ``image_size`` is not two positive integers, or is the calibration's size turned
+            (``(height, width)``: ``frame.shape[:2]`` given for ``frame.shape[1::-1]``).
         """
         size = self._check_size(image_size)
         if size == self.image_size:
             return self
+        turned = (size[1], size[0])
+        if not same_aspect(self.image_size, size) and same_aspect(self.image_size, turned):
+            # frame.shape[:2] for (width, height): scaled by 3/8 and 2/3 (a 640x480 rig, 320x240
+            # frames), a calibration of no camera, said only by depth_map's size check later
+            w, h = self.image_size
+            raise ValueError(
+                f"image_size: {size[0]}x{size[1]} is the calibration's {w}x{h} turned: width "
+                f"and height swapped? image_size is (width, height): ({turned[0]}, "
+                f"{turned[1]}) (an image's shape[1::-1], not its shape[:2])"
+            )
         return self._scaled(size, size[0] / self.image_size[0], size[1] / self.image_size[1])
 
     def _scaled(self, size: tuple[int, int], sx: float, sy: float) -> Calibration:
@@ -1581,8 +1604,7 @@ class Calibration:
             w, h = calib.image_size
             raise ValueError(
                 f"{path} is a calibration of {w}x{h} images, not of the image_size "
-                f"{given} given: leave image_size out, or resize the calibration "
-                f"with .scaled_to({given}) if the images were resized"
+                f"{given} given: {_resize_advice(calib.image_size, given)}"
             )
         return calib
 
@@ -2078,8 +2100,7 @@ class Calibration:
                 # as from_file refuses it: the file's own size was kept, the given one dropped
                 raise ValueError(
                     f"{p} is a calibration of {size[0]}x{size[1]} images ({s_rect}), not of "
-                    f"the image_size {given} given: leave image_size out, or resize the "
-                    f"calibration with .scaled_to({given}) if the images were resized"
+                    f"the image_size {given} given: {_resize_advice(size, given)}"
                 )
         elif given is not None:
             size = given
