@@ -1406,6 +1406,30 @@ def test_saved_yaml_holds_opencvs_shapes_and_every_field(tmp_path: Path) -> None
         fs.release()
 
 
+def test_a_plain_yaml_of_the_fields_is_read_as_its_json_twin(tmp_path: Path) -> None:
+    """The fields as a script's yaml.safe_dump writes them (nested lists, no '%YAML:1.0'
+    header, no !!opencv-matrix tags) were 'unrecognised calibration format in rig.yaml:
+    expected OpenCV YAML/XML, JSON, ...' (load: 'not a stereovision calibration file'), though
+    the same mapping as JSON is read. Read as the JSON is, with its checks; a YAML holding no
+    calibration field is still unrecognised."""
+    import yaml
+
+    c = raw_calib()
+    fields = {k: getattr(c, k).tolist() for k in ("K1", "D1", "K2", "D2", "R", "T")}
+    fields.update(image_width=SIZE[0], image_height=SIZE[1], unit="m")
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(yaml.safe_dump(fields))
+    assert Calibration.from_file(rig) == c and Calibration.load(rig) == c
+    del fields["unit"]  # no unit of its own: from_file's, as for a JSON file
+    rig.write_text(yaml.safe_dump(fields))
+    assert Calibration.from_file(rig, unit="m") == c
+    with pytest.raises(ValueError, match=r"^calibration file .*rig\.yaml lacks field 'unit'"):
+        Calibration.from_file(rig)
+    (tmp_path / "devices.yaml").write_text("left: /dev/video0\nright: /dev/video2\n")
+    with pytest.raises(ValueError, match="unrecognised calibration format"):
+        Calibration.from_file(tmp_path / "devices.yaml")
+
+
 # ------------------------------------------------------ rectification geometry (mutation audit)
 
 

@@ -1492,8 +1492,10 @@ class Calibration:
         """Read a calibration written by :meth:`save` (OpenCV YAML/XML or JSON).
 
         The format is recognised from the content; JSON is :meth:`save`'s nested lists or
-        ``cv::FileStorage``'s JSON (matrices as ``opencv-matrix`` objects). ``M1``/``M2``
-        (OpenCV's ``stereo_calib`` sample names) are accepted for ``K1``/``K2``.
+        ``cv::FileStorage``'s JSON (matrices as ``opencv-matrix`` objects); a YAML file without
+        OpenCV's ``%YAML:1.0`` header (a script's ``yaml.safe_dump``) is read as the JSON's
+        nested lists. ``M1``/``M2`` (OpenCV's ``stereo_calib`` sample names) are accepted for
+        ``K1``/``K2``.
 
         Parameters
         ----------
@@ -1524,7 +1526,26 @@ class Calibration:
             return cls._from_filestorage_text(text, str(p), unit)
         if head.startswith("{"):
             return cls._from_json_text(text, str(p), unit)
+        calib = cls._from_plain_yaml(text, str(p), unit)
+        if calib is not None:
+            return calib
         raise ValueError(f"not a stereovision calibration file (OpenCV YAML/XML or JSON): {p}")
+
+    @classmethod
+    def _from_plain_yaml(cls, text: str, source: str, unit: str | None) -> Calibration | None:
+        """A YAML mapping of :meth:`save`'s fields without OpenCV's ``%YAML:1.0`` header and
+        ``!!opencv-matrix`` tags (a script's ``yaml.safe_dump`` of nested lists, a hand-written
+        file), read as its JSON twin is; None when the text is no such mapping. It was
+        'unrecognised calibration format ... expected OpenCV YAML/XML, JSON, ...'."""
+        import yaml
+
+        try:
+            doc = yaml.safe_load(text)
+        except yaml.YAMLError:
+            return None
+        if not isinstance(doc, dict) or not any(k in doc for k in _CALIBRATION_FIELDS):
+            return None
+        return cls._from_mapping(doc.get, source, unit)
 
     @classmethod
     def from_file(
@@ -1535,7 +1556,8 @@ class Calibration:
     ) -> Calibration:
         """Read any supported calibration, detecting the format from the content.
 
-        OpenCV YAML/XML and JSON (:meth:`load`), Middlebury ``calib.txt``
+        OpenCV YAML/XML, JSON and a plain YAML of the same fields (:meth:`load`), Middlebury
+        ``calib.txt``
         (:meth:`from_middlebury`), KITTI ``calib_cam_to_cam`` / object calibration
         (:meth:`from_kitti`; ``image_size`` is passed on), and ROS ``camera_info``
         (:meth:`from_ros`): a folder holding ``left.yaml`` and ``right.yaml``, ROS
@@ -1684,6 +1706,9 @@ class Calibration:
             return cls.from_q(
                 p, _scene_image_size(p) if image_size is None else image_size, unit=unit or "m"
             )
+        plain = cls._from_plain_yaml(text, str(p), unit)  # a YAML without OpenCV's header
+        if plain is not None:
+            return plain
         if any(re.search(rf"^{k}\s*:", text, re.MULTILINE) for k in _MATLAB_FIELDS):
             raise ValueError(_matlab_export(str(p)))  # a YAML written without OpenCV's header
         raise ValueError(
