@@ -1410,8 +1410,9 @@ def test_a_plain_yaml_of_the_fields_is_read_as_its_json_twin(tmp_path: Path) -> 
     """The fields as a script's yaml.safe_dump writes them (nested lists, no '%YAML:1.0'
     header, no !!opencv-matrix tags) were 'unrecognised calibration format in rig.yaml:
     expected OpenCV YAML/XML, JSON, ...' (load: 'not a stereovision calibration file'), though
-    the same mapping as JSON is read. Read as the JSON is, with its checks; a YAML holding no
-    calibration field is still unrecognised."""
+    the same mapping as JSON is read (with PyYAML's '%YAML 1.1' directive, 'cannot parse ... as
+    OpenCV YAML/XML: line 4: Incorrect indentation'). Read as the JSON is, with its checks; a
+    YAML holding no calibration field is still unrecognised."""
     import yaml
 
     c = raw_calib()
@@ -1420,6 +1421,8 @@ def test_a_plain_yaml_of_the_fields_is_read_as_its_json_twin(tmp_path: Path) -> 
     rig = tmp_path / "rig.yaml"
     rig.write_text(yaml.safe_dump(fields))
     assert Calibration.from_file(rig) == c and Calibration.load(rig) == c
+    rig.write_text(yaml.safe_dump(fields, version=(1, 1)))  # "%YAML 1.1": not OpenCV's header
+    assert rig.read_text().startswith("%YAML 1.1") and Calibration.from_file(rig) == c
     del fields["unit"]  # no unit of its own: from_file's, as for a JSON file
     rig.write_text(yaml.safe_dump(fields))
     assert Calibration.from_file(rig, unit="m") == c

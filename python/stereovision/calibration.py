@@ -1522,6 +1522,12 @@ class Calibration:
         """:meth:`load`, a file without ``unit`` given ``unit`` (:meth:`from_file`'s)."""
         p, text = cls._read_text(path)
         head = text.lstrip()
+        if head.startswith("%YAML") and not head.startswith("%YAML:"):
+            # PyYAML's directive (yaml.safe_dump(..., version=(1, 1)): "%YAML 1.1"), which
+            # OpenCV's parser refused ("line 4: Incorrect indentation"); its own is "%YAML:1.0"
+            calib = cls._from_plain_yaml(text, str(p), unit)
+            if calib is not None:
+                return calib
         if head.startswith("%YAML") or head.startswith("<?xml") or head.startswith("<opencv"):
             return cls._from_filestorage_text(text, str(p), unit)
         if head.startswith("{"):
