@@ -1563,8 +1563,7 @@ class Calibration:
         """Read any supported calibration, detecting the format from the content.
 
         OpenCV YAML/XML, JSON and a plain YAML of the same fields (:meth:`load`), Middlebury
-        ``calib.txt``
-        (:meth:`from_middlebury`), KITTI ``calib_cam_to_cam`` / object calibration
+        ``calib.txt`` (:meth:`from_middlebury`), KITTI ``calib_cam_to_cam`` / object calibration
         (:meth:`from_kitti`; ``image_size`` is passed on), and ROS ``camera_info``
         (:meth:`from_ros`): a folder holding ``left.yaml`` and ``right.yaml``, ROS
         ``camera_calibration``'s ``calibrationdata.tar.gz``, or one of the two files when the
