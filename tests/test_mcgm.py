@@ -1699,3 +1699,21 @@ def test_channel_curves_compare_and_hash_by_identity() -> None:
     a, b = mcgm.curves(img, sigmas=[2.0])[0], mcgm.curves(img, sigmas=[2.0])[0]
     assert a == a and a != b and b not in [a]
     assert {a: 1, b: 2}[a] == 1 and len({a, b, a}) == 2
+
+
+def test_save_csv_writes_each_float32_as_its_str_whatever_its_bits(tmp_path: Path) -> None:
+    """save_csv gives each distinct value's str once (str of a float32 is slow): the bytes
+    must stay those of str per value, -0.0 beside 0.0, NaN payloads, denormals, float32's
+    largest and repeated values included."""
+    rng = np.random.default_rng(0)
+    bits = rng.integers(0, 2**32, 1000, dtype=np.uint64).astype(np.uint32)
+    some = bits.view(np.float32)
+    edge = np.float32([-0.0, 0.0, np.nan, -np.inf, 1e-45, 3.4028235e38, 0.1, 248.0])
+    col = np.concatenate([some, np.tile(edge, 100)])
+    with np.errstate(all="ignore"):
+        m = sv.Matches(col, col[::-1], -col, np.rint(col), col * 0, (8, 8))
+    text = m.save_csv(tmp_path / "m.csv").read_text()
+    rows = np.stack([m.xl, m.yl, m.xr, m.yr, m.score], axis=1)
+    want = "".join(",".join(str(v) for v in row) + "\n" for row in rows)
+    assert text == "x_left,y_left,x_right,y_right,score\n" + want
+    assert text.count("\n-0.0,") == text.count("\n0.0,") == 100

@@ -52,6 +52,18 @@ def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
     return arr
 
 
+def _float32_text(values: F32) -> list[str]:
+    """``str`` of each float32 (the shortest text that round-trips), computed once per distinct
+    value: str of a NumPy float32 is slow (about 2 us), and a row index or an integer column
+    repeats few values (save_csv of teddy's 130,614 Gabor matches: 1.2 s -> 0.7 s)."""
+    # distinct bit patterns, not values: np.unique would make -0.0 and 0.0 one ("0.0")
+    bits = np.ascontiguousarray(values, dtype=np.float32).view(np.uint32)
+    uniq, inverse = np.unique(bits, return_inverse=True)
+    text = np.array([str(v) for v in uniq.view(np.float32)], dtype=object)
+    out: list[str] = text[inverse.reshape(-1)].tolist()
+    return out
+
+
 def _whole_positive(v: object) -> bool:
     """Whether ``v`` is a positive whole number: an integer (not a bool) or a finite whole
     float (``64.0``; not ``64.5``); never one of NOT_NUMBERS (3 ns was 3 pixels)."""
@@ -362,11 +374,10 @@ class Matches:
         pathlib.Path
             ``path`` (as the other writers return it).
         """
-        rows = np.stack([self.xl, self.yl, self.xr, self.yr, self.score], axis=1)
+        cols = [_float32_text(c) for c in (self.xl, self.yl, self.xr, self.yr, self.score)]
         with atomic_write(path, "w") as fh:
             fh.write(_CSV_HEADER + "\n")
-            # str of a NumPy float32: the shortest text that round-trips
-            fh.writelines(",".join(str(v) for v in row) + "\n" for row in rows)
+            fh.writelines(f"{a},{b},{c},{d},{e}\n" for a, b, c, d, e in zip(*cols, strict=True))
         return Path(path)
 
     @classmethod
