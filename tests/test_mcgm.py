@@ -1507,6 +1507,20 @@ def test_filter_windows_near_the_int32_limit_are_the_whole_image() -> None:
         np.testing.assert_array_equal(huge.xl, want.xl)
 
 
+def test_ght_min_score_above_1_is_refused() -> None:
+    """A GHT score is at most 1 (a translation pairs each pixel once): ght_min_score=2 (or 40,
+    a percentage) kept no candidate and gave 0 matches without a word. It is named; 1 runs."""
+    left, right = _sine_pair()
+    for bad in (1.01, 2, 40):
+        with pytest.raises(ValueError) as exc:
+            mcgm.mcgm_match(left, right, max_disparity=8, ght_min_score=bad)
+        assert str(exc.value) == (
+            f"invalid parameter `ght_min_score`: must be in [0, 1] (a GHT score is at most 1), "
+            f"got {float(bad):g}"
+        )
+    mcgm.mcgm_match(left, right, max_disparity=8, ght_min_score=1)
+
+
 @pytest.mark.parametrize("deg", [90.5, 180, 2**32, 1e30])
 def test_horiz_skip_deg_beyond_90_is_refused(deg: float) -> None:
     """An angle to the horizontal: above 90 its sine came round again (180 skipped no pixel, as

@@ -67,7 +67,7 @@ DEFAULTS: dict[str, Any] = {
     "dy_band": 1,  # epipolar band (rows; B.8: t_y in {-1, 0, 1} for 1.5 px)
     "n_theta_bins": 36,  # R-table orientation bins over [0, 2 pi) (B.2)
     "vote_bin_tol": 2,  # +- bins when indexing the R-table (B.2: 1; 2 measured, docs/mcgm.md)
-    "ght_min_score": 0.4,  # GHT peak / max(|A|, |A'|) (B.8: 0.5; docs/mcgm.md)
+    "ght_min_score": 0.4,  # GHT peak / max(|A|, |A'|), 0 to 1 (B.8: 0.5; docs/mcgm.md)
     "k_cand": 6,  # candidates per left segment (B.2)
     "knn": 6,  # neighbours in the segment graph (B.4.9)
     "r_graph": 60.0,  # longest graph edge (px, B.2)

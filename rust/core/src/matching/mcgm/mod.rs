@@ -380,6 +380,17 @@ fn validate_params(p: &McgmParams) -> Result<()> {
             ));
         }
     }
+    // A GHT score is at most 1 (graph.rs: the peak is at most the shorter segment's length):
+    // a larger threshold kept no candidate, 0 matches without a word.
+    if p.cand.ght_min_score > 1.0 {
+        return Err(CoreError::param(
+            "ght_min_score",
+            format!(
+                "must be in [0, 1] (a GHT score is at most 1), got {}",
+                p.cand.ght_min_score
+            ),
+        ));
+    }
     // An angle to the horizontal: above 90 degrees its sine (the skip's threshold) came round
     // again, 180 skipping nothing and 1e30 what sin(1e30 deg) happened to give.
     if p.horiz_skip_deg > 90.0 {

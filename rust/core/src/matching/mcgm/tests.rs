@@ -2061,6 +2061,28 @@ fn huge_filter_windows_are_the_whole_image() {
     assert!(keep.iter().any(|&k| k));
 }
 
+/// `ght_min_score` is a GHT score's threshold, [0, 1]: above 1 no candidate passed and the
+/// matcher gave 0 matches without a word; 1 itself is a threshold some pair can meet.
+#[test]
+fn ght_min_score_above_1_is_refused() {
+    let (l, r) = (blobs(90, 60, 0.0), blobs(90, 60, 3.0));
+    let with = |score: f32| McgmParams {
+        cand: graph::CandParams {
+            ght_min_score: score,
+            ..McgmParams::default().cand
+        },
+        ..McgmParams::default()
+    };
+    for bad in [1.01f32, 2.0, 40.0] {
+        let err = mcgm_match(&l, &r, &with(bad)).unwrap_err();
+        assert!(
+            matches!(&err, CoreError::InvalidParameter { name, .. } if *name == "ght_min_score"),
+            "{bad}: {err}"
+        );
+    }
+    assert!(mcgm_match(&l, &r, &with(1.0)).is_ok());
+}
+
 /// `horiz_skip_deg` is an angle to the horizontal, [0, 90]: beyond 90 its sine came round
 /// again (180 skipped nothing, as 0; 2**32 and 1e30 whatever their sine gave).
 #[test]
