@@ -1343,3 +1343,75 @@ def test_a_float_argument_that_is_no_number_names_it() -> None:
     assert str(err.value) == "invalid parameter `freq`: must be real number, not str"
     ok = _core.gabor_lr_check(a, a, np.float64(2))  # NumPy scalars and ints still taken
     assert ok.shape == (8, 12) and _core.gabor_lr_check(a, a, 2).shape == (8, 12)
+
+
+@pytest.mark.parametrize(
+    ("call", "said"),
+    [
+        (
+            # a sigma given > 0 was "invalid parameter `fill sigma`: must be > 0, got 0"
+            lambda a: _core.refine_disparity(
+                a, a, a, a, *REFINE_ARGS[:10], [(1e-50, 0.3)], 0.1, True, 1.0
+            ),
+            "invalid parameter `fill sigma`: 1e-50 is 0 in float32, the kernel's precision (give "
+            "0, or a magnitude of at least 1e-45)",
+        ),
+        (
+            # "invalid parameter `fill min_score`: must be in (-1, 1), got inf"
+            lambda a: _core.refine_disparity(
+                a, a, a, a, *REFINE_ARGS[:10], [(16.0, 1e39)], 0.1, True, 1.0
+            ),
+            "invalid parameter `fill min_score`: expected a number within float32's range, the "
+            "kernel's precision, got 1e+39",
+        ),
+        (
+            # "parameter `sigmas`: OverflowError: int too large to convert to float"
+            lambda a: _core.mcgm_match(a, a, {"sigmas": [2.0, 10**400]}),
+            "invalid parameter `sigmas`: expected a number within float32's range, the kernel's "
+            f"precision, got {10**400}",
+        ),
+        (
+            # "invalid parameter `sigmas`: each sigma must lie in [0.3, 64] px, got inf"
+            lambda a: _core.mcgm_curves(a, {"sigmas": [1e39]}),
+            "invalid parameter `sigmas`: expected a number within float32's range, the kernel's "
+            "precision, got 1e+39",
+        ),
+        (
+            # "weights: expected three finite non-negative numbers (B, G, R), got [inf, 0.5, 0.5]"
+            lambda a: _core.gray_u8(np.zeros(a.shape, np.uint8), (1e39, 0.5, 0.5)),
+            "invalid parameter `weights`: expected a number within float32's range, the "
+            "kernel's precision, got 1e+39",
+        ),
+        (
+            # a bare "OverflowError: int too large to convert to float"
+            lambda a: _core.hopfield_match_u8(
+                np.zeros(a.shape, np.uint8), np.zeros(a.shape, np.uint8), (0.1, 10**400, 0.3), {}
+            ),
+            "invalid parameter `weights`: expected a number within float32's range, the "
+            f"kernel's precision, got {10**400}",
+        ),
+        (
+            lambda a: _core.refine_disparity(
+                a, a, a, a, *REFINE_ARGS[:10], [(16.0,)], 0.1, True, 1.0
+            ),
+            "invalid parameter `fills`: element 0 ((16.0,)): expected a (sigma, min_score) pair",
+        ),
+    ],
+)
+def test_a_float_in_a_sequence_argument_float32_cannot_hold_is_named(
+    call: Callable[[np.ndarray], object], said: str
+) -> None:
+    """The numbers inside ``refine_disparity``'s ``fills``, the MCGM dict's ``sigmas`` and the
+    8-bit kernels' ``weights`` skipped the float32 check the scalar arguments have (3b1afe37):
+    cut to inf or 0 before the kernel's check, which then quoted a value not given (a fill
+    sigma of 1e-50 "must be > 0, got 0", through ``refine.refine_disparity`` too), or a bare
+    OverflowError naming nothing. In-range values are taken as before."""
+    a = np.random.default_rng(0).random((8, 12), dtype=np.float32)
+    with pytest.raises(ValueError) as err:
+        call(a)
+    assert str(err.value) == said
+    r = _core.refine_disparity(
+        a, a, a, a, *REFINE_ARGS[:10], [(1, 0.3), (2.0, -0.5)], 0.1, True, 1.0
+    )
+    assert r[0].shape == (8, 12)
+    assert _core.gray_u8(np.zeros((2, 3, 3), np.uint8), (0, 1, np.float64(0.5))).shape == (2, 3)

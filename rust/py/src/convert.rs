@@ -299,6 +299,26 @@ pub fn u8_layout<'a>(
     Ok((h, w, c, row_major(a, what)?))
 }
 
+/// The argument `weights`, three numbers (B, G, R), each through
+/// [`FloatArg`](crate::params::FloatArg) as the scalar arguments are: pyo3's own conversion cut
+/// 1e39 to inf ("expected three finite non-negative numbers (B, G, R), got [inf, ...]", a
+/// value not given) and 10**400 was a bare "OverflowError: int too large to convert to float".
+pub fn weights_arg(ob: &Bound<'_, PyAny>) -> PyResult<(f32, f32, f32)> {
+    use crate::params::FloatArg;
+    let (b, g, r): (Bound<'_, PyAny>, Bound<'_, PyAny>, Bound<'_, PyAny>) =
+        ob.extract().map_err(|_| {
+            let got = ob
+                .repr()
+                .map_or_else(|_| "?".to_string(), |r| r.to_string());
+            PyTypeError::new_err(format!(
+                "invalid parameter `weights`: expected a tuple of three numbers (B, G, R), got \
+                 {got}"
+            ))
+        })?;
+    let f = |v: &Bound<'_, PyAny>| f32::extract_named(v, "weights");
+    Ok((f(&b)?, f(&g)?, f(&r)?))
+}
+
 /// The B, G, R grey weights as an array, checked to be finite and non-negative (a NaN weight
 /// made every grey level NaN, and the matcher found nothing, without a word).
 pub fn luma_weights(weights: (f32, f32, f32)) -> PyResult<[f32; 3]> {
@@ -320,7 +340,7 @@ pub fn luma_weights(weights: (f32, f32, f32)) -> PyResult<[f32; 3]> {
 pub fn gray_u8<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
-    weights: (f32, f32, f32),
+    #[pyo3(from_py_with = weights_arg)] weights: (f32, f32, f32),
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let image: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(image, "image")?;
     let (h, w, c, data) = u8_layout(&image, "image")?;

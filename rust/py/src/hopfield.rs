@@ -244,7 +244,7 @@ pub fn hopfield_match_u8<'py>(
     py: Python<'py>,
     left: &Bound<'py, PyAny>,
     right: &Bound<'py, PyAny>,
-    weights: (f32, f32, f32),
+    #[pyo3(from_py_with = crate::convert::weights_arg)] weights: (f32, f32, f32),
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
     let left: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(left, "left")?;

@@ -96,7 +96,17 @@ impl Slot for f32 {
 impl Slot for f64 {}
 impl Slot for bool {}
 impl Slot for String {}
-impl Slot for Vec<f32> {}
+/// Each value as a float slot's ([`FloatArg`]): `sigmas: [1e39]` was cut to inf ("each sigma
+/// must lie in [0.3, 64] px, got inf"), `[1e-50]` to 0, and `[10**400]` was "parameter
+/// `sigmas`: OverflowError: int too large to convert to float".
+impl Slot for Vec<f32> {
+    fn check_exact(v: &Bound<'_, PyAny>, key: &str) -> PyResult<()> {
+        for item in v.try_iter()? {
+            f32::extract_named(&item?, key)?;
+        }
+        Ok(())
+    }
+}
 
 /// `Ok` when `v` is a finite number >= 0, else a `ValueError` naming it.
 pub fn non_negative(name: &str, v: f32) -> PyResult<()> {

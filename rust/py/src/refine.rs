@@ -33,7 +33,7 @@ pub fn refine_disparity<'py>(
     #[pyo3(from_py_with = fill_search_arg)] fill_search: usize,
     #[pyo3(from_py_with = fill_step_f32)] fill_step: f32,
     #[pyo3(from_py_with = var_floor_f32)] var_floor: f32,
-    fills: Vec<(f32, f32)>,
+    #[pyo3(from_py_with = fills_arg)] fills: Vec<(f32, f32)>,
     #[pyo3(from_py_with = fill_confidence_f32)] fill_confidence: f32,
     fill_plane: bool,
     #[pyo3(from_py_with = fill_max_residual_f32)] fill_max_residual: f32,
@@ -112,4 +112,40 @@ crate::named_floats! {
     var_floor_f32: f32 = "var_floor";
     fill_confidence_f32: f32 = "fill_confidence";
     fill_max_residual_f32: f32 = "fill_max_residual";
+}
+
+/// `fills`, a sequence of `(sigma, min_score)` pairs, each value through
+/// [`FloatArg`](crate::params::FloatArg) as the scalar arguments are, named as the kernel names
+/// it: pyo3's own conversion cut `(1e-50, 0.3)` to a sigma of 0 ("`fill sigma`: must be > 0,
+/// got 0", of a sigma given > 0), `(16, 1e39)` to a min_score of inf, and `(10**400, 0.3)` was
+/// a bare "OverflowError: int too large to convert to float".
+fn fills_arg(ob: &Bound<'_, PyAny>) -> PyResult<Vec<(f32, f32)>> {
+    use crate::params::FloatArg;
+    let repr = |o: &Bound<'_, PyAny>| o.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+    let not_pairs = || {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "invalid parameter `fills`: expected a sequence of (sigma, min_score) pairs, got {}",
+            repr(ob)
+        ))
+    };
+    if ob.is_instance_of::<pyo3::types::PyString>() {
+        return Err(not_pairs());
+    }
+    let mut out = Vec::new();
+    for (i, item) in ob.try_iter().map_err(|_| not_pairs())?.enumerate() {
+        let item = item?;
+        let (sigma, min_score): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
+            item.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "invalid parameter `fills`: element {i} ({}): expected a (sigma, min_score) \
+                     pair",
+                    repr(&item)
+                ))
+            })?;
+        out.push((
+            f32::extract_named(&sigma, "fill sigma")?,
+            f32::extract_named(&min_score, "fill min_score")?,
+        ));
+    }
+    Ok(out)
 }
