@@ -1415,3 +1415,17 @@ def test_a_float_in_a_sequence_argument_float32_cannot_hold_is_named(
     )
     assert r[0].shape == (8, 12)
     assert _core.gray_u8(np.zeros((2, 3, 3), np.uint8), (0, 1, np.float64(0.5))).shape == (2, 3)
+
+
+def test_mcgm_curves_refuses_a_huge_image_before_copying_it() -> None:
+    """``mcgm_curves`` copied ``img`` before its kernel's 32-bit size check, which
+    ``mcgm_log`` (1eeb7ba4) and the matchers make from the shape first: a broadcast
+    (2**30, 2**30) image was "MemoryError: out of memory: a copy of img needs 4294967296.00
+    GiB", a 65536 x 65536 one a 16 GiB copy. It is the size's ValueError now, copying nothing."""
+    big = np.broadcast_to(np.float32(0), (2**30, 2**30))
+    with pytest.raises(ValueError) as err:
+        _core.mcgm_curves(big, {})
+    assert str(err.value) == (
+        "img: image of 1073741824x1073741824 pixels is too large: the kernels index pixels with "
+        "32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
+    )

@@ -263,6 +263,12 @@ pub fn mcgm_curves<'py>(
     params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyList>> {
     let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
+    // The kernel's 32-bit size check, from the shape before the copy, as `mcgm_log` does: a
+    // broadcast 65536 x 65536 image was copied first (16 GiB taken, or a MemoryError under a
+    // memory limit), a (2**30, 2**30) one a MemoryError instead of the size's ValueError.
+    let (rows, cols) = img.as_array().dim();
+    let max = stereovision_core::image::MAX_PIXELS;
+    crate::errors::check_size(cols, rows, max, "img", "image")?;
     let im = image_from_numpy(&img, "img")?;
     let p = self::params(params)?;
     let chans = crate::workers::detach(py, || guard("mcgm_curves", || image_curves(&im, &p)))?;
