@@ -1429,3 +1429,26 @@ def test_mcgm_curves_refuses_a_huge_image_before_copying_it() -> None:
         "img: image of 1073741824x1073741824 pixels is too large: the kernels index pixels with "
         "32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
     )
+
+
+def test_lzf_decompress_takes_any_bytes_like_data_and_names_other_data() -> None:
+    """Only ``bytes`` was taken: a ``bytearray`` or ``memoryview`` (a message's payload) was
+    pyo3's "'bytearray' object is not an instance of 'bytes'", and a str or list the same words,
+    naming no argument. Any bytes-like object is decoded as ``zlib.decompress`` takes it; other
+    data is a TypeError naming ``data``."""
+    stream = b"\x03abcd\x20\x03"  # "abcd", then 3 bytes from 4 back
+    for data in (
+        bytearray(stream),
+        memoryview(b"xx" + stream)[2:],
+        np.frombuffer(stream, np.uint8),
+    ):
+        assert _core.lzf_decompress(data, 7) == b"abcdabc"
+    with pytest.raises(ValueError, match=r"^corrupt LZF data: the data decompress to 7 bytes"):
+        _core.lzf_decompress(bytearray(stream), 8)
+    for bad, name in (("abcd", "str"), ([3, 97], "list"), (5, "int")):
+        with pytest.raises(TypeError) as err:
+            _core.lzf_decompress(bad, 7)  # type: ignore[arg-type]
+        assert str(err.value) == (
+            "invalid parameter `data`: expected a bytes-like object (bytes, bytearray, "
+            f"memoryview), got {name}"
+        )

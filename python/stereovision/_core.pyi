@@ -307,8 +307,9 @@ def kept_memory() -> tuple[tuple[int, int], int]:
 
 # --- LZF decompression (rust/py/src/lzf.rs) ------------------------------------------------------
 
-def lzf_decompress(data: bytes, out_len: int) -> bytes:
-    """The ``out_len`` bytes the LZF stream ``data`` decompresses to (liblzf's
-    ``lzf_decompress``: PCL's ``binary_compressed`` PCD data). A damaged or cut stream, or one
-    that does not decompress to exactly ``out_len`` bytes, is a ``ValueError`` saying what is
-    wrong; an ``out_len`` more than 88 times ``len(data)`` is refused before any allocation."""
+def lzf_decompress(data: bytes | bytearray | memoryview, out_len: int) -> bytes:
+    """The ``out_len`` bytes the LZF stream ``data`` (any bytes-like object) decompresses to
+    (liblzf's ``lzf_decompress``: PCL's ``binary_compressed`` PCD data). A damaged or cut
+    stream, or one that does not decompress to exactly ``out_len`` bytes, is a ``ValueError``
+    saying what is wrong; an ``out_len`` more than 88 times the size of ``data`` in bytes is
+    refused before any allocation; ``data`` that is not bytes-like is a ``TypeError``."""
