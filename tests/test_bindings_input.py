@@ -1452,3 +1452,25 @@ def test_lzf_decompress_takes_any_bytes_like_data_and_names_other_data() -> None
             "invalid parameter `data`: expected a bytes-like object (bytes, bytearray, "
             f"memoryview), got {name}"
         )
+
+
+@pytest.mark.parametrize("empty", ["left", "right"])
+def test_an_empty_8_bit_image_is_named(empty: str) -> None:
+    """The 8-bit kernels said "image is empty: got 5x0 pixels" of an empty ``left`` or
+    ``right`` (which one?), ``frame`` or ``image``; the float ones named it ("left: image is
+    empty: ..."). The argument is named now, with its own size."""
+    pair = {"left": np.zeros((4, 5, 3), np.uint8), "right": np.zeros((4, 5, 3), np.uint8)}
+    pair[empty] = np.zeros((4, 0, 3), np.uint8)
+    with pytest.raises(ValueError) as err:
+        _core.hopfield_match_u8(pair["left"], pair["right"], LUMA_WEIGHTS_BGR, {})
+    assert str(err.value) == f"{empty}: image is empty: got 0x4 pixels"
+    both = np.zeros((0, 5), np.uint8)
+    with pytest.raises(ValueError) as err:
+        _core.hopfield_match_u8(both, both, LUMA_WEIGHTS_BGR, {})
+    assert str(err.value) == "left: image is empty: got 5x0 pixels"
+    with pytest.raises(ValueError) as err:
+        _core.gray_u8(both, LUMA_WEIGHTS_BGR)
+    assert str(err.value) == "image: image is empty: got 5x0 pixels"
+    with pytest.raises(ValueError) as err:
+        _core.temporal_grey_difference(both, np.zeros((0, 5), np.float32))
+    assert str(err.value) == "frame: image is empty: got 5x0 pixels"

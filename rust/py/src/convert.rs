@@ -285,6 +285,15 @@ pub fn u8_shape(
             "{what}: expected 1, 3 or 4 channels, got {c} (shape {shape:?})"
         )));
     }
+    // Named, and by its own size: the kernels' "image is empty" named no argument (which of
+    // hopfield_match_u8's left and right?), and the temporal ones know only a pixel count.
+    if h == 0 || w == 0 {
+        let e = stereovision_core::CoreError::EmptyImage {
+            width: w,
+            height: h,
+        };
+        return Err(PyValueError::new_err(format!("{what}: {e}")));
+    }
     Ok((h, w, c))
 }
 

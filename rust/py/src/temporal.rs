@@ -12,20 +12,7 @@ use pyo3::prelude::*;
 use stereovision_core::temporal::{grey_difference, running_mean};
 
 use crate::convert::{row_major, u8_layout, u8_shape, vec_to_numpy};
-use crate::errors::{guard, to_pyerr};
-use stereovision_core::CoreError;
-
-/// A frame without pixels, refused with its size: the kernels know only the pixel count, and
-/// said "image is empty: got 0x0 pixels" of a 5x0 frame.
-fn non_empty(h: usize, w: usize) -> PyResult<()> {
-    if h == 0 || w == 0 {
-        return Err(to_pyerr(CoreError::EmptyImage {
-            width: w,
-            height: h,
-        }));
-    }
-    Ok(())
-}
+use crate::errors::guard;
 
 /// The mean's values in row-major order, checked to have the frame's shape: its own buffer
 /// when C-contiguous, else a copy.
@@ -54,8 +41,7 @@ pub fn temporal_grey_difference<'py>(
     let mean: PyReadonlyArrayDyn<'py, f32> = crate::convert::array_arg(mean, "mean")?;
     // The mean's shape before the frame's copy: the frame was copied (4 GiB for a broadcast
     // one) before a mean of another shape was refused.
-    let (h, w, _) = u8_shape(&frame, "frame")?;
-    non_empty(h, w)?;
+    u8_shape(&frame, "frame")?;
     let m = mean_values(&mean, frame.shape())?;
     let (h, w, c, f) = u8_layout(&frame, "frame")?;
     let d = crate::workers::detach(py, || {
@@ -84,7 +70,6 @@ pub fn temporal_running_mean<'py>(
     let frame: PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(frame, "frame")?;
     let diff: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(diff, "diff")?;
     let (h, w, _) = u8_shape(&frame, "frame")?;
-    non_empty(h, w)?;
     let shape = frame.shape().to_vec();
     if mean.shape() != shape.as_slice() {
         return Err(PyValueError::new_err(format!(
