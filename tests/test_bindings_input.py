@@ -1474,3 +1474,19 @@ def test_an_empty_8_bit_image_is_named(empty: str) -> None:
     with pytest.raises(ValueError) as err:
         _core.temporal_grey_difference(both, np.zeros((0, 5), np.float32))
     assert str(err.value) == "frame: image is empty: got 5x0 pixels"
+
+
+def test_an_array_of_the_other_byte_order_is_said_to_be_one() -> None:
+    """A big-endian float32 array (a PFM's, a file read with ``np.fromfile(..., ">f4")``) was
+    "img: expected a float32 array, got >f4": float32 refused for not being float32. The error
+    says it is the other byte order and how to convert it; other dtypes are said as before."""
+    a = np.zeros((4, 5), np.float32)
+    with pytest.raises(TypeError) as err:
+        _core.gabor_responses(a.astype(">f4"))
+    assert str(err.value) == (
+        "img: expected a float32 array, got >f4 (float32 in the other byte order: convert it "
+        "with .astype(np.float32))"
+    )
+    with pytest.raises(TypeError) as err:
+        _core.gabor_responses(a.astype(">f8"))
+    assert str(err.value) == "img: expected a float32 array, got >f8"

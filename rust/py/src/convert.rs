@@ -108,8 +108,18 @@ fn describe_mismatch<T: numpy::Element, D: Dimension>(
     };
     let got = arr.dtype();
     if !got.is_equiv_to(&want) {
+        // ">f4" alone read as another type than the float32 asked for: it is float32 in the
+        // other byte order (a big-endian file's, a PFM's), which the kernels do not read.
+        let swapped = got.is_native_byteorder() == Some(false)
+            && got.kind() == want.kind()
+            && got.itemsize() == want.itemsize();
+        let hint = if swapped {
+            format!(" ({want} in the other byte order: convert it with .astype(np.{want}))")
+        } else {
+            String::new()
+        };
         return Some(PyTypeError::new_err(format!(
-            "{name}: expected a {want} array, got {got}"
+            "{name}: expected a {want} array, got {got}{hint}"
         )));
     }
     match D::NDIM {
