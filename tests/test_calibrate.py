@@ -668,11 +668,11 @@ def test_squares_counted_for_the_inner_corners_are_named(
     # a board one fewer no way (11x7): test_squares_counted_along_one_side_are_named
 
 
-def test_squares_counted_along_one_side_are_named(monkeypatch: pytest.MonkeyPatch) -> None:
-    """pattern=(10, 6) or (9, 7) for a 9x6 board (the squares counted along one side, the
-    corners along the other; OpenCV's left01.jpg measured) was 'found in both images of only 0
-    of 1 pairs' with no word of why, the hint trying one fewer both ways only. One fewer along
-    either side is tried too. A stand-in finder that sees 9x6 alone keeps it fast."""
+def _finder_of_a_9x6_board(
+    monkeypatch: pytest.MonkeyPatch,
+) -> tuple[list[tuple[int, int]], np.ndarray]:
+    """A stand-in corner finder that sees a 9x6 board alone (fast), the patterns it was asked
+    for, and a blank image to calibrate with."""
     seen: list[tuple[int, int]] = []
 
     def finder(image: Any, pattern: tuple[int, int] = (9, 6)) -> Any:
@@ -680,7 +680,15 @@ def test_squares_counted_along_one_side_are_named(monkeypatch: pytest.MonkeyPatc
         return np.zeros((54, 2)) if tuple(pattern) == (9, 6) else None
 
     monkeypatch.setattr(calmod, "find_corners", finder)
-    img = np.zeros((48, 64), np.uint8)
+    return seen, np.zeros((48, 64), np.uint8)
+
+
+def test_squares_counted_along_one_side_are_named(monkeypatch: pytest.MonkeyPatch) -> None:
+    """pattern=(10, 6) or (9, 7) for a 9x6 board (the squares counted along one side, the
+    corners along the other; OpenCV's left01.jpg measured) was 'found in both images of only 0
+    of 1 pairs' with no word of why, the hint trying one fewer both ways only. One fewer along
+    either side is tried too. A stand-in finder that sees 9x6 alone keeps it fast."""
+    seen, img = _finder_of_a_9x6_board(monkeypatch)
     for pattern in ((10, 6), (9, 7)):
         with pytest.raises(ValueError) as err:
             calibrate([img], [img], pattern=pattern, square_size=1.0)
@@ -699,14 +707,7 @@ def test_a_row_of_corners_missed_is_named(monkeypatch: pytest.MonkeyPatch) -> No
     no 9x5 on its left01.jpg) was 'found in both images of only 0 of 1 pairs ... board not
     found in either image' with no hint, the hint trying fewer corners only. One more along
     either side is tried after them and named. A stand-in finder keeps it fast."""
-    seen: list[tuple[int, int]] = []
-
-    def finder(image: Any, pattern: tuple[int, int] = (9, 6)) -> Any:
-        seen.append(tuple(pattern))
-        return np.zeros((54, 2)) if tuple(pattern) == (9, 6) else None
-
-    monkeypatch.setattr(calmod, "find_corners", finder)
-    img = np.zeros((48, 64), np.uint8)
+    seen, img = _finder_of_a_9x6_board(monkeypatch)
     for pattern in ((9, 5), (8, 6)):
         with pytest.raises(ValueError) as err:
             calibrate([img], [img], pattern=pattern, square_size=1.0)
