@@ -2294,7 +2294,7 @@ def test_occupancy_grid_yaml_names_its_picture_as_saved(tmp_path: Path, name: st
          "[0.0, 0.0, 0.0] of length 0"),
         ([math.nan, -1.0, 0.0], 1.0, "normal: expected a unit vector (finite, of length 1), got "
          "[nan, -1.0, 0.0] of length nan"),
-        ([0.0, -1.0, 0.0], math.nan, "height: expected a number of metres, got nan"),
+        ([0.0, -1.0, 0.0], math.nan, "height: expected a finite number of metres, got nan"),
     ],
 )  # fmt: skip
 def test_a_hand_made_plane_of_no_unit_normal_or_a_nan_height_is_refused(
@@ -2311,6 +2311,16 @@ def test_a_hand_made_plane_of_no_unit_normal_or_a_nan_height_is_refused(
     tilt = np.array([0.0, -math.cos(0.1), -math.sin(0.1)])
     for n in (tilt.astype(np.float32), [round(v, 4) for v in tilt]):
         GroundPlane(n, 1.0, (0.0, 0.0, 0.0), np.zeros((2, 2), bool), 1.0, 0.0)
+
+
+@pytest.mark.parametrize("height", [math.inf, -math.inf])
+def test_a_hand_made_plane_of_an_infinite_height_is_refused(height: float) -> None:
+    """A height of inf built, as NaN did before: 'camera inf m above it', every point's height
+    inf (no obstacle marked: obstacle_mask all False) and as_dict's height_m Infinity, which
+    is no JSON; refused as NaN is."""
+    with pytest.raises(ValueError) as exc:
+        GroundPlane([0.0, -1.0, 0.0], height, (0.0, 0.0, 0.0), np.zeros((2, 2), bool), 1.0, 0.0)
+    assert str(exc.value) == f"height: expected a finite number of metres, got {height!r}"
 
 
 @pytest.mark.parametrize(

@@ -198,8 +198,10 @@ class GroundPlane:
         # ("unsupported operand type(s) for /: 'str' and 'float'"), naming no field
         for name in ("height", "inlier_share", "rms_px", "below_share"):
             _number(getattr(self, name), name)
-        if math.isnan(_number(self.height, "height")):  # every height NaN, without a word
-            raise ValueError(f"height: expected a number of metres, got {self.height!r}")
+        # a NaN made every height NaN, without a word; an infinity every height infinite (no
+        # obstacle marked, 'camera inf m above it', as_dict's Infinity not JSON)
+        if not math.isfinite(_number(self.height, "height")):
+            raise ValueError(f"height: expected a finite number of metres, got {self.height!r}")
         try:
             coef = _real_array(self.disparity_plane)
         except ValueError:  # ragged
