@@ -2362,8 +2362,8 @@ def test_a_hand_made_grid_of_bad_fields_is_refused_naming_the_field(
 @pytest.mark.parametrize(
     ("field", "value", "says"),
     [
-        ("angle_increment", 0.0, "angle_increment: expected a positive finite number, got 0.0"),
-        ("angle_increment", math.nan, "angle_increment: expected a positive finite number, "
+        ("angle_increment", 0.0, "angle_increment: expected a nonzero finite number, got 0.0"),
+        ("angle_increment", math.nan, "angle_increment: expected a nonzero finite number, "
          "got nan"),
         ("angle_min", None, "angle_min: expected a number, got None"),
         ("angle_max", "inf", "angle_min, angle_max: expected finite radians, got -0.5, inf"),
@@ -2388,3 +2388,23 @@ def test_a_hand_made_scan_of_bad_angles_or_ranges_is_refused_naming_the_field(
     scan = LaserScan(**{**fields, "range_max": "inf", "angle_min": np.float32(-0.5)})  # type: ignore[arg-type]
     assert (scan.range_max, type(scan.angle_min)) == (math.inf, float)
     np.testing.assert_allclose(scan.endpoints()[:, 1], [-0.479426, 0.0, 1.438277], atol=1e-6)
+
+
+def test_a_hand_made_scan_turning_clockwise_is_taken() -> None:
+    """sensor_msgs/LaserScan allows a negative angle_increment (a lidar mounted upside down:
+    beams from angle_min down to angle_max); such a scan, drawn right before, was refused as
+    'angle_increment: expected a positive finite number, got -0.5'. It is taken; beams that
+    turn away from angle_max are refused, either way round."""
+    from stereovision.ground import LaserScan
+
+    ranges = np.float32([1.0, 2.0, 3.0])
+    scan = LaserScan(0.5, -0.5, -0.5, 0.0, 20.0, ranges)
+    np.testing.assert_allclose(scan.angles, [0.5, 0.0, -0.5])
+    np.testing.assert_allclose(scan.endpoints()[:, 1], [0.479426, 0.0, -1.438277], atol=1e-6)
+    for a0, a1, inc in ((0.5, -0.5, 0.5), (-0.5, 0.5, -0.5)):
+        with pytest.raises(ValueError) as exc:
+            LaserScan(a0, a1, inc, 0.0, 20.0, ranges)
+        assert str(exc.value) == (
+            "angle_min, angle_max: expected angle_max >= angle_min for a positive "
+            f"angle_increment (<= for a negative one), got {a0!r}, {a1!r} and {inc!r}"
+        )

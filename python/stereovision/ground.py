@@ -1257,7 +1257,8 @@ class LaserScan:
     Attributes
     ----------
     angle_min, angle_max, angle_increment : float
-        Radians.
+        Radians (``angle_increment`` negative for a scan turning clockwise, ``angle_max``
+        then at or below ``angle_min``).
     range_min, range_max : float
         Metres.
     ranges : numpy.ndarray
@@ -1310,8 +1311,15 @@ class LaserScan:
         a0, a1, inc = values["angle_min"], values["angle_max"], values["angle_increment"]
         if not (math.isfinite(a0) and math.isfinite(a1)):
             raise ValueError(f"angle_min, angle_max: expected finite radians, got {a0!r}, {a1!r}")
-        if not (math.isfinite(inc) and inc > 0):
-            raise ValueError(f"angle_increment: expected a positive finite number, got {inc!r}")
+        # negative: a scan turning clockwise, as sensor_msgs/LaserScan allows (a lidar mounted
+        # upside down); its beams go down from angle_min, angle_max at or below it
+        if not (math.isfinite(inc) and inc != 0):
+            raise ValueError(f"angle_increment: expected a nonzero finite number, got {inc!r}")
+        if (a1 - a0) * inc < 0:  # beams that turn away from angle_max
+            raise ValueError(
+                "angle_min, angle_max: expected angle_max >= angle_min for a positive "
+                f"angle_increment (<= for a negative one), got {a0!r}, {a1!r} and {inc!r}"
+            )
         r0, r1 = values["range_min"], values["range_max"]
         if not (r0 >= 0 and r1 > r0):
             raise ValueError(
