@@ -897,6 +897,22 @@ def test_render_refuses_over_2000_px_per_square() -> None:
         render_charuco(board, K1, D1, np.zeros(3), np.array([0, 0, 0.5]), pixels_per_square=2001)
 
 
+def test_render_names_pixels_per_square_of_a_board_image_past_remaps_sides() -> None:
+    """A long board (25x3) at 1300 px a square is a 35100x6500 image, past cv2.remap's 32766
+    a side: render_charuco drew it (5 s, 1 GB) and then failed with render_plane's 'texture:
+    ... shrink it and scale units_per_pixel up as much', neither its argument; it now names
+    pixels_per_square and its bound up front, before drawing the board."""
+    board = CharucoBoard("25x3", 0.04, 0.03, "DICT_5X5_100")
+    pose = (np.zeros(3), np.array([-0.2, -0.1, 0.6]))
+    with pytest.raises(ValueError) as exc:
+        render_charuco(board, K1, D1, *pose, image_size=(16, 12), pixels_per_square=1214)
+    assert str(exc.value) == (
+        "pixels_per_square: a 25x3 board of 1214 px squares is a 32778x6070 image (its margin "
+        "of one square included), past OpenCV's remap's 32766 a side; use at most 1213 pixels "
+        "per square"
+    )
+
+
 def test_a_boards_fields_are_stored_as_plain_python_values() -> None:
     """A mutation audit found the stored fields unasserted: sizes given as NumPy numbers (a
     size-1 array among them) are kept as floats (an array left the board unhashable for its

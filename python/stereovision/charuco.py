@@ -34,7 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import int_in_range, real_number
-from stereovision.synthetic import render_plane
+from stereovision.synthetic import _REMAP_MAX_SIDE, render_plane
 
 __all__ = [
     "DICTIONARY_FAMILIES",
@@ -733,7 +733,8 @@ def render_charuco(
     Raises
     ------
     ValueError
-        A board whose dictionary is not known, ``pixels_per_square`` outside 10 to 2000, a
+        A board whose dictionary is not known, ``pixels_per_square`` outside 10 to 2000 or
+        making the board's image (its margin included) over 32766 pixels a side, a
         ``background`` that is no grey level from 0 to 255, or a camera, pose, size,
         ``supersample`` or ``model`` :func:`~stereovision.synthetic.render_plane` refuses.
     TypeError
@@ -745,6 +746,16 @@ def render_charuco(
     # "60" 60, each without a word
     if not (real_number(background) and 0 <= background <= 255):
         raise ValueError(f"background: expected a grey level from 0 to 255, got {background!r}")
+    cols, rows = board.squares
+    if (max(cols, rows) + 2) * p > _REMAP_MAX_SIDE:
+        # render_plane's refusal named its texture and units_per_pixel, neither of them this
+        # function's, and only after drawing the board (25x3 at 1300 px: 5 s, 1 GB of it)
+        w, h = (cols + 2) * p, (rows + 2) * p
+        raise ValueError(
+            f"pixels_per_square: a {cols}x{rows} board of {p} px squares is a {w}x{h} image (its "
+            f"margin of one square included), past OpenCV's remap's {_REMAP_MAX_SIDE} a side; "
+            f"use at most {_REMAP_MAX_SIDE // (max(cols, rows) + 2)} pixels per square"
+        )
     img = board.image(p, margin=p)
     tone = (img.astype(np.float32) * ((230.0 - 25.0) / 255.0) + 25.0).astype(np.float32)
     # Board coordinate 0 is the outer edge of the squares: the image's pixel p - 0.5 (centres).
