@@ -997,6 +997,24 @@ def test_dense_metrics_warns_of_a_gt_that_reads_as_a_disparity_png() -> None:
     assert m.bad[2.0] == 0.0 and m.n_gt == 16
 
 
+def test_dense_metrics_warns_not_of_the_0s_its_mask_leaves_out() -> None:
+    """An integer GT in pixels whose 0s (unknown) a mask leaves out, as KITTI's devkit scores
+    (valid = gt > 0), was warned of as 'an integer map with 16 pixels at 0, scored as known
+    0 px disparities' where none of them was scored; the 0s the mask keeps are still said."""
+    d = np.full((4, 8), 3.0)
+    gt = np.zeros((4, 8), np.uint8)
+    gt[:2] = 3  # 3 px, the lower half unknown (0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = dense_metrics(d, gt, mask=gt > 0)
+    assert m.bad[2.0] == 0.0 and m.n_gt == 16
+    keep = gt > 0
+    keep[2, :3] = True  # three of the 0s scored
+    with pytest.warns(UserWarning, match=r"^gt: an integer map with 3 pixels at 0, scored as "):
+        m = dense_metrics(d, gt, mask=keep)
+    assert m.n_gt == 19
+
+
 def test_sparse_figures_warn_of_a_gt_that_reads_as_a_disparity_png() -> None:
     """As dense_metrics: matches scored against KITTI's GT PNG as read (d * 256, 0 = unknown)
     had a precision of about 0 without a word; sparse_metrics and count_at_precision warn at

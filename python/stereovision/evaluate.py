@@ -211,7 +211,8 @@ def dense_metrics(
     UserWarning
         For an integer ``gt`` that reads as a disparity PNG's values (scored as they are): one
         holding a disparity as wide as the map or wider (no match lies that far: KITTI's
-        ``d * 256``), or 0s (a PNG's mark of unknown pixels; an integer map has no other).
+        ``d * 256``), or 0s (a PNG's mark of unknown pixels; an integer map has no other),
+        among the pixels ``mask`` keeps.
 
     Examples
     --------
@@ -231,12 +232,13 @@ def dense_metrics(
         if ts is not None and any(map(too_large_for_float, ts)):  # not the 401 digits of 10**400
             shown = f"({', '.join(map(number_shown, ts))})"
         raise ValueError(f"thresholds must be positive and finite, got {shown}")
-    _warn_if_png_gt(g, np.asarray(gt).dtype.kind in "iu")
     known = np.isfinite(g)
     if mask is not None:
         m = _bool_mask(mask)
         _same_shape(m, g, "mask", "gt")
         known &= m
+    # after the mask: the 0s it leaves out are not scored
+    _warn_if_png_gt(g, np.asarray(gt).dtype.kind in "iu", scored=known)
     n_gt = int(known.sum())
     est = np.isfinite(d) & known
     err = np.abs(d[est] - g[est])
@@ -252,11 +254,18 @@ def dense_metrics(
     )
 
 
-def _warn_if_png_gt(g: npt.NDArray[np.float64], integer: bool, stacklevel: int = 4) -> None:
+def _warn_if_png_gt(
+    g: npt.NDArray[np.float64],
+    integer: bool,
+    stacklevel: int = 4,
+    scored: npt.NDArray[np.bool_] | None = None,
+) -> None:
     """Warn, at the caller of :func:`dense_metrics`, :func:`sparse_metrics` or
     :func:`count_at_precision` (``stacklevel`` frames up), of an integer GT map that reads as
     a disparity PNG's: a disparity as wide as the map or wider (no match lies that far), or 0s
     (a PNG's mark of unknown pixels; an integer map has no other). A float map is pixels.
+    With ``scored`` (dense_metrics' mask), only those pixels are looked at: 0s a mask leaves
+    out (KITTI's devkit's ``gt > 0``) are not scored, and were said to be.
 
     KITTI's GT PNG read with ``cv2.imread`` (``d * 256``, 0 = unknown) was scored as pixels
     with its unknown pixels known: SGBM-3WAY on 000005 bad-2.0 99.9 % (29.5 % against the GT
@@ -267,8 +276,9 @@ def _warn_if_png_gt(g: npt.NDArray[np.float64], integer: bool, stacklevel: int =
     import warnings
 
     width = g.shape[1]
-    top = float(np.max(g, initial=-np.inf))
-    zeros = int(np.count_nonzero(g == 0))
+    values = g if scored is None else g[scored]
+    top = float(np.max(values, initial=-np.inf))
+    zeros = int(np.count_nonzero(values == 0))
     if top < width and zeros == 0:
         return
     said = (
