@@ -2432,3 +2432,22 @@ def test_from_file_refuses_an_empty_path_by_name(
     with pytest.raises(ValueError) as err:
         Calibration.from_file("")
     assert str(err.value) == "path: expected a file name, got ''"
+
+
+def test_a_q_dat_with_a_byte_order_mark_is_sized_by_the_commands_pair(tmp_path: Path) -> None:
+    """A Q.dat saved by a Windows editor (a UTF-8 BOM) is read by from_file, but its check of
+    a Q.dat read it without the "-sig": ``depth l.png r.png --calib q.dat`` refused it ("does
+    not give the image size ...: this command cannot read it from its images") where the file
+    without the mark is sized by the pair, and ``info --size`` left out its size line."""
+    from stereovision.calibration import _sizeless
+    from stereovision.cli import load_calibration
+
+    text = b"1 0 0 -32\n0 1 0 -24\n0 0 0 50\n0 0 10 0\n"
+    plain, marked = tmp_path / "q.dat", tmp_path / "qb.dat"
+    plain.write_bytes(text)
+    marked.write_bytes(b"\xef\xbb\xbf" + text.replace(b"\n", b"\r\n"))
+    assert _sizeless(marked) and _sizeless(plain)
+    pair = np.zeros((48, 64), np.uint8)
+    got = load_calibration(marked, pair=pair)
+    assert got.image_size == (64, 48)
+    assert got == load_calibration(plain, pair=pair)

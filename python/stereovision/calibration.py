@@ -2919,7 +2919,11 @@ def _q_file(path: Path) -> Path | None:
         q = path / "Q.dat"
         return q if q.is_file() else None
     try:
-        if not path.is_file() or path.stat().st_size > 4096 or not _q_numbers(path.read_text()):
+        if not path.is_file() or path.stat().st_size > 4096:
+            return None
+        # utf-8-sig: a Q.dat saved by a Windows editor (a BOM) is read by from_file, but was not
+        # told one here: depth's --calib refused it for an image size its images give
+        if not _q_numbers(path.read_text(encoding="utf-8-sig")):
             return None
     except (OSError, UnicodeDecodeError):
         return None
