@@ -4028,3 +4028,18 @@ def test_a_suggested_command_names_a_path_past_ascii_as_its_utf8_bytes() -> None
         env={**os.environ, "LC_ALL": "C"},
     )
     assert said.stdout.split(b"\0")[:-1] == [n.encode("utf-8") for n in names]
+
+
+def test_a_suggested_command_names_a_name_byte_that_is_not_utf8_as_that_byte() -> None:
+    """escaped() shows a name's byte that is not UTF-8 (os.fsdecode's lone surrogate) as
+    "\\udce9" (22cb4006); _shell_path then encoded that character as UTF-8, which cannot be:
+    `rectify l.png r.png --calib q.dat -o $'r\\xe9'` wrote its files, then "stereovision: error:
+    'utf-8' codec can't encode character '\\udce9'", exit 2, even in the C locale where it had
+    printed. The $'...' word holds that byte, as bash reads back the name."""
+    import os
+
+    from stereovision.cli import _shell_path
+
+    name = os.fsdecode(b"r\xe9/left_rect.png")
+    assert _shell_path(Path(name)) == "$'r\\xe9/left_rect.png'"
+    assert _shell_path(Path(os.fsdecode(b"-\xff a"))) == "$'./-\\xff a'"

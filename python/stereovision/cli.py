@@ -1462,9 +1462,12 @@ _WIDE_ESCAPE = re.compile(r"(?<!\\)((?:\\\\)*)\\(x[89][0-9a-f]|u[0-9a-f]{4})")
 
 
 def _utf8_bytes(m: re.Match[str]) -> str:
-    """:data:`_WIDE_ESCAPE`'s character as ``$'...'`` reads its UTF-8 bytes (``\\xc2\\x85``)."""
+    """:data:`_WIDE_ESCAPE`'s character as ``$'...'`` reads its UTF-8 bytes (``\\xc2\\x85``);
+    a name's byte that is not UTF-8 (os.fsdecode's ``\\udce9``) as that byte (``\\xe9``)."""
     char = chr(int(m.group(2)[1:], 16))
-    return m.group(1) + "".join(f"\\x{b:02x}" for b in char.encode("utf-8"))
+    # surrogateescape: escaped() shows such a byte as "\udce9" (22cb4006), which UTF-8 cannot
+    # encode: `rectify -o $'r\xe9'` wrote its files, then failed on its "Next:" line
+    return m.group(1) + "".join(f"\\x{b:02x}" for b in char.encode("utf-8", "surrogateescape"))
 
 
 def _stale_rectify_output(path: Path) -> bool:
