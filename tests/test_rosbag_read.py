@@ -550,6 +550,25 @@ def test_bag_errors(cones: Any, tmp_path: Path) -> None:
         cam.read()
 
 
+def test_a_bag_link_whose_target_moved_names_it(tmp_path: Path) -> None:
+    """A bag linked in from a disk since unmounted (run.bag -> moved/run.bag) was "bag not
+    found: run.bag", of a name ls lists (stream --from-bag said it alike), where the file
+    readers name the link's target (b7feb4e7); a loop of links alike. A missing bag as before."""
+    (tmp_path / "run.bag").symlink_to(tmp_path / "moved" / "run.bag")
+    (tmp_path / "loop.bag").symlink_to(tmp_path / "loop.bag")
+    with pytest.raises(FileNotFoundError) as err:
+        BagCamera(tmp_path / "run.bag")
+    assert str(err.value) == (
+        f"bag not found: {tmp_path / 'run.bag'} (a link to {tmp_path / 'moved' / 'run.bag'}, "
+        "which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError, match=r"loop.bag \(a link to .*loop.bag, one of a loop"):
+        BagCamera(tmp_path / "loop.bag")
+    with pytest.raises(FileNotFoundError) as err:
+        BagCamera(tmp_path / "missing.bag")
+    assert str(err.value) == f"bag not found: {tmp_path / 'missing.bag'}"
+
+
 # ------------------------------------------------------------------------------------ CLI
 
 

@@ -1353,7 +1353,12 @@ class BagCamera(PairSource):
 
         self.path = _bag_path(path)
         if not self.path.exists():
-            raise FileNotFoundError(f"bag not found: {self.path}")
+            # a link whose target moved (a bag linked in from a disk since unmounted) was "not
+            # found" alone, of a name ls lists: its target is named, as io's readers name it
+            from stereovision.io import _broken_link
+
+            gone = f" ({_broken_link(self.path)})" if self.path.is_symlink() else ""
+            raise FileNotFoundError(f"bag not found: {self.path}{gone}")
         if self.path.is_file() and (self.path.parent / "metadata.yaml").is_file():
             self.path = self.path.parent  # a file of a ROS 2 bag (its .db3, .mcap or metadata)
         if (left_topic is None) != (right_topic is None):
