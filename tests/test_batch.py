@@ -1731,6 +1731,32 @@ def test_a_tartanair_trajectory_is_camera_folders_paired_by_number(
     assert {j.calib for j in find_pairs(tmp_path / "oldtown", calib=cal)} == {cal}
 
 
+def test_a_named_frame_of_a_camera_folder_without_its_other_names_the_other_folder(
+    tmp_path: Path,
+) -> None:
+    """A TartanAir frame whose right image was dropped (image_left/000002_left.png alone) was
+    reported by its folder's own walk: 'P000/image_left/000002: unpaired image: no
+    000002_right.png beside .../image_left/000002_left.png', sending the user to the wrong
+    folder (seq/left/left_0002.png alike). It is the half pair P000/000002, the missing file in
+    the other camera's folder; an unnamed frame (k/left/0002.png) as before."""
+    from stereovision.batch import _scan
+
+    traj = tmp_path / "P000"
+    _blank(
+        traj,
+        *(f"image_{s}/000000_{s}.png" for s in ("left", "right")),
+        "image_left/000002_left.png",
+        "image_right/000003_right.png",
+    )
+    jobs, unpaired, _ = _scan(tmp_path)
+    assert [j.name for j in jobs] == ["P000/000000"]
+    left, right = traj / "image_left", traj / "image_right"
+    assert sorted((u.name, u.what) for u in unpaired) == [
+        ("P000/000002", f"no {right}/000002_right.png for {left}/000002_left.png"),
+        ("P000/000003", f"no {left}/000003_left.png for {right}/000003_right.png"),
+    ]
+
+
 def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
     data_dir: Path, tmp_path: Path
 ) -> None:

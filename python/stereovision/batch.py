@@ -590,10 +590,13 @@ def _sibling_pairs(
     in their names (``left/left_0001.png`` + ``right/right_0001.png``). Each is named
     ``prefix`` + its left image's path under the camera folder without the extension (and
     without ``left``: ``seq/data/0001`` for ``seq/cam0/data/0001.png``, ``seq/0001`` for
-    ``seq/left/left_0001.png``); an image without the other is an :class:`_Unpaired`. Also
-    returns the named images paired here (the folder's own walk does not report them).
+    ``seq/left/left_0001.png``); an image without the other is an :class:`_Unpaired` (a named
+    one too when its other is not in the other folder). Also returns the named images paired
+    or reported here (the folder's own walk does not report them).
     Folders in ``skip`` (the output folder) are not searched."""
     lefts, rights = _camera_images(left_dir, skip), _camera_images(right_dir, skip)
+    lone_lefts = _lone_named_images(left_dir, skip)
+    lone_rights = _lone_named_images(right_dir, skip)
 
     def name(sub: str) -> str:
         short = sub.rsplit(".", 1)[0]
@@ -601,10 +604,7 @@ def _sibling_pairs(
 
     pairs = [PairJob(name(f), left_dir / f, right_dir / f, cal) for f in sorted(lefts & rights)]
     # the others, by the number in their names (left/left_0001.png + right/right_0001.png)
-    by_number = _by_number(
-        (lefts - rights) | _lone_named_images(left_dir, skip),
-        (rights - lefts) | _lone_named_images(right_dir, skip),
-    )
+    by_number = _by_number((lefts - rights) | lone_lefts, (rights - lefts) | lone_rights)
     for a, b in by_number:
         pairs.append(PairJob(name(_without_side(a)), left_dir / a, right_dir / b, cal))
     taken = {a for a, _ in by_number} | {b for _, b in by_number}
@@ -618,10 +618,29 @@ def _sibling_pairs(
         for f in rights - lefts
         if f not in taken
     ]
+    # a named image whose other is not in the other camera's folder either (TartanAir's
+    # image_left/000002_left.png, its right frame dropped) was reported by its folder's own
+    # walk as "no 000002_right.png beside .../image_left/000002_left.png", named
+    # P000/image_left/000002: the other folder's file is the one missing, the pair P000/000002
+    told: set[Path] = set()
+    for own, other, lone, side in (
+        (left_dir, right_dir, lone_lefts - taken, "left"),
+        (right_dir, left_dir, lone_rights - taken, "right"),
+    ):
+        for f in sorted(lone):
+            m = _last_left(Path(f).stem) if side == "left" else _last(_RIGHT_RE, Path(f).stem)
+            if m is None or (side == "right" and _last_left(Path(f).stem) is not None):
+                continue  # a right image in the left camera's folder: its walk says it
+            partner = _swap(Path(f), m, "right" if side == "left" else "left")
+            if (other / partner).exists():
+                continue  # there, not paired (a number two images carry): not guessed
+            left_name = f if side == "left" else partner.as_posix()
+            alone.append(_Unpaired(name(_without_side(left_name)), own / f, other / partner, side))
+            told.add(own / f)
     return (
         pairs,
         alone,
-        {left_dir / a for a, _ in by_number} | {right_dir / b for _, b in by_number},
+        {left_dir / a for a, _ in by_number} | {right_dir / b for _, b in by_number} | told,
     )
 
 
