@@ -1548,6 +1548,28 @@ def test_info_says_the_size_it_gives_a_q_dat_sets_the_field_of_view(
     )
 
 
+def test_info_says_the_size_it_gives_a_q_dat_sized_by_a_left_png(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The note above was left out for a Q.dat with its left.png beside it (a scene folder):
+    ``info scene --size 100x100`` said "field of view 10.5 x 13.2 degrees" for the 640x480
+    left.png's 90-degree cameras, --size taken over the image unsaid. Now said, the image
+    named; without --size the left.png sizes it, as before."""
+    (tmp_path / "Q.dat").write_text("1 0 0 -320\n0 1 0 -240\n0 0 0 320\n0 0 4 0\n")
+    cv2.imwrite(str(tmp_path / "left.png"), np.zeros((480, 640), np.uint8))
+    assert main(["info", str(tmp_path), "--size", "100x100"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == "field of view 10.5 x 13.2 degrees"
+    assert lines[-1].startswith(
+        "image size 100x100 from --size (the file holds none; left.png beside it not read): "
+        "the field of view is for it; the principal point (320.0, 240.0) px lies outside"
+    )
+    assert main(["info", str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == "field of view 90.0 x 73.7 degrees"
+    assert not any(line.startswith("image size") for line in lines)
+
+
 def test_info_on_an_image_list_says_it_is_not_a_calibration(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

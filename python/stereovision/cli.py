@@ -1517,14 +1517,18 @@ def _paper_baseline_words(text: str, baseline: float) -> str:
 MAX_PAPER_BASELINE_M = 1e6
 
 
-def _given_size_note(calib: Any) -> str:
+def _given_size_note(calib: Any, beside: Path | None = None) -> str:
     """``info CALIB --size WxH``'s line for a calibration that holds no image size: the field
     of view is the size given's (the depths are not), and a principal point outside that size
-    is named (the rig's images are another size)."""
+    is named (the rig's images are another size). ``beside``: the image that sizes it when no
+    size is given (a Q.dat's left.png), not read."""
     w, h = calib.image_size
     rc = calib if calib.rectified else calib.rectified_calibration()
     cx, cy = float(rc.K1[0, 2]), float(rc.K1[1, 2])
-    note = f"image size {w}x{h} from --size (the file holds none): the field of view is for it"
+    unread = "" if beside is None else f"; {beside.name} beside it not read"
+    note = (
+        f"image size {w}x{h} from --size (the file holds none{unread}): the field of view is for it"
+    )
     if not (0 <= cx <= w - 1 and 0 <= cy <= h - 1):
         note += (
             f"; the principal point ({cx:.1f}, {cy:.1f}) px lies outside a {w}x{h} image: "
@@ -1575,7 +1579,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     if not is_bag(args.calib):
         if topics != (None, None):
             raise CliError("--left-topic and --right-topic are for a bag")
-        from stereovision.calibration import _sizeless
+        from stereovision.calibration import _sizeless, _sizing_images
         from stereovision.capture import parse_size
 
         # --size with a calibration: the image size of one that holds none (stereo_calib
@@ -1587,6 +1591,10 @@ def cmd_info(args: argparse.Namespace) -> int:
             # the field of view is --size's alone: a Q.dat of a 640x480 rig given 100x100 said
             # "field of view 10.5 x 13.2 degrees" for its 90 degree cameras, without a word
             print(_given_size_note(calib))
+        elif size is not None and (beside := _sizing_images(args.calib)):
+            # --size wins over the left.png beside a Q.dat (or a KITTI file) that sizes it
+            # otherwise: its field of view was --size's, unsaid
+            print(_given_size_note(calib, beside[0]))
         return 0
     if args.size is not None or args.calib_unit is not None:
         raise CliError("--size and --calib-unit are for a calibration file, not a bag")
