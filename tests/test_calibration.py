@@ -2451,3 +2451,22 @@ def test_a_q_dat_with_a_byte_order_mark_is_sized_by_the_commands_pair(tmp_path: 
     got = load_calibration(marked, pair=pair)
     assert got.image_size == (64, 48)
     assert got == load_calibration(plain, pair=pair)
+
+
+def test_a_kitti_file_with_a_byte_order_mark_keeps_its_first_key(tmp_path: Path) -> None:
+    """An odometry calib.txt saved by a Windows editor (a UTF-8 BOM) lost its first key, P0
+    (read as '\\ufeffP0'): from_kitti(cameras=(0, 1)) said it "lacks P_rect_00/P_rect_01 (or
+    P0/P1)" and batch read its grey pairs as the colour pair (depth 0.9 % off, unsaid). Read
+    as the file without the mark, as the Middlebury and Q.dat readers read it."""
+    from stereovision.calibration import parse_kitti_calib
+
+    def p(tx: float) -> str:
+        return f"718.856 0 607.1928 {tx} 0 718.856 185.2157 0 0 0 1 0"
+
+    text = f"P0: {p(0.0)}\nP1: {p(-386.1448)}\nP2: {p(45.38225)}\nP3: {p(-337.2877)}\n"
+    plain, marked = tmp_path / "plain.txt", tmp_path / "marked.txt"
+    plain.write_text(text)
+    marked.write_bytes(b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode())
+    assert list(parse_kitti_calib(marked)) == ["P0", "P1", "P2", "P3"]
+    grey = Calibration.from_kitti(marked, image_size=(1241, 376), cameras=(0, 1))
+    assert grey == Calibration.from_kitti(plain, image_size=(1241, 376), cameras=(0, 1))

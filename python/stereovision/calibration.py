@@ -2645,7 +2645,9 @@ def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
     from stereovision.io import _existing_file
 
     p = _existing_file(path, "KITTI calibration")
-    text = p.read_text(encoding="utf-8", errors="replace")
+    # utf-8-sig: a file saved by a Windows editor (a BOM) lost its first key, odometry's P0:
+    # from_kitti(cameras=(0, 1)) said it "lacks P0/P1", batch read its grey pairs as the colour
+    text = p.read_text(encoding="utf-8-sig", errors="replace")
     out: dict[str, F64] = {}
     key: str | None = None
     values: list[str] = []
