@@ -1931,3 +1931,18 @@ def test_model_quasi_euclidean_not_fitting_names_the_option_too(
         "(median residual 2.62 px, at most 0.5 px): use model='projective' or 'auto' (--model "
         "projective or auto)"
     )
+
+
+def test_a_rectification_file_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
+    """A rectification.json edited in a Windows editor (a UTF-8 BOM) was refused: "is not an
+    uncalibrated rectification: not JSON text" (depth --rectification alike), where the
+    calibration readers skip the mark. It reads as the file without it."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (100, 80), (100, 80), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16,
+        (0.0, 0.0), (1.0, 1.0), "quasi-euclidean",
+    )  # fmt: skip
+    plain = rect.save(tmp_path / "plain.json")
+    marked = tmp_path / "marked.json"
+    marked.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes().replace(b"\n", b"\r\n"))
+    back = UncalibratedRectification.load(marked)
+    assert back.as_dict() == UncalibratedRectification.load(plain).as_dict()

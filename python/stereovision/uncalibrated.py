@@ -648,7 +648,9 @@ class UncalibratedRectification:
 
         _existing_file(p, "rectification file")
         try:
-            d = json.loads(p.read_text())
+            # utf-8-sig: a file edited in a Windows editor (a BOM) was "not JSON text", as the
+            # calibration readers read it without
+            d = json.loads(p.read_text(encoding="utf-8-sig"))
         except (UnicodeDecodeError, json.JSONDecodeError):
             # json's "Expecting value: line 1 column 1 (char 0)", or utf-8's "can't decode byte
             # 0x89", of an image given for it: neither said what was expected
