@@ -3926,3 +3926,19 @@ def test_a_middlebury_scene_with_a_q_dat_is_sized_by_its_im0(tmp_path: Path) -> 
     name, data = _task(job, {})["calib"]
     (tmp_path / name).write_bytes(data)
     assert Calibration.from_file(tmp_path / name).image_size == (40, 30)
+
+
+def test_an_input_link_whose_target_moved_names_it(tmp_path: Path) -> None:
+    """``batch data -o out`` with data -> /mnt/usb/data (the disk unmounted) said "input
+    folder not found: data", of a name ls lists, where the file readers name a link's target
+    (b7feb4e7). Now named; a missing folder as before."""
+    (tmp_path / "data").symlink_to(tmp_path / "moved" / "data")
+    with pytest.raises(FileNotFoundError) as err:
+        find_pairs(tmp_path / "data")
+    assert str(err.value) == (
+        f"input folder not found: {tmp_path / 'data'} (a link to {tmp_path / 'moved' / 'data'}, "
+        "which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as err:
+        find_pairs(tmp_path / "none")
+    assert str(err.value) == f"input folder not found: {tmp_path / 'none'}"

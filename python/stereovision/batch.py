@@ -292,11 +292,15 @@ def _scan(
     r = as_path(root, "root")
     if not r.exists():
         from stereovision.capture import mask_url_secrets
+        from stereovision.io import _broken_link
 
         # a URL given (Path made rtsp:// rtsp:/): its password is not said
         given = os.fspath(root)
+        # a link whose target moved (a dataset linked in from a disk since unmounted) was "not
+        # found" alone, of a name ls lists: its target is named, as io's readers name it
+        gone = f" ({_broken_link(r)})" if r.is_symlink() else ""
         raise FileNotFoundError(
-            f"input folder not found: {mask_url_secrets(given) if '://' in given else r}"
+            f"input folder not found: {mask_url_secrets(given) if '://' in given else r}{gone}"
         )
     if not r.is_dir():
         raise NotADirectoryError(f"input is not a folder: {r}")
