@@ -2074,6 +2074,23 @@ def test_eval_of_a_missing_folder_names_it(capsys: pytest.CaptureFixture[str]) -
     )
 
 
+def test_eval_and_bench_name_a_scene_link_whose_target_moved(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``eval data`` (and ``bench data``) with data -> /mnt/usb/data, the disk unmounted, said
+    "scene folder not found: data", of a name ls lists, where the file readers name a link's
+    target (b7feb4e7). Now named."""
+    link = tmp_path / "data"
+    link.symlink_to(tmp_path / "moved" / "data")
+    said = (
+        f"stereovision: error: scene folder not found: {link} (a link to "
+        f"{tmp_path / 'moved' / 'data'}, which does not exist)\n"
+    )
+    for command in ("eval", "bench"):
+        assert main([command, str(link)]) == 2
+        assert capsys.readouterr().err == said
+
+
 def test_depth_refuses_rectification_and_calib_together(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

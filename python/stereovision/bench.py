@@ -344,7 +344,10 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
     dirs: list[Path] = []
     for d in paths:
         if not Path(d).exists():  # as eval says it (scan_scenes: "scene root not found")
-            raise FileNotFoundError(f"scene folder not found: {d}")
+            from stereovision.io import _broken_link
+
+            gone = f" ({_broken_link(Path(d))})" if Path(d).is_symlink() else ""
+            raise FileNotFoundError(f"scene folder not found: {d}{gone}")
         if not Path(d).is_dir():  # find_scenes: "scene root not found"
             raise ValueError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found, half = scan_scenes(d)

@@ -2021,7 +2021,11 @@ def cmd_eval(args: argparse.Namespace) -> int:
     for d in args.scenes:
         p = Path(d)
         if not p.exists():
-            raise FileNotFoundError(f"scene folder not found: {d}")
+            from stereovision.io import _broken_link
+
+            # a link whose target moved (a dataset on a disk since unmounted): its target named
+            gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+            raise FileNotFoundError(f"scene folder not found: {d}{gone}")
         if not p.is_dir():  # find_scenes said "scene root not found" of an existing image
             raise CliError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found, half = scan_scenes(p)
