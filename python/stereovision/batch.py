@@ -315,7 +315,7 @@ def _scan(
     unpaired: list[_Unpaired] = []
     cam_found: list[PairJob] = []  # in sibling camera folders
     cam_unpaired: list[_Unpaired] = []
-    cam_taken: set[Path] = set()  # named images paired across camera folders, by number
+    cam_taken: set[Path] = set()  # named images paired (or reported) across camera folders
     cam_images: set[Path] = set()  # every image of a camera folder's pair or half pair
     skip = _output_below(r, output)
     for d, _dirs, files, listed in _walk(r, skip):
