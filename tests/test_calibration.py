@@ -1433,6 +1433,19 @@ def test_a_plain_yaml_of_the_fields_is_read_as_its_json_twin(tmp_path: Path) -> 
         Calibration.from_file(tmp_path / "devices.yaml")
 
 
+def test_a_file_pyyaml_fails_on_otherwise_than_yamlerror_is_unrecognised(tmp_path: Path) -> None:
+    """Every file unrecognised before is tried as a plain YAML of the fields, and PyYAML raises
+    more than YAMLError: a date that is none ('stamp: 2024-13-01') was from_file's bare
+    'month must be in 1..12' naming no file (a deep nesting of '[' a RecursionError, the CLI's
+    'internal RecursionError ... (please report this)'). It is unrecognised, as before."""
+    log = tmp_path / "log.txt"
+    log.write_text("stamp: 2024-13-01\nimage_width: 640\n")
+    with pytest.raises(ValueError, match=r"^unrecognised calibration format in .*log\.txt"):
+        Calibration.from_file(log)
+    with pytest.raises(ValueError, match=r"^not a stereovision calibration file .*log\.txt"):
+        Calibration.load(log)
+
+
 # ------------------------------------------------------ rectification geometry (mutation audit)
 
 

@@ -1547,7 +1547,9 @@ class Calibration:
 
         try:
             doc = yaml.safe_load(text)
-        except yaml.YAMLError:
+        except (yaml.YAMLError, ValueError, RecursionError):
+            # not YAML: any file unrecognised so far comes here, and PyYAML raises more than
+            # YAMLError ("d: 2024-13-01" -> "month must be in 1..12", a deep nesting of "[")
             return None
         if not isinstance(doc, dict) or not any(k in doc for k in _CALIBRATION_FIELDS):
             return None
