@@ -1446,6 +1446,21 @@ def test_a_file_pyyaml_fails_on_otherwise_than_yamlerror_is_unrecognised(tmp_pat
         Calibration.load(log)
 
 
+def test_load_of_one_ros_camera_info_says_what_it_is(tmp_path: Path) -> None:
+    """load(left.yaml), a ROS camera_info, was read as a plain YAML of the fields for its
+    image_width: 'calibration file left.yaml lacks field 'K1'' (before the plain YAML: 'not a
+    stereovision calibration file'). It is named, with the readers of a ROS pair."""
+    left = tmp_path / "left.yaml"
+    left.write_text(
+        "image_width: 640\nimage_height: 480\ncamera_name: left\ncamera_matrix:\n  rows: 3\n"
+        "  cols: 3\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\ndistortion_model: plumb_bob\n"
+    )
+    with pytest.raises(
+        ValueError, match=r"left\.yaml is one camera's ROS camera_info: .*Calibration\.from_ros"
+    ):
+        Calibration.load(left)
+
+
 # ------------------------------------------------------ rectification geometry (mutation audit)
 
 

@@ -1553,6 +1553,13 @@ class Calibration:
             return None
         if not isinstance(doc, dict) or not any(k in doc for k in _CALIBRATION_FIELDS):
             return None
+        if "camera_matrix" in doc and not any(k in doc for k in ("K1", "M1", "K2", "M2")):
+            # a ROS camera_info (load(left.yaml)): its image_width made it "lacks field 'K1'"
+            raise ValueError(
+                f"{source} is one camera's ROS camera_info: a rig needs both cameras' files; "
+                "read them with Calibration.from_ros(left, right), or from_file on the folder "
+                "holding left.yaml and right.yaml"
+            )
         return cls._from_mapping(doc.get, source, unit)
 
     @classmethod
