@@ -1446,6 +1446,25 @@ def test_a_file_pyyaml_fails_on_otherwise_than_yamlerror_is_unrecognised(tmp_pat
         Calibration.load(log)
 
 
+def test_a_flow_style_yaml_of_the_fields_is_read(tmp_path: Path) -> None:
+    """yaml.safe_dump(fields, default_flow_style=True) writes '{D1: [...], K1: ...}', a plain
+    YAML of the fields whose first '{' sent it to JSON: 'cannot parse rig.yaml as JSON:
+    Expecting property name enclosed in double quotes'. It is read as the block style is; a
+    JSON that is broken and no such YAML keeps JSON's words."""
+    import yaml
+
+    c = raw_calib()
+    fields = {k: getattr(c, k).tolist() for k in ("K1", "D1", "K2", "D2", "R", "T")}
+    fields.update(image_width=SIZE[0], image_height=SIZE[1], unit="m")
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(yaml.safe_dump(fields, default_flow_style=True))
+    assert rig.read_text().startswith("{D1: ")
+    assert Calibration.from_file(rig) == c and Calibration.load(rig) == c
+    rig.write_text('{"image_width": 320 "image_height": 240}')
+    with pytest.raises(ValueError, match=r"^cannot parse .*rig\.yaml as JSON: Expecting ','"):
+        Calibration.from_file(rig)
+
+
 def test_load_of_one_ros_camera_info_says_what_it_is(tmp_path: Path) -> None:
     """load(left.yaml), a ROS camera_info, was read as a plain YAML of the fields for its
     image_width: 'calibration file left.yaml lacks field 'K1'' (before the plain YAML: 'not a

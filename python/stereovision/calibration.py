@@ -1531,6 +1531,14 @@ class Calibration:
         if head.startswith("%YAML") or head.startswith("<?xml") or head.startswith("<opencv"):
             return cls._from_filestorage_text(text, str(p), unit)
         if head.startswith("{"):
+            try:
+                json.loads(text)
+            except json.JSONDecodeError:
+                # YAML's flow mapping (yaml.safe_dump(..., default_flow_style=True), a line
+                # "{image_width: 640, ...}"), keys unquoted, was "cannot parse ... as JSON"
+                calib = cls._from_plain_yaml(text, str(p), unit)
+                if calib is not None:
+                    return calib
             return cls._from_json_text(text, str(p), unit)
         calib = cls._from_plain_yaml(text, str(p), unit)
         if calib is not None:
