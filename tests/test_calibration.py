@@ -1446,6 +1446,23 @@ def test_a_file_pyyaml_fails_on_otherwise_than_yamlerror_is_unrecognised(tmp_pat
         Calibration.load(log)
 
 
+def test_a_yaml_dump_of_numpy_arrays_is_said(tmp_path: Path) -> None:
+    """yaml.dump of the fields as NumPy arrays (a script's first way: !!python/object tags,
+    which safe loading constructs no object of) was 'unrecognised calibration format in
+    rig.yaml: expected OpenCV YAML/XML, JSON, ...', a YAML of the fields all the same. It is
+    said, with the lists to write instead."""
+    import yaml
+
+    c = raw_calib()
+    fields = {k: getattr(c, k) for k in ("K1", "D1", "K2", "D2", "R", "T")}
+    fields.update(image_width=SIZE[0], image_height=SIZE[1], unit="m")
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(yaml.dump(fields))
+    for read in (Calibration.from_file, Calibration.load):
+        with pytest.raises(ValueError, match=r"rig\.yaml holds Python objects .*\.tolist\(\)"):
+            read(rig)
+
+
 def test_a_flow_style_yaml_of_the_fields_is_read(tmp_path: Path) -> None:
     """yaml.safe_dump(fields, default_flow_style=True) writes '{D1: [...], K1: ...}', a plain
     YAML of the fields whose first '{' sent it to JSON: 'cannot parse rig.yaml as JSON:

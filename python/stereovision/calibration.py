@@ -1556,6 +1556,16 @@ class Calibration:
         try:
             doc = yaml.safe_load(text)
         except (yaml.YAMLError, ValueError, RecursionError):
+            if "!!python/" in text and any(
+                re.search(rf"^{k}\s*:", text, re.MULTILINE) for k in _CALIBRATION_FIELDS
+            ):
+                # yaml.dump of the NumPy arrays, the first way a script writes them: it was
+                # "unrecognised calibration format" (safe_load constructs no Python object)
+                raise ValueError(
+                    f"calibration file {source} holds Python objects (yaml.dump's !!python/ "
+                    "tags: NumPy arrays), which are not loaded: write the arrays as lists "
+                    "(yaml.safe_dump({'K1': K1.tolist(), ...})), or use Calibration.save"
+                ) from None
             # not YAML: any file unrecognised so far comes here, and PyYAML raises more than
             # YAMLError ("d: 2024-13-01" -> "month must be in 1..12", a deep nesting of "[")
             return None
