@@ -1495,6 +1495,14 @@ def test_load_of_one_ros_camera_info_says_what_it_is(tmp_path: Path) -> None:
         ValueError, match=r"left\.yaml is one camera's ROS camera_info: .*Calibration\.from_ros"
     ):
         Calibration.load(left)
+    # a message echoed to a file (ROS 1: K, R, P, its R one of the fields) without the echo's
+    # closing '---': "lacks field 'image_width': ... cv2.stereoCalibrate's ..."
+    left.write_text(
+        "height: 480\nwidth: 640\ndistortion_model: plumb_bob\nD: [0, 0, 0, 0, 0]\n"
+        "K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\nR: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+    )
+    with pytest.raises(ValueError, match=r"left\.yaml is one camera's ROS camera_info: "):
+        Calibration.load(left)
 
 
 # ------------------------------------------------------ rectification geometry (mutation audit)

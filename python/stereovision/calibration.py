@@ -1571,8 +1571,10 @@ class Calibration:
             return None
         if not isinstance(doc, dict) or not any(k in doc for k in _CALIBRATION_FIELDS):
             return None
-        if "camera_matrix" in doc and not any(k in doc for k in ("K1", "M1", "K2", "M2")):
+        ros = "camera_matrix" in doc or "distortion_model" in doc  # a file, a message echo
+        if ros and not any(k in doc for k in ("K1", "M1", "K2", "M2")):
             # a ROS camera_info (load(left.yaml)): its image_width made it "lacks field 'K1'"
+            # (a message's R: "lacks field 'image_width': ... cv2.stereoCalibrate's ...")
             raise ValueError(
                 f"{source} is one camera's ROS camera_info: a rig needs both cameras' files; "
                 "read them with Calibration.from_ros(left, right), or from_file on the folder "
