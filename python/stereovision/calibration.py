@@ -300,6 +300,11 @@ def _first_line(exc: BaseException) -> str:
 
 #: Fields of which an OpenCV YAML/XML calibration has at least one.
 _CALIBRATION_FIELDS = ("image_width", "image_height", "K1", "M1", "K2", "M2", "R", "T")
+# One of them as a mapping's key, in block style (at a line's start) or flow style (after "{" or
+# ","), quoted or not: what a plain YAML of a calibration holds (Calibration._from_plain_yaml)
+_PLAIN_YAML_KEY = re.compile(
+    r"(?:^|[{,])[ \t]*([\"']?)(?:" + "|".join(_CALIBRATION_FIELDS) + r")\1[ \t]*:", re.MULTILINE
+)
 
 
 #: Fields of MATLAB's ``stereoParameters`` (its ``toStruct``, saved or ``jsonencode``-d).
@@ -1551,6 +1556,10 @@ class Calibration:
         ``!!opencv-matrix`` tags (a script's ``yaml.safe_dump`` of nested lists, a hand-written
         file), read as its JSON twin is; None when the text is no such mapping. It was
         'unrecognised calibration format ... expected OpenCV YAML/XML, JSON, ...'."""
+        if not _PLAIN_YAML_KEY.search(text):
+            # no field as a key: not parsed (PyYAML's pure-Python parser took 5.5 s on a 2.7 MB
+            # point list given as --calib by mistake, which this comes to unrecognised)
+            return None
         import yaml
 
         try:
