@@ -2566,3 +2566,25 @@ def test_a_kitti_file_with_a_byte_order_mark_keeps_its_first_key(tmp_path: Path)
     assert list(parse_kitti_calib(marked)) == ["P0", "P1", "P2", "P3"]
     grey = Calibration.from_kitti(marked, image_size=(1241, 376), cameras=(0, 1))
     assert grey == Calibration.from_kitti(plain, image_size=(1241, 376), cameras=(0, 1))
+
+
+def test_from_q_reads_commas_and_brackets_and_names_what_is_no_number(tmp_path: Path) -> None:
+    """A Q.dat of ``np.savetxt(..., delimiter=',')`` or a pasted ``Q.tolist()`` was refused as
+    "not a Q matrix (16 numbers expected)" without a reason; commas, semicolons and brackets
+    part the entries, and an entry that is no number is named."""
+    q = np.array([[1, 0, 0, -5], [0, 1, 0, -4], [0, 0, 0, 100], [0, 0, 10, 0]], dtype=float)
+    plain = tmp_path / "plain.dat"
+    np.savetxt(plain, q)
+    want = Calibration.from_q(plain, (10, 8))
+    np.savetxt(tmp_path / "comma.dat", q, delimiter=",")
+    (tmp_path / "list.dat").write_text(str(q.tolist()))
+    (tmp_path / "matlab.dat").write_text("[1 0 0 -5; 0 1 0 -4; 0 0 0 100; 0 0 10 0]")
+    for name in ("comma.dat", "list.dat", "matlab.dat"):
+        got = Calibration.from_q(tmp_path / name, (10, 8))
+        assert (got.K1 == want.K1).all() and (got.T == want.T).all(), name
+    assert Calibration.from_file(tmp_path / "comma.dat", image_size=(10, 8)).K1[0, 0] == 100
+    (tmp_path / "Q.dat").write_text("Q = 1 0 0 -5 0 1 0 -4 0 0 0 100 0 0 10 0")
+    with pytest.raises(
+        ValueError, match=r"Q\.dat: not a Q matrix \(16 numbers expected, got 'Q'\)$"
+    ):
+        Calibration.from_q(tmp_path / "Q.dat", (10, 8))

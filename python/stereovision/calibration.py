@@ -1987,10 +1987,15 @@ class Calibration:
             ``image_size`` is not two positive whole numbers.
         """
         p, text = cls._read_text(path)
+        tokens = _q_tokens(text)
         try:
-            q = np.array([float(t) for t in text.split()], dtype=np.float64)
+            q = np.array([float(t) for t in tokens], dtype=np.float64)
         except ValueError:
-            raise ValueError(f"{p}: not a Q matrix (16 numbers expected)") from None
+            # which entry is no number: the refusal said only "16 numbers expected"
+            word = next(t for t in tokens if not _is_float(t))
+            raise ValueError(
+                f"{p}: not a Q matrix (16 numbers expected, got {reprlib.repr(word)})"
+            ) from None
         if q.size != 16:
             raise ValueError(f"{p}: not a Q matrix (16 finite numbers expected, got {q.size})")
         if not np.isfinite(q).all():
@@ -2938,16 +2943,25 @@ def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, 
     )
 
 
-def _q_numbers(text: str) -> bool:
-    """Whether a text is 16 numbers and nothing else (OpenCV's 4x4 ``Q`` as a ``Q.dat``)."""
-    tokens = text.split()
-    if len(tokens) != 16:
-        return False
+def _q_tokens(text: str) -> list[str]:
+    """The entries of a ``Q.dat``'s text: parted by white space, commas (``np.savetxt(...,
+    delimiter=',')``) or semicolons, brackets dropped (a pasted ``print(Q)`` or
+    ``Q.tolist()``): those were "not a Q matrix (16 numbers expected)" without a reason."""
+    return [t for t in re.split(r"[\s,;\[\]]+", text) if t]
+
+
+def _is_float(text: str) -> bool:
     try:
-        [float(t) for t in tokens]
+        float(text)
     except ValueError:
         return False
     return True
+
+
+def _q_numbers(text: str) -> bool:
+    """Whether a text is 16 numbers and nothing else (OpenCV's 4x4 ``Q`` as a ``Q.dat``)."""
+    tokens = _q_tokens(text)
+    return len(tokens) == 16 and all(_is_float(t) for t in tokens)
 
 
 def _q_file(path: Path) -> Path | None:
