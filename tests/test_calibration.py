@@ -2588,3 +2588,17 @@ def test_from_q_reads_commas_and_brackets_and_names_what_is_no_number(tmp_path: 
         ValueError, match=r"Q\.dat: not a Q matrix \(16 numbers expected, got 'Q'\)$"
     ):
         Calibration.from_q(tmp_path / "Q.dat", (10, 8))
+
+
+def test_middlebury_calib_skips_comments(tmp_path: Path) -> None:
+    """A calib.txt with a '# comment' line or a note after a value was refused: "calib.txt:1:
+    expected key=value, got '# ...'"; the rest of a line from '#' on is skipped."""
+    (tmp_path / "calib.txt").write_text(
+        "# my rig, 2026-12-07\n"
+        "cam0=[500 0 320; 0 500 240; 0 0 1]  # left\n"
+        "cam1=[500 0 320; 0 500 240; 0 0 1]\n"
+        "doffs=0\nbaseline=100 # mm\nwidth=640\nheight=480\n"
+    )
+    v = parse_middlebury_calib(tmp_path / "calib.txt")
+    assert v["baseline"] == 100.0 and v["cam0"][0, 2] == 320.0 and "#" not in str(v.keys())
+    assert Calibration.from_file(tmp_path / "calib.txt").baseline == 100.0

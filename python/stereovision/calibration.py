@@ -2586,7 +2586,7 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     ``cam0``/``cam1`` (``[f 0 cx; 0 f cy; 0 0 1]``, MATLAB's syntax: commas may part the
     numbers, a ``;`` may end the last row or the line) become ``(3, 3)`` float64 arrays; every
     other ``key=number`` line (``doffs``, ``baseline``, ``width``, ``height``, ``ndisp``,
-    ``vmin``, ...) a float.
+    ``vmin``, ...) a float. A ``#`` starts a comment, to the end of its line.
 
     Parameters
     ----------
@@ -2616,6 +2616,9 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     # "-sig": a byte-order mark (Windows Notepad writes one) made line 1 "expected key=value,
     # got '\ufeffcam0=[...]'", though from_middlebury's own _read_text skips it
     for n, line in enumerate(p.read_text(encoding="utf-8-sig", errors="replace").splitlines(), 1):
+        # a '# comment' line (or one after a value) was "expected key=value, got '# ...'": no
+        # key or value of the format holds a '#', so the rest of the line is a note
+        line = line.split("#", 1)[0]
         if not line.strip():
             continue
         m = _MB_LINE.match(line)
