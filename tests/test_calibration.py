@@ -2602,3 +2602,18 @@ def test_middlebury_calib_skips_comments(tmp_path: Path) -> None:
     v = parse_middlebury_calib(tmp_path / "calib.txt")
     assert v["baseline"] == 100.0 and v["cam0"][0, 2] == 320.0 and "#" not in str(v.keys())
     assert Calibration.from_file(tmp_path / "calib.txt").baseline == 100.0
+
+
+def test_a_plain_yaml_reads_numbers_written_without_a_point(tmp_path: Path) -> None:
+    """PyYAML (YAML 1.1) reads ``1e-3`` (no '.', or an unsigned exponent) as a string: a plain
+    YAML's ``doffs: 1e-3`` was "doffs must be a number, got '1e-3'", and such a number in a
+    matrix failed too; every scalar field and matrix entry reads it as a number."""
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(
+        "image_width: 640\nimage_height: 480\nunit: m\nrectified: 1\ndoffs: 1e-3\n"
+        "K1: [[5e2, 0, 320], [0, 5E+2, 240], [0, 0, 1]]\nD1: [0, 0, 0, 0, 0]\n"
+        "K2: [[5e2, 0, 320], [0, 5E+2, 240], [0, 0, 1]]\nD2: [0, 0, 0, 0, 0]\n"
+        "R: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\nT: [-1e-1, 0, 0]\n"
+    )
+    c = Calibration.from_file(rig)
+    assert c.doffs == 1e-3 and c.K1[1, 1] == 500.0 and c.T[0] == -0.1

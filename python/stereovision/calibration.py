@@ -1563,7 +1563,7 @@ class Calibration:
         import yaml
 
         try:
-            doc = yaml.safe_load(text)
+            doc = yaml.load(text, Loader=_yaml_loader())  # a SafeLoader
         except (yaml.YAMLError, ValueError, RecursionError):
             if "!!python/" in text and any(
                 re.search(rf"^{k}\s*:", text, re.MULTILINE) for k in _CALIBRATION_FIELDS
@@ -2944,6 +2944,23 @@ def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, 
         + mat("rectification_matrix", R)
         + mat("projection_matrix", P)
     )
+
+
+def _yaml_loader() -> Any:
+    """PyYAML's ``SafeLoader`` that also reads ``1e-3`` and ``2.5e3`` as numbers (YAML 1.2,
+    JSON and Python do; PyYAML's YAML 1.1 wants a '.' and a signed exponent): a plain YAML's
+    ``doffs: 1e-3`` was "doffs must be a number, got '1e-3'"."""
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+        list("-+0123456789."),
+    )
+    return Loader
 
 
 def _q_tokens(text: str) -> list[str]:
