@@ -2617,3 +2617,27 @@ def test_a_plain_yaml_reads_numbers_written_without_a_point(tmp_path: Path) -> N
     )
     c = Calibration.from_file(rig)
     assert c.doffs == 1e-3 and c.K1[1, 1] == 500.0 and c.T[0] == -0.1
+
+
+def test_a_calibrate_report_given_as_a_calibration_is_named(tmp_path: Path) -> None:
+    """``stereovision calibrate``'s report.json / report.yaml, given for the calibration beside
+    them, was "is not a calibration: it has none of the fields ..." (JSON) or "unrecognised
+    calibration format" (YAML); it is named a report and the calibration file pointed to."""
+    import yaml
+
+    from stereovision.calibrate import CalibrationReport
+
+    c = raw_calib()
+    report = {"rms": 0.3, "used_pairs": ["01"], "rejected_pairs": {}, "image_size": [64, 48]}
+    report["calibration"] = {k: getattr(c, k).tolist() for k in ("K1", "D1", "K2", "D2", "R", "T")}
+    assert set(report) - {"calibration"} <= set(CalibrationReport.__dataclass_fields__)
+    (tmp_path / "report.json").write_text(json.dumps(report))
+    (tmp_path / "report.yaml").write_text(yaml.safe_dump(report, sort_keys=False))
+    for name in ("report.json", "report.yaml"):
+        for read in (Calibration.from_file, Calibration.load):
+            with pytest.raises(
+                ValueError,
+                match=rf"{name} is a `stereovision calibrate` report \(its figures\), not a "
+                r"calibration: give the calibration file calibrate wrote \(its -o / --output",
+            ):
+                read(tmp_path / name)

@@ -307,6 +307,9 @@ _PLAIN_YAML_KEY = re.compile(
 )
 
 
+#: Fields of a ``stereovision calibrate`` report (``CalibrationReport.as_dict``).
+_REPORT_FIELDS = frozenset(("rms", "used_pairs", "rejected_pairs", "calibration"))
+
 #: Fields of MATLAB's ``stereoParameters`` (its ``toStruct``, saved or ``jsonencode``-d).
 _MATLAB_FIELDS = ("CameraParameters1", "CameraParameters2", "RotationOfCamera2")
 
@@ -327,6 +330,12 @@ def _not_a_calibration_keys(keys: list[str], source: str) -> str:
     (named), or which fields it has."""
     if any(k in _MATLAB_FIELDS for k in keys):
         return _matlab_export(source)
+    if _REPORT_FIELDS <= set(keys):
+        # report.json / report.yaml lie beside the calibration and were given for it
+        return (
+            f"{source} is a `stereovision calibrate` report (its figures), not a calibration: "
+            "give the calibration file calibrate wrote (its -o / --output file)"
+        )
     held = ", ".join(keys) if keys else "nothing"
     return (
         f"{source} is not a calibration: it has none of the fields image_width, K1, K2, R, T "
@@ -1578,6 +1587,8 @@ class Calibration:
             # not YAML: any file unrecognised so far comes here, and PyYAML raises more than
             # YAMLError ("d: 2024-13-01" -> "month must be in 1..12", a deep nesting of "[")
             return None
+        if isinstance(doc, dict) and _REPORT_FIELDS <= set(doc):
+            raise ValueError(_not_a_calibration_keys(list(doc), source))
         if not isinstance(doc, dict) or not any(k in doc for k in _CALIBRATION_FIELDS):
             return None
         ros = "camera_matrix" in doc or "distortion_model" in doc  # a file, a message echo
