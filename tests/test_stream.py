@@ -2574,10 +2574,13 @@ def test_a_temporal_stream_averages_up_to_255_pairs(
     assert main([*argv, "--max-disparity", "8", "--temporal", "255", "--json"]) == 0
     summary = _json_lines(capsys.readouterr().out)[-1]
     assert summary["frames"] == 1 and summary["temporal"]["frames_averaged"] == 1.0
-    for n in (1, 256):
-        assert main([*argv, "--max-disparity", "8", "--temporal", str(n)]) == 2
+    for n in (1, 256):  # refused by argparse (test_temporal_is_refused_at_parse_time)
+        with pytest.raises(SystemExit) as info:
+            main([*argv, "--max-disparity", "8", "--temporal", str(n)])
+        assert info.value.code == 2
         assert capsys.readouterr().err.strip().splitlines() == [
-            f"stereovision: error: --temporal: expected 2-255 pairs to average, got {n}"
+            "stereovision stream: error: argument --temporal: expected 2-255 pairs to average, "
+            f"got '{n}' (see stereovision stream --help)"
         ]
 
 
@@ -3729,3 +3732,19 @@ def test_the_bag_line_names_a_folder_with_a_newline_escaped_on_one_line() -> Non
     assert _bag_line(bag(0, 0), 2).startswith(
         "no ROS 2 bag written to o\\nut: none of the 2 pairs processed; "
     )
+
+
+def test_temporal_is_refused_at_parse_time(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """``--temporal 8.5`` was argparse's "invalid int value: '8.5'" where the other counts say
+    what they expect, and ``--temporal 1`` was refused only after ``--calib`` was read (a
+    missing calibration was said first); both are refused by argparse, in the option's name."""
+    argv = ["stream", "--left", "0", "--right", "1", "--calib", str(tmp_path / "no.yaml")]
+    for n in ("8.5", "1"):
+        with pytest.raises(SystemExit) as info:
+            main([*argv, "--temporal", n])
+        assert info.value.code == 2
+        err = capsys.readouterr().err
+        assert f"argument --temporal: expected 2-255 pairs to average, got '{n}'" in err
+        assert "no.yaml" not in err

@@ -1887,6 +1887,19 @@ def _bag_line(bag: Any, pairs: int) -> str:
     return line + "; " + lost if frames < pairs else line
 
 
+def temporal_pairs(text: str) -> int:
+    """argparse type of ``--temporal``: 2 to 255 pairs (the filter's bounds), refused in the
+    option's name as the other counts are (``8.5`` was argparse's "invalid int value", and ``1``
+    was refused only after ``--calib`` was read)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 2 <= value <= 255:
+        raise argparse.ArgumentTypeError(f"expected 2-255 pairs to average, got {text!r}")
+    return value
+
+
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision stream`` on the CLI's sub-parsers."""
     # cli builds its parser with these
@@ -2009,7 +2022,7 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--temporal",
-        type=int,
+        type=temporal_pairs,
         metavar="N",
         help="average a still rig's frames over up to N pairs (e.g. 8) before matching: less "
         "noise in low light; starts again where the rig or the scene moves",
