@@ -2395,3 +2395,19 @@ def test_view_names_a_folder_with_a_newline_escaped_on_one_line(
     assert capsys.readouterr().out == (
         f"3 points -> {shown}/shot.png (the one it replaced kept as {shown}/shot.previous.png)\n"
     )
+
+
+def test_point_cloud_names_points_beyond_float32s_range():
+    """A float64 point past float32's range (1e39) gave NumPy's "RuntimeWarning: overflow
+    encountered in cast", naming nothing, and was dropped; one warning counts the points."""
+    import warnings
+
+    pts = np.array([[0, 0, 1], [1e39, 0, 1], [2, -1e40, 2], [1, 1, 4]])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cloud = render.point_cloud(pts)
+    assert [str(w.message) for w in caught] == [
+        "points: 2 point(s) with a coordinate beyond float32's range (e.g. 1e+39) dropped "
+        "(not shown)"
+    ]
+    np.testing.assert_array_equal(cloud.points, pts[[0, 3]])
