@@ -2408,3 +2408,21 @@ def test_a_hand_made_scan_turning_clockwise_is_taken() -> None:
             "angle_min, angle_max: expected angle_max >= angle_min for a positive "
             f"angle_increment (<= for a negative one), got {a0!r}, {a1!r} and {inc!r}"
         )
+
+
+def test_occupancy_grid_save_names_a_null_byte(tmp_path: Path) -> None:
+    """A ``name`` or ``directory`` holding a null byte raised the OS's bare "ValueError:
+    embedded null byte", naming no argument; the argument is named and nothing is written."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    with pytest.raises(
+        ValueError, match=r"^name: expected a file stem without a null byte, got 'a\\x00b'$"
+    ):
+        grid.save(tmp_path, "a\x00b")
+    with pytest.raises(
+        ValueError,
+        match=r"^directory: expected a folder name without a null byte, got '.*x\\x00y'$",
+    ):
+        grid.save(tmp_path / "x\x00y")
+    assert list(tmp_path.iterdir()) == []

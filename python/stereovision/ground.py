@@ -1065,7 +1065,8 @@ class OccupancyGrid:
         Raises
         ------
         ValueError
-            A ``name`` that is empty or holds a folder (``"../x"``, ``"a/b"``).
+            A ``name`` that is empty or holds a folder (``"../x"``, ``"a/b"``), or a ``name``
+            or ``directory`` holding a null byte.
         TypeError
             A ``directory`` that is bytes or no file name at all.
         RuntimeError
@@ -1084,10 +1085,16 @@ class OccupancyGrid:
         # a stem with a folder in it ("../x") wrote outside ``directory``
         if not isinstance(name, str) or name in ("", ".", "..") or Path(name).name != name:
             raise ValueError(f"name: expected a file stem without a folder, got {name!r}")
+        if "\x00" in name:  # the OS's bare "embedded null byte" named no argument
+            raise ValueError(f"name: expected a file stem without a null byte, got {name!r}")
         from stereovision._validate import as_path
 
         # Path(str(...)): b"/tmp/maps" wrote into a folder named "b'", None into "None"
         d = as_path(directory, "directory")
+        if "\x00" in str(d):
+            raise ValueError(
+                f"directory: expected a folder name without a null byte, got {str(d)!r}"
+            )
         if d.exists() and not d.is_dir():  # mkdir's "[Errno 17] File exists: 'maps'"
             raise FileExistsError(f"cannot write the map into {d}: it is a file, not a folder")
         from stereovision.io import make_folder
