@@ -1699,8 +1699,9 @@ def test_load_scene_right_image_gt_width_and_range_without_gt(tmp_path: Path) ->
     with pytest.raises(ValueError) as info:
         load_scene(d)
     assert str(info.value) == f"scene {d}: gt_disp.pfm is 199x40, left.png 200x40"
-    with pytest.raises(FileNotFoundError, match=r"^scene directory not found: .*left\.png$"):
-        load_scene(d / "left.png")  # a file is no scene folder
+    # a file is no scene folder: it was "scene directory not found" (a deliberate change)
+    with pytest.raises(NotADirectoryError, match=r"left\.png is a file, not a scene directory"):
+        load_scene(d / "left.png")
 
 
 def test_scene_range_ignores_infinite_gt_and_calib_ndisp_inf_names_the_file(
@@ -2896,3 +2897,18 @@ def test_read_ply_of_an_ascii_cloud_with_a_byte_order_mark(tmp_path: Path) -> No
     (tmp_path / "b.ply").write_bytes(b"\xef\xbb\xbf" + body.replace(b"\n", b"\r\n"))
     pts, cols = read_ply(tmp_path / "b.ply")
     assert pts.tolist() == [[1, 2, 3], [4, 5, 6.5]] and cols is None
+
+
+def test_load_scene_of_a_file_says_its_folder_is_the_scene(tmp_path: Path) -> None:
+    """``load_scene('cones/left.png')`` said "scene directory not found: .../left.png" of a
+    file that is there; it says it is a file and names its folder; a missing path is still
+    "not found"."""
+    d = _scene(tmp_path / "cones", 8, 6)
+    with pytest.raises(NotADirectoryError) as info:
+        load_scene(d / "left.png")
+    assert str(info.value) == (
+        f"{d / 'left.png'} is a file, not a scene directory: a scene is the folder holding "
+        f"left.png and right.png ({d}?)"
+    )
+    with pytest.raises(FileNotFoundError, match=r"^scene directory not found: .*nothing$"):
+        load_scene(tmp_path / "nothing")

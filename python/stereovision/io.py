@@ -2089,6 +2089,8 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
         Middlebury's ``im0.png`` + ``im1.png``, naming the files to rename; of ``Left.png`` +
         ``Right.png``, saying the names are lower case), or ``gt_disp.pfm``,
         ``calib.txt`` or ``Q.dat`` is a link to a file that does not exist.
+    NotADirectoryError
+        If ``directory`` is a file (``cones/left.png``: the scene is its folder).
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
         its size differs from the left image, or the calibration file is invalid (an
@@ -2097,6 +2099,12 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
     d = as_path(directory, "directory")
+    if d.is_file():
+        # load_scene('cones/left.png') was "scene directory not found" of a file that is there
+        raise NotADirectoryError(
+            f"{d} is a file, not a scene directory: a scene is the folder holding left.png and "
+            f"right.png ({d.parent}?)"
+        )
     if not d.is_dir():
         raise FileNotFoundError(f"scene directory not found: {d}")
     if not any(os.path.lexists(d / n) for n in ("left.png", "right.png")) and all(
