@@ -1731,3 +1731,14 @@ def test_save_csv_writes_each_float32_as_its_str_whatever_its_bits(tmp_path: Pat
     want = "".join(",".join(str(v) for v in row) + "\n" for row in rows)
     assert text == "x_left,y_left,x_right,y_right,score\n" + want
     assert text.count("\n-0.0,") == text.count("\n0.0,") == 100
+
+
+def test_matches_of_plain_numbers_are_refused() -> None:
+    """``Matches(1.0, 1.0, 1.0, 1.0, 1.0, (4, 5))``, numbers where arrays go, made one match
+    without a word (the float32 cast made each a 1-D array); the field is named."""
+    with pytest.raises(ValueError, match=r"^xl: expected a 1-D array, got shape \(\)$"):
+        sv.Matches(1.0, 1.0, 1.0, 1.0, 1.0, (4, 5))
+    a = np.ones(1)
+    with pytest.raises(ValueError, match=r"^score: expected a 1-D array, got shape \(\)$"):
+        sv.Matches(a, a, a, a, np.float64(0.5), (4, 5))
+    assert len(sv.Matches(a, a, a, a, [0.5], (4, 5))) == 1

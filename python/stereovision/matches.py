@@ -46,10 +46,10 @@ def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
     # a finite 1e40 became inf with only NumPy's "overflow encountered in cast" (from_csv
     # refuses it in a file)
     refuse_beyond_float32(raw, name, "would be read as inf (the matches are float32)")
-    arr = np.ascontiguousarray(raw, dtype=np.float32)
-    if arr.ndim != 1:
-        raise ValueError(f"{name}: expected a 1-D array, got shape {arr.shape}")
-    return arr
+    # checked before the cast: ascontiguousarray makes a plain number (shape ()) one match
+    if raw.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D array, got shape {raw.shape}")
+    return np.ascontiguousarray(raw, dtype=np.float32)
 
 
 def _float32_text(values: F32) -> list[str]:
