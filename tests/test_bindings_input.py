@@ -1431,6 +1431,20 @@ def test_mcgm_curves_refuses_a_huge_image_before_copying_it() -> None:
     )
 
 
+def test_hopfield_match_u8_refuses_a_huge_pair_before_copying_it() -> None:
+    """``hopfield_match_u8`` copied ``left`` before the kernel's 32-bit size check, which
+    ``hopfield_match`` makes from the shapes first: a broadcast (2**30, 2**30) uint8 pair was
+    "MemoryError: out of memory: a copy of left needs 1073741824.00 GiB", a 65536 x 65536 x 3
+    one two 12 GiB copies. It is the size's ValueError now, as for the float pair."""
+    big = np.broadcast_to(np.uint8(5), (2**30, 2**30))
+    with pytest.raises(ValueError) as err:
+        _core.hopfield_match_u8(big, big, (0.114, 0.587, 0.299), {})
+    assert str(err.value) == (
+        "left: image of 1073741824x1073741824 pixels is too large: the kernels index pixels with "
+        "32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
+    )
+
+
 def test_lzf_decompress_takes_any_bytes_like_data_and_names_other_data() -> None:
     """Only ``bytes`` was taken: a ``bytearray`` or ``memoryview`` (a message's payload) was
     pyo3's "'bytearray' object is not an instance of 'bytes'", and a str or list the same words,

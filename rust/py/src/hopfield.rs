@@ -259,6 +259,10 @@ pub fn hopfield_match_u8<'py>(
             right.shape()
         )));
     }
+    // The kernel's 32-bit size check before the copies, as `hopfield_match` makes it: a
+    // broadcast (2**30, 2**30) pair was a MemoryError for left's copy, a 65536 x 65536 x 3 one
+    // two 12 GiB copies (and their grey images) before the refusal.
+    crate::errors::check_size(w, h, stereovision_core::image::MAX_PIXELS, "left", "image")?;
     let wts = crate::convert::luma_weights(weights)?;
     let (p, best) = parse_match(params)?;
     let (_, _, _, ld) = u8_layout(&left, "left")?;
