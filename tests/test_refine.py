@@ -531,15 +531,28 @@ def test_min_disparity_defaults_to_zero_a_confidence_of_one_is_read_and_3d_is_na
 
 
 @pytest.mark.parametrize(
-    "fills", [((2**1100, 0.3),), ((True, 0.3),), ((16.0, False),), (("16", "0.3"),)]
+    ("fills", "said"),
+    [
+        (
+            ((2**1100, 0.3),),
+            "fill sigma must be a finite number, got an integer of 332 digits (too large for a "
+            "float)",
+        ),
+        (((True, 0.3),), "fill sigma must be a number, got True"),
+        (((16.0, False),), "fill min_score must be a number, got False"),
+        ((("16", "0.3"),), "fill sigma must be a number, got '16'"),
+    ],
 )
-def test_fills_entries_are_numbers_as_every_other_parameter(fills: object) -> None:
+def test_fills_entries_are_numbers_as_every_other_parameter(fills: object, said: str) -> None:
     """``fills`` went through ``float()``: an int past a float's range was a bare OverflowError
     naming nothing, and True and "16" were taken as a sigma of 1 and 16, where every other
-    parameter refuses them by name (``win_sigma=True``: "must be a number")."""
+    parameter refuses them by name (``win_sigma=True``: "must be a number"). The number is
+    named, as the kernel names it: "fills must be a sequence of (sigma, min_score), got
+    ((True, 0.3),)" said a sequence of pairs was none (and 2**1100 in 332 digits)."""
     a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
-    with pytest.raises(ValueError, match=r"^fills must be a sequence of \(sigma, min_score\)"):
+    with pytest.raises(ValueError) as err:
         refine_disparity(a, a, a, max_disparity=8, fills=fills)
+    assert str(err.value) == said
     arr = refine_disparity(a, a, a, max_disparity=8, fills=np.array([[16.0, 0.3]]))
     np.testing.assert_array_equal(
         arr.disparity, refine_disparity(a, a, a, max_disparity=8).disparity

@@ -220,13 +220,15 @@ def refine_disparity(
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:
-        # Numbers as every other parameter: float() took True and "16" and raised a bare
-        # OverflowError for 2**1100.
-        fills = [(_number(s, "sigma"), _number(m, "min_score")) for s, m in fills_raw]  # type: ignore[attr-defined]
+        pairs = [(s, m) for s, m in fills_raw]  # type: ignore[attr-defined]
     except (TypeError, ValueError) as exc:
         raise ValueError(
             f"fills must be a sequence of (sigma, min_score), got {fills_raw!r}"
         ) from exc
+    # Numbers as every other parameter: float() took True and "16" and raised a bare
+    # OverflowError for 2**1100. Named as the kernel names them: a pair's bad number was
+    # "fills must be a sequence of (sigma, min_score)" of a sequence of pairs, hiding why.
+    fills = [(_number(s, "fill sigma"), _number(m, "fill min_score")) for s, m in pairs]
     f = {k: _number(kw[k], k) for k in _FLOAT_KEYS}
     # The kernel's float32 reads an infinity, or a value past float32 (1e39), as inf: "invalid
     # parameter `base_sigma`: must be > 0, got inf" told the caller to give a larger value.
