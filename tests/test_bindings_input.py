@@ -1468,6 +1468,18 @@ def test_lzf_decompress_takes_any_bytes_like_data_and_names_other_data() -> None
         )
 
 
+def test_lzf_decompress_says_why_a_released_memoryview_is_not_read() -> None:
+    """A released memoryview was "expected a bytes-like object (bytes, bytearray, memoryview),
+    got memoryview": a memoryview refused as none. Python's own reason is said now."""
+    view = memoryview(bytearray(b"\x02abc"))
+    view.release()
+    with pytest.raises(ValueError) as err:
+        _core.lzf_decompress(view, 3)
+    assert str(err.value) == (
+        "invalid parameter `data`: operation forbidden on released memoryview object"
+    )
+
+
 @pytest.mark.parametrize("empty", ["left", "right"])
 def test_an_empty_8_bit_image_is_named(empty: str) -> None:
     """The 8-bit kernels said "image is empty: got 5x0 pixels" of an empty ``left`` or

@@ -1,6 +1,6 @@
 //! Binding of `stereovision_core::lzf`: bytes-like in, `bytes` out.
 
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyMemoryView};
 use stereovision_core::lzf::{check_expansion, lzf_decompress_into};
@@ -37,7 +37,14 @@ fn data_arg<'py>(ob: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyBytes>> {
     if let Ok(b) = ob.cast::<PyBytes>() {
         return Ok(b.clone());
     }
-    let view = PyMemoryView::from(ob).map_err(|_| {
+    let view = PyMemoryView::from(ob).map_err(|e| {
+        // A bytes-like object Python itself refuses to read (a released memoryview: "operation
+        // forbidden on released memoryview object") says why; it was "expected a bytes-like
+        // object (bytes, bytearray, memoryview), got memoryview".
+        let py = ob.py();
+        if !e.is_instance_of::<PyTypeError>(py) {
+            return PyValueError::new_err(format!("invalid parameter `data`: {}", e.value(py)));
+        }
         let got = ob
             .get_type()
             .name()
