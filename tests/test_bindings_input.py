@@ -1516,3 +1516,23 @@ def test_an_array_of_the_other_byte_order_is_said_to_be_one() -> None:
     with pytest.raises(TypeError) as err:
         _core.gabor_responses(a.astype(">f8"))
     assert str(err.value) == "img: expected a float32 array, got >f8"
+
+
+def test_an_array_updated_in_place_of_the_other_byte_order_is_said_to_be_kept() -> None:
+    """``temporal_running_mean`` updates ``mean`` in place: the byte-order advice
+    ("convert it with .astype(np.float32)") taken in the call updated that copy, and the
+    caller's mean kept its old values without a word. The advice says to keep the converted
+    array."""
+    frame = np.full((2, 3), 9, np.uint8)
+    mean = np.zeros((2, 3), ">f4")
+    count, diff = np.zeros((2, 3), np.uint8), np.zeros((2, 3), np.float32)
+    with pytest.raises(TypeError) as err:
+        _core.temporal_running_mean(frame, mean, count, diff, 1.0, 8)
+    assert str(err.value) == (
+        "mean: expected a float32 array, got >f4 (float32 in the other byte order: it is "
+        "updated in place, so convert the array you keep and pass that: mean = "
+        "mean.astype(np.float32))"
+    )
+    mean = mean.astype(np.float32)  # as said: the update reaches the caller's array
+    _core.temporal_running_mean(frame, mean, count, diff, 1.0, 8)
+    assert mean.max() > 0

@@ -71,6 +71,11 @@ pub fn array_arg_rw<'py, T: numpy::Element, D: Dimension>(
         }
         Err(e) => e,
     };
+    // float32 of the other byte order: describe_mismatch's advice, `.astype(np.float32)` in
+    // the call, had the kernel update that copy, the caller's array left as it was unsaid.
+    if let Some(e) = swapped_in_place::<T>(obj, name) {
+        return Err(e);
+    }
     // An array of the right type that cannot be written: read-only, or shared with another
     // argument ("The given array is not writeable" named no argument).
     Err(describe_mismatch::<T, D>(obj, name).unwrap_or_else(|| {
@@ -80,6 +85,24 @@ pub fn array_arg_rw<'py, T: numpy::Element, D: Dimension>(
             err.value(obj.py())
         ))
     }))
+}
+
+/// The `TypeError` for an array the kernel writes into that is `T` in the other byte order,
+/// saying to keep the converted array: a copy passed in the call is updated, not the array.
+fn swapped_in_place<T: numpy::Element>(obj: &Bound<'_, PyAny>, name: &str) -> Option<PyErr> {
+    let want = numpy::dtype::<T>(obj.py());
+    let got = obj.cast::<PyUntypedArray>().ok()?.dtype();
+    let swapped = !got.is_equiv_to(&want)
+        && got.is_native_byteorder() == Some(false)
+        && got.kind() == want.kind()
+        && got.itemsize() == want.itemsize();
+    swapped.then(|| {
+        PyTypeError::new_err(format!(
+            "{name}: expected a {want} array, got {got} ({want} in the other byte order: it is \
+             updated in place, so convert the array you keep and pass that: {name} = \
+             {name}.astype(np.{want}))"
+        ))
+    })
 }
 
 /// Whether the array's items are aligned and its strides whole items: what rust-numpy's views
