@@ -1487,6 +1487,22 @@ def test_a_yaml_dump_of_numpy_arrays_is_said(tmp_path: Path) -> None:
             read(rig)
 
 
+def test_a_flow_style_yaml_dump_of_numpy_arrays_is_said(tmp_path: Path) -> None:
+    """yaml.dump(fields, default_flow_style=True) of NumPy arrays ('{D1: !!python/object/...')
+    went to JSON alone: 'cannot parse rig.yaml as JSON: Expecting property name ...', the
+    Python objects unsaid (the block style's words looked for a field at a line's start)."""
+    import yaml
+
+    c = raw_calib()
+    fields = {k: getattr(c, k) for k in ("K1", "D1", "K2", "D2", "R", "T")}
+    fields.update(image_width=SIZE[0], image_height=SIZE[1], unit="m")
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(yaml.dump(fields, default_flow_style=True))
+    for read in (Calibration.from_file, Calibration.load):
+        with pytest.raises(ValueError, match=r"rig\.yaml holds Python objects .*\.tolist\(\)"):
+            read(rig)
+
+
 def test_a_flow_style_yaml_of_the_fields_is_read(tmp_path: Path) -> None:
     """yaml.safe_dump(fields, default_flow_style=True) writes '{D1: [...], K1: ...}', a plain
     YAML of the fields whose first '{' sent it to JSON: 'cannot parse rig.yaml as JSON:

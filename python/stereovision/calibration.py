@@ -1574,11 +1574,10 @@ class Calibration:
         try:
             doc = yaml.load(text, Loader=_yaml_loader())  # a SafeLoader
         except (yaml.YAMLError, ValueError, RecursionError):
-            if "!!python/" in text and any(
-                re.search(rf"^{k}\s*:", text, re.MULTILINE) for k in _CALIBRATION_FIELDS
-            ):
+            if "!!python/" in text:  # a field is a key: _PLAIN_YAML_KEY, in flow style too
                 # yaml.dump of the NumPy arrays, the first way a script writes them: it was
-                # "unrecognised calibration format" (safe_load constructs no Python object)
+                # "unrecognised calibration format" (safe_load constructs no Python object);
+                # in flow style ("{D1: !!python/...}") "cannot parse ... as JSON"
                 raise ValueError(
                     f"calibration file {source} holds Python objects (yaml.dump's !!python/ "
                     "tags: NumPy arrays), which are not loaded: write the arrays as lists "
