@@ -2606,6 +2606,20 @@ def test_from_q_reads_commas_and_brackets_and_names_what_is_no_number(tmp_path: 
         Calibration.from_q(tmp_path / "Q.dat", (10, 8))
 
 
+def test_a_q_dat_with_np_savetxt_header_is_read(tmp_path: Path) -> None:
+    """np.savetxt(path, Q, header=...) writes '# ...' lines, which np.loadtxt skips: from_q
+    said "not a Q matrix (16 numbers expected, got '#')", from_file 'unrecognised calibration
+    format'. A '#' starts a comment, to the end of its line."""
+    q = np.array([[1, 0, 0, -5], [0, 1, 0, -4], [0, 0, 0, 100], [0, 0, 10, 0]], dtype=float)
+    np.savetxt(tmp_path / "plain.dat", q)
+    want = Calibration.from_q(tmp_path / "plain.dat", (10, 8))
+    np.savetxt(tmp_path / "Q.dat", q, header="Q of cv2.stereoRectify\nrig 2", footer="end")
+    got = Calibration.from_q(tmp_path / "Q.dat", (10, 8))
+    assert (got.K1 == want.K1).all() and (got.T == want.T).all()
+    got = Calibration.from_file(tmp_path / "Q.dat", image_size=(10, 8))
+    assert (got.K1 == want.K1).all() and (got.T == want.T).all()
+
+
 def test_middlebury_calib_skips_comments(tmp_path: Path) -> None:
     """A calib.txt with a '# comment' line or a note after a value was refused: "calib.txt:1:
     expected key=value, got '# ...'"; the rest of a line from '#' on is skipped."""

@@ -1973,6 +1973,9 @@ class Calibration:
         scaled by ``Q[0,0]`` (ROS ``image_geometry``'s ``StereoCameraModel`` writes it times
         ``-f B``) is read as that matrix divided by ``Q[0,0]``.
 
+        White space, commas or semicolons part the numbers (brackets are dropped), and a
+        ``#`` starts a comment, to the end of its line (``np.savetxt``'s ``header``).
+
         Parameters
         ----------
         path : str or os.PathLike
@@ -2976,7 +2979,10 @@ def _yaml_loader() -> Any:
 def _q_tokens(text: str) -> list[str]:
     """The entries of a ``Q.dat``'s text: parted by white space, commas (``np.savetxt(...,
     delimiter=',')``) or semicolons, brackets dropped (a pasted ``print(Q)`` or
-    ``Q.tolist()``): those were "not a Q matrix (16 numbers expected)" without a reason."""
+    ``Q.tolist()``): those were "not a Q matrix (16 numbers expected)" without a reason. A
+    ``#`` starts a comment, to the end of its line (``np.savetxt``'s ``header=``, which
+    ``np.loadtxt`` skips, was "16 numbers expected, got '#'")."""
+    text = re.sub(r"#[^\r\n]*", "", text)
     return [t for t in re.split(r"[\s,;\[\]]+", text) if t]
 
 
