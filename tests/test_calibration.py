@@ -1446,6 +1446,19 @@ def test_a_file_pyyaml_fails_on_otherwise_than_yamlerror_is_unrecognised(tmp_pat
         Calibration.load(log)
 
 
+def test_a_file_with_a_bad_explicit_yaml_tag_is_unrecognised(tmp_path: Path) -> None:
+    """PyYAML refuses an explicit tag's bad value with bare Python errors: 'K1: !!bool maybe'
+    was KeyError: 'maybe', "!!float ''" IndexError, '!!timestamp x' AttributeError (the CLI's
+    'internal ... (please report this)'). It is unrecognised, as a date that is none."""
+    log = tmp_path / "log.txt"
+    for value in ("!!bool maybe", "!!float ''", "!!timestamp x"):
+        log.write_text(f"image_width: 640\nK1: {value}\n")
+        with pytest.raises(ValueError, match=r"^unrecognised calibration format in .*log\.txt"):
+            Calibration.from_file(log)
+        with pytest.raises(ValueError, match=r"^not a stereovision calibration file .*log\.txt"):
+            Calibration.load(log)
+
+
 def test_a_text_without_a_field_as_a_key_is_not_parsed_as_yaml(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

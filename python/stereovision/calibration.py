@@ -1573,7 +1573,7 @@ class Calibration:
 
         try:
             doc = yaml.load(text, Loader=_yaml_loader())  # a SafeLoader
-        except (yaml.YAMLError, ValueError, RecursionError):
+        except (yaml.YAMLError, ValueError, RecursionError, LookupError, AttributeError):
             if "!!python/" in text:  # a field is a key: _PLAIN_YAML_KEY, in flow style too
                 # yaml.dump of the NumPy arrays, the first way a script writes them: it was
                 # "unrecognised calibration format" (safe_load constructs no Python object);
@@ -1584,7 +1584,9 @@ class Calibration:
                     "(yaml.safe_dump({'K1': K1.tolist(), ...})), or use Calibration.save"
                 ) from None
             # not YAML: any file unrecognised so far comes here, and PyYAML raises more than
-            # YAMLError ("d: 2024-13-01" -> "month must be in 1..12", a deep nesting of "[")
+            # YAMLError ("d: 2024-13-01" -> "month must be in 1..12", a deep nesting of "[";
+            # an explicit tag's bad value: "!!bool x" KeyError, "!!float ''" IndexError,
+            # "!!timestamp x" AttributeError)
             return None
         if isinstance(doc, dict) and _REPORT_FIELDS <= set(doc):
             raise ValueError(_not_a_calibration_keys(list(doc), source))
