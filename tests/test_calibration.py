@@ -1558,6 +1558,23 @@ def test_load_of_one_ros_camera_info_says_what_it_is(tmp_path: Path) -> None:
         Calibration.load(left)
 
 
+def test_load_of_a_ros2_camera_info_echo_says_what_it_is(tmp_path: Path) -> None:
+    """load of a ROS 2 echo of one camera's camera_info (k, d, r, p: none of them a field) said
+    'not a stereovision calibration file (OpenCV YAML/XML or JSON)', where ROS 1's (its R a
+    field) is named as one camera's ROS camera_info. It is named alike."""
+    left = tmp_path / "left.yaml"
+    left.write_text(
+        "header:\n  frame_id: cam\nheight: 480\nwidth: 640\ndistortion_model: plumb_bob\n"
+        "d: [0.0, 0.0, 0.0, 0.0, 0.0]\nk: [500.0, 0.0, 320.0, 0.0, 500.0, 240.0, 0.0, 0.0, 1.0]\n"
+        "r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]\n"
+        "p: [500.0, 0.0, 320.0, 0.0, 0.0, 500.0, 240.0, 0.0, 0.0, 0.0, 1.0, 0.0]\n---\n"
+    )
+    with pytest.raises(
+        ValueError, match=r"left\.yaml is one camera's ROS camera_info: .*Calibration\.from_ros"
+    ):
+        Calibration.load(left)
+
+
 # ------------------------------------------------------ rectification geometry (mutation audit)
 
 

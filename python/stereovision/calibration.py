@@ -314,6 +314,16 @@ _REPORT_FIELDS = frozenset(("rms", "used_pairs", "rejected_pairs", "calibration"
 _MATLAB_FIELDS = ("CameraParameters1", "CameraParameters2", "RotationOfCamera2")
 
 
+def _one_ros_camera_info(source: str) -> str:
+    """What :meth:`Calibration.load` says of one camera's ROS ``camera_info`` (a file or a
+    message echo): a rig is two of them, read by other means."""
+    return (
+        f"{source} is one camera's ROS camera_info: a rig needs both cameras' files; "
+        "read them with Calibration.from_ros(left, right), or from_file on the folder "
+        "holding left.yaml and right.yaml"
+    )
+
+
 def _matlab_export(source: str, what: str = "MATLAB's stereoParameters") -> str:
     """How to bring MATLAB's stereo calibration here: its own convention (a transposed
     ``IntrinsicMatrix``, the second camera's pose) is not read, OpenCV's is."""
@@ -1557,6 +1567,10 @@ class Calibration:
         calib = cls._from_plain_yaml(text, str(p), unit)
         if calib is not None:
             return calib
+        if all(r.search(text) for r in _ROS_MESSAGE):
+            # a ROS 2 echo (k, d, r, p: none of the fields) was "not a stereovision calibration
+            # file", where ROS 1's (its R a field) is named
+            raise ValueError(_one_ros_camera_info(str(p)))
         raise ValueError(f"not a stereovision calibration file (OpenCV YAML/XML or JSON): {p}")
 
     @classmethod
@@ -1596,11 +1610,7 @@ class Calibration:
         if ros and not any(k in doc for k in ("K1", "M1", "K2", "M2")):
             # a ROS camera_info (load(left.yaml)): its image_width made it "lacks field 'K1'"
             # (a message's R: "lacks field 'image_width': ... cv2.stereoCalibrate's ...")
-            raise ValueError(
-                f"{source} is one camera's ROS camera_info: a rig needs both cameras' files; "
-                "read them with Calibration.from_ros(left, right), or from_file on the folder "
-                "holding left.yaml and right.yaml"
-            )
+            raise ValueError(_one_ros_camera_info(source))
         return cls._from_mapping(doc.get, source, unit)
 
     @classmethod
