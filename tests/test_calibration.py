@@ -1469,13 +1469,20 @@ def test_a_text_without_a_field_as_a_key_is_not_parsed_as_yaml(
     import yaml
 
     parsed: list[str] = []
-    real = yaml.safe_load
+    real, real_load = yaml.safe_load, yaml.load
 
     def safe_load(text: str) -> object:
         parsed.append(text)
         return real(text)
 
+    def load(text: str, Loader: type) -> object:
+        parsed.append(text)
+        return real_load(text, Loader=Loader)
+
+    # both: the plain YAML is read with yaml.load and a SafeLoader since 577db24e, and a spy
+    # on safe_load alone saw no parse with the check or without it
     monkeypatch.setattr(yaml, "safe_load", safe_load)
+    monkeypatch.setattr(yaml, "load", load)
     pts = tmp_path / "cloud.xyz"
     pts.write_text("0.1 0.2 0.3\n0.4 0.5 0.6\n")
     with pytest.raises(ValueError, match=r"^unrecognised calibration format in .*cloud\.xyz"):
