@@ -297,6 +297,7 @@ def test_load_errors(tmp_path: Path) -> None:
     ("field", "value", "message"),
     [
         ("image_width", 1e400, "image_width must be an integer"),
+        ("image_width", 10**400, r"image_width must be an integer, got an integer of 401 digits"),
         ("image_width", [640, 1], "image_width must be an integer"),
         ("image_height", 2.5, "image_height must be an integer"),
         ("rectified", [1], "rectified must be 0 or 1"),

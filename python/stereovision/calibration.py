@@ -44,6 +44,7 @@ from stereovision._validate import (
     renamed_keyword,
     same_aspect,
     text_shown,
+    too_large_for_float,
     user_stacklevel,
     xy_points,
 )
@@ -1403,9 +1404,13 @@ class Calibration:
 
         def integer(key: str) -> int:
             v = need(key)
-            ok = real_number(v)
+            # an int past a float (a width of 10**400, JSON's or YAML's) was a bare
+            # "OverflowError: int too large to convert to float"
+            ok = real_number(v) and too_large_for_float(v) is None
             if not ok or not math.isfinite(float(v)) or float(v) != int(v):
-                raise ValueError(f"calibration file {source}: {key} must be an integer, got {v!r}")
+                raise ValueError(
+                    f"calibration file {source}: {key} must be an integer, got {number_shown(v)}"
+                )
             return int(v)
 
         width = integer("image_width")
