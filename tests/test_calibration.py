@@ -1460,6 +1460,21 @@ def test_a_file_with_a_bad_explicit_yaml_tag_is_unrecognised(tmp_path: Path) -> 
             Calibration.load(log)
 
 
+def test_ros_and_kalibr_files_pyyaml_fails_on_otherwise_are_named(tmp_path: Path) -> None:
+    """The ROS camera_info and Kalibr readers caught YAMLError alone: a date that is none
+    ('stamp: 2024-13-01') was a bare 'month must be in 1..12' naming no file, 'x: !!bool y' a
+    KeyError. Both say the file cannot be parsed, as a YAML error."""
+    from stereovision.calibration import parse_ros_camera_info
+
+    for bad in ("stamp: 2024-13-01", "x: !!bool y"):
+        with pytest.raises(ValueError, match=r"^cannot parse left\.yaml as ROS camera_info YAML"):
+            parse_ros_camera_info(f"image_width: 640\n{bad}\n", "left.yaml")
+        chain = tmp_path / "camchain.yaml"
+        chain.write_text(f"cam0:\n  intrinsics: [1, 1, 1, 1]\n  {bad}\n")
+        with pytest.raises(ValueError, match=r"^cannot parse .*camchain\.yaml as Kalibr YAML"):
+            Calibration.from_file(chain)
+
+
 def test_a_text_without_a_field_as_a_key_is_not_parsed_as_yaml(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

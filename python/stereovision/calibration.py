@@ -2378,7 +2378,9 @@ class Calibration:
         p, text = cls._read_text(path)
         try:
             doc = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
+        except (yaml.YAMLError, ValueError, RecursionError, LookupError, AttributeError) as exc:
+            # not YAMLError alone: "2024-13-01" was a bare "month must be in 1..12", "!!bool x"
+            # a KeyError (as _from_plain_yaml catches)
             raise ValueError(f"cannot parse {p} as Kalibr YAML: {exc}") from None
         if not isinstance(doc, dict):
             raise ValueError(f"{p}: expected Kalibr's camchain mapping (cam0, cam1, ...)")
@@ -2853,6 +2855,10 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
         # a topic echo ends its message with "---" (and may print several): the first one,
         # the rest left unparsed (an echo stopped by Ctrl-C cut its last message mid-array)
         doc = next((d for d in yaml.safe_load_all(clean) if d is not None), None)
+    except (ValueError, RecursionError, LookupError, AttributeError) as exc:
+        # PyYAML raises more than YAMLError ("2024-13-01": "month must be in 1..12", no file
+        # named; "!!bool x": a bare KeyError), as _from_plain_yaml catches
+        raise ValueError(f"cannot parse {source} as ROS camera_info YAML: {exc}") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}: " if mark is not None else ""
