@@ -2912,3 +2912,22 @@ def test_load_scene_of_a_file_says_its_folder_is_the_scene(tmp_path: Path) -> No
     )
     with pytest.raises(FileNotFoundError, match=r"^scene directory not found: .*nothing$"):
         load_scene(tmp_path / "nothing")
+
+
+def test_a_scene_link_whose_target_moved_names_it(tmp_path: Path) -> None:
+    """A scene folder (or scene root) given as a link whose target moved (a dataset on a disk
+    since unmounted) was "scene directory not found: data" / "scene root not found: data", of
+    a name ls lists; the link's target is named, as eval's and bench's words name it; a
+    missing folder as before."""
+    link = tmp_path / "data"
+    link.symlink_to("moved/data")
+    gone = f"{link} (a link to moved/data, which does not exist)"
+    with pytest.raises(FileNotFoundError) as info:
+        load_scene(link)
+    assert str(info.value) == f"scene directory not found: {gone}"
+    with pytest.raises(FileNotFoundError) as info:
+        scan_scenes(link)
+    assert str(info.value) == f"scene root not found: {gone}"
+    with pytest.raises(FileNotFoundError) as info:
+        scan_scenes(tmp_path / "nothing")
+    assert str(info.value) == f"scene root not found: {tmp_path / 'nothing'}"

@@ -2106,7 +2106,10 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
             f"right.png ({d.parent}?)"
         )
     if not d.is_dir():
-        raise FileNotFoundError(f"scene directory not found: {d}")
+        # a link whose target moved (a dataset on a disk since unmounted) was "not found" alone,
+        # of a name ls lists: its target is named, as eval's and the file readers' words name it
+        gone = f" ({_broken_link(d)})" if d.is_symlink() and not d.exists() else ""
+        raise FileNotFoundError(f"scene directory not found: {d}{gone}")
     if not any(os.path.lexists(d / n) for n in ("left.png", "right.png")) and all(
         (d / n).is_file() for n in ("im0.png", "im1.png")
     ):
@@ -2283,7 +2286,9 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     """
     r = as_path(root, "root")
     if not r.is_dir():
-        raise FileNotFoundError(f"scene root not found: {r}")
+        # a link whose target moved: its target named, as load_scene's words name it
+        gone = f" ({_broken_link(r)})" if r.is_symlink() and not r.exists() else ""
+        raise FileNotFoundError(f"scene root not found: {r}{gone}")
     # Links followed: Path.rglob does not enter a link to a folder, so scenes linked into a
     # folder were not found. As batch's walk, a link to a folder inside the root (or holding
     # it: a loop), or to one entered already, is an alias, not entered: `latest -> run3` listed
