@@ -5258,3 +5258,19 @@ def test_cli_capture_says_its_sources_in_a_sentence_and_a_folder_with_a_newline_
     assert capsys.readouterr().err.splitlines() == [
         "stereovision: interrupted: 0 pairs saved in a\\nb this run are kept; run again to add more"
     ]
+
+
+def test_a_source_link_whose_target_moved_names_it(tmp_path: Path) -> None:
+    """A video given as a link whose target moved (a recording on a disk since unmounted) was
+    "left source not found: v.mp4", of a name ls lists; the link's target is named, as io's
+    readers name it; a missing file as before."""
+    link = tmp_path / "v.mp4"
+    link.symlink_to("moved/v.mp4")
+    with pytest.raises(FileNotFoundError) as info:
+        StereoCamera(link, link)
+    assert str(info.value) == (
+        f"left source not found: {link} (a link to moved/v.mp4, which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as info:
+        StereoCamera(tmp_path / "none.mp4", link)
+    assert str(info.value) == f"left source not found: {tmp_path / 'none.mp4'}"

@@ -75,7 +75,7 @@ from stereovision.calibrate import (
     parse_pattern,
 )
 from stereovision.charuco import CharucoBoard
-from stereovision.io import _opencv_quiet, check_output_folder, make_folder
+from stereovision.io import _broken_link, _opencv_quiet, check_output_folder, make_folder
 
 __all__ = [
     "MIN_POSE_DISTANCE",
@@ -1724,7 +1724,10 @@ class StereoCamera(PairSource):
             if "%" not in path and "://" not in path and not os.path.exists(path):
                 if re.search(r"[*?[]", path):  # "not found" said nothing of the pattern
                     raise FileNotFoundError(_glob_hint(side, path))
-                raise FileNotFoundError(f"{side} source not found: {path}")
+                # a link whose target moved (a recording on a disk since unmounted) was "not
+                # found" alone, of a name ls lists: its target is named, as io's readers name it
+                gone = f" ({_broken_link(Path(path))})" if os.path.islink(path) else ""
+                raise FileNotFoundError(f"{side} source not found: {path}{gone}")
             if os.path.isdir(path):  # "cannot open" said nothing of what to give instead
                 raise SourceError(_folder_hint(side, path), side=side, end=False)
             # looked for once: each look at a late start lists the whole folder (0.2 s for
