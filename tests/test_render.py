@@ -2411,3 +2411,19 @@ def test_point_cloud_names_points_beyond_float32s_range():
         "(not shown)"
     ]
     np.testing.assert_array_equal(cloud.points, pts[[0, 3]])
+
+
+def test_view_names_a_link_whose_target_moved(tmp_path: Path) -> None:
+    """``view data`` of a link whose target moved (an output folder on a disk since unmounted)
+    was "no such file or folder: data", of a name ls lists; the link's target is named, as
+    io's readers name it; a missing path as before."""
+    link = tmp_path / "data"
+    link.symlink_to("moved/data")
+    with pytest.raises(FileNotFoundError) as info:
+        render.load_view_source(link)
+    assert str(info.value) == (
+        f"no such file or folder: {link} (a link to moved/data, which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as info:
+        render.load_view_source(tmp_path / "nothing")
+    assert str(info.value) == f"no such file or folder: {tmp_path / 'nothing'}"

@@ -1544,7 +1544,11 @@ def load_view_source(
 
     p = Path(path)
     if not p.exists():
-        raise FileNotFoundError(f"no such file or folder: {p}")
+        from stereovision.io import _broken_link
+
+        # a link whose target moved was "no such file or folder" of a name ls lists
+        gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+        raise FileNotFoundError(f"no such file or folder: {p}{gone}")
     if p.is_dir():
         if (p / "cloud.ply").is_file():
             p = p / "cloud.ply"
