@@ -569,6 +569,24 @@ def test_a_bag_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     assert str(err.value) == f"bag not found: {tmp_path / 'missing.bag'}"
 
 
+def test_bag_topics_of_a_missing_bag_says_not_found(tmp_path: Path) -> None:
+    """bag_topics of a missing bag was a ValueError in rosbags' words: "missing.bag is not a
+    readable ROS 1 or ROS 2 bag: The following paths are missing: [PosixPath(...)]", and of
+    a link whose target moved said nothing of it; both are BagCamera's FileNotFoundError."""
+    from stereovision.rosbag import bag_topics
+
+    (tmp_path / "run.bag").symlink_to(tmp_path / "moved" / "run.bag")
+    with pytest.raises(FileNotFoundError) as err:
+        bag_topics(tmp_path / "run.bag")
+    assert str(err.value) == (
+        f"bag not found: {tmp_path / 'run.bag'} (a link to {tmp_path / 'moved' / 'run.bag'}, "
+        "which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as err:
+        bag_topics(tmp_path / "missing.bag")
+    assert str(err.value) == f"bag not found: {tmp_path / 'missing.bag'}"
+
+
 # ------------------------------------------------------------------------------------ CLI
 
 

@@ -993,12 +993,21 @@ def bag_topics(path: str | os.PathLike[str]) -> str:
 
     Raises
     ------
+    FileNotFoundError
+        If ``path`` does not exist (a link whose target moved named so).
     ValueError
         If ``path`` is not a readable bag.
     ImportError
         Without the ``rosbags`` package.
     """
     p = _bag_path(path)
+    if not p.exists():
+        # as BagCamera says it: a missing bag was "not a readable ROS 1 or ROS 2 bag: The
+        # following paths are missing: [PosixPath('run.bag')]", a ValueError
+        from stereovision.io import _broken_link
+
+        gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+        raise FileNotFoundError(f"bag not found: {p}{gone}")
     if p.is_file() and (p.parent / "metadata.yaml").is_file():
         p = p.parent  # a file of a ROS 2 bag, as BagCamera takes it
     try:
