@@ -2426,3 +2426,29 @@ def test_occupancy_grid_save_names_a_null_byte(tmp_path: Path) -> None:
     ):
         grid.save(tmp_path / "x\x00y")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("disparity_plane", (math.nan, 0.0, 0.0),
+         "disparity_plane: expected 3 finite numbers (a, b, c), got (nan, 0.0, 0.0)"),
+        ("rms_px", math.inf, "rms_px: expected a finite number, got inf"),
+        ("inlier_share", math.nan, "inlier_share: expected a finite number, got nan"),
+        ("below_share", -math.inf, "below_share: expected a finite number, got -inf"),
+    ],
+)  # fmt: skip
+def test_a_hand_made_plane_of_figures_not_finite_is_refused(
+    field: str, value: object, says: str
+) -> None:
+    """As a height of inf or NaN (7486b0c3): a NaN disparity_plane built a plane whose
+    support was 0 on any map ("the camera moved"), and each of these went to as_dict as NaN
+    or Infinity (json.dumps(allow_nan=False): "Out of range float values are not JSON
+    compliant"). Each is refused naming the field."""
+    fields = {
+        "normal": [0.0, -1.0, 0.0], "height": 1.0, "disparity_plane": (0.0, 0.1, -5.0),
+        "inliers": np.zeros((2, 2), bool), "inlier_share": 0.5, "rms_px": 0.1,
+    }  # fmt: skip
+    with pytest.raises(ValueError) as exc:
+        GroundPlane(**{**fields, field: value})
+    assert str(exc.value) == says

@@ -202,6 +202,11 @@ class GroundPlane:
         # obstacle marked, 'camera inf m above it', as_dict's Infinity not JSON)
         if not math.isfinite(_number(self.height, "height")):
             raise ValueError(f"height: expected a finite number of metres, got {self.height!r}")
+        # the fit's figures alike: a NaN or infinite one built, and went to as_dict as NaN or
+        # Infinity (not JSON); a fitted plane's are finite
+        for name in ("inlier_share", "rms_px", "below_share"):
+            if not math.isfinite(_number(getattr(self, name), name)):
+                raise ValueError(f"{name}: expected a finite number, got {getattr(self, name)!r}")
         try:
             coef = _real_array(self.disparity_plane)
         except ValueError:  # ragged
@@ -209,6 +214,12 @@ class GroundPlane:
         if coef is None or coef.dtype.kind == "b" or coef.shape != (3,):
             raise ValueError(
                 "disparity_plane: expected 3 numbers (a, b, c), got "
+                + reprlib.repr(self.disparity_plane)
+            )
+        if not np.isfinite(coef).all():
+            # a NaN coefficient held no pixel on the plane: support 0, "the camera moved"
+            raise ValueError(
+                "disparity_plane: expected 3 finite numbers (a, b, c), got "
                 + reprlib.repr(self.disparity_plane)
             )
         # None (no mask at hand: a plane rebuilt from ground.json) built, then repr and support
