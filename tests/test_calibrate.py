@@ -2886,3 +2886,24 @@ def test_whole_number_floats_are_a_pattern_and_a_charuco_boards_squares() -> Non
         parse_pattern((9, 6.5))  # type: ignore[arg-type]
     with pytest.raises(ValueError, match=r"^squares: expected a ChArUco board's squares"):
         CharucoBoard((10.5, 7), 0.03, 0.02)  # type: ignore[arg-type]
+
+
+def test_calibrate_names_an_input_link_whose_target_moved(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``calibrate --left data`` of a link whose target moved (a folder of board images on a
+    disk since unmounted) said "--left: file not found: data", of a name ls lists; the link's
+    target is named, as io's readers name it; a missing path as before."""
+    from stereovision import cli
+
+    link = tmp_path / "data"
+    link.symlink_to("moved/data")
+    out = str(tmp_path / "c.yaml")
+    for given, said in (
+        (link, f"{link} (a link to moved/data, which does not exist)"),
+        (tmp_path / "none", f"{tmp_path / 'none'}"),
+    ):
+        argv = ["calibrate", "--left", str(given), "--right", str(given), "--square", "0.02"]
+        assert cli.main([*argv, "-o", out]) == 2
+        assert capsys.readouterr().err == f"stereovision: error: --left: file not found: {said}\n"
+    assert not Path(out).exists()

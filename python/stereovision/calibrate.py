@@ -2787,7 +2787,12 @@ def _expand(pattern: str, option: str) -> list[str]:
         return files
     p = os.path.expanduser(pattern)
     if not os.path.exists(p):  # a stream's password is not said
-        raise FileNotFoundError(f"{option}: file not found: {mask_url_secrets(pattern)}")
+        from stereovision.io import _broken_link
+
+        # a link whose target moved (a folder of board images on a disk since unmounted) was
+        # "not found" alone, of a name ls lists: its target is named, as io's readers name it
+        gone = f" ({_broken_link(Path(p))})" if os.path.islink(p) else ""
+        raise FileNotFoundError(f"{option}: file not found: {mask_url_secrets(pattern)}{gone}")
     if os.path.isdir(p):
         example = os.path.join(pattern, "*.png")
         raise ValueError(
