@@ -2931,3 +2931,21 @@ def test_a_scene_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError) as info:
         scan_scenes(tmp_path / "nothing")
     assert str(info.value) == f"scene root not found: {tmp_path / 'nothing'}"
+
+
+def test_a_link_target_holding_a_newline_is_escaped(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A link whose target moved and holds a newline (data -> 'moved\\nx') was said with it
+    raw: the CLI's one-line error was cut there ("image file not found: data (a link to
+    moved"), the rest lost. The target is escaped as paths are ('moved\\\\nx')."""
+    from stereovision import cli
+
+    link = tmp_path / "data"
+    link.symlink_to("moved\nx")
+    said = f"image file not found: {link} (a link to moved\\nx, which does not exist)"
+    with pytest.raises(FileNotFoundError) as info:
+        read_image(link)
+    assert str(info.value) == said
+    assert cli.main(["depth", str(link), str(link), "-o", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {said}\n"

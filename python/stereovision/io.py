@@ -918,7 +918,9 @@ def _broken_link(link: Path) -> str:
     does not exist, or it is one of a loop of links. ``exists()`` is False for both (ELOOP);
     "which does not exist" of a loop's target, which is there, sent the user looking for a
     moved file."""
-    target = os.readlink(link)
+    # escaped: a target holding a newline cut the CLI's one-line error there ("... (a link to
+    # moved"), the rest of it lost
+    target = escaped(os.readlink(link))
     try:
         os.stat(link)
     except OSError as exc:
