@@ -2422,7 +2422,7 @@ def test_occupancy_grid_save_names_a_null_byte(tmp_path: Path) -> None:
         grid.save(tmp_path, "a\x00b")
     with pytest.raises(
         ValueError,
-        match=r"^directory: expected a folder name without a null byte, got '.*x\\x00y'$",
+        match=r"^directory: expected a path without a null byte, got '.*x\\x00y'$",
     ):
         grid.save(tmp_path / "x\x00y")
     assert list(tmp_path.iterdir()) == []

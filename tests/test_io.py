@@ -2949,3 +2949,23 @@ def test_a_link_target_holding_a_newline_is_escaped(
     assert str(info.value) == said
     assert cli.main(["depth", str(link), str(link), "-o", str(tmp_path / "o")]) == 2
     assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+
+
+def test_a_path_holding_a_null_byte_is_refused_in_the_arguments_name(tmp_path: Path) -> None:
+    """10c9107a named a null byte in OccupancyGrid.save's arguments only: write_pfm,
+    Matches.save_csv, read_pfm (every as_path caller) still raised the OS's bare "ValueError:
+    embedded null byte" (a read: "PFM file not found" of a garbled name). as_path refuses it
+    in the argument's name, and nothing is written."""
+    from stereovision.io import read_pfm, write_pfm
+    from stereovision.matches import Matches
+
+    bad = str(tmp_path / "a\x00b.pfm")
+    said = r"^path: expected a path without a null byte, got '.*a\\x00b\.pfm'$"
+    with pytest.raises(ValueError, match=said):
+        write_pfm(bad, np.ones((2, 3), np.float32))
+    with pytest.raises(ValueError, match=said):
+        read_pfm(bad)
+    z = np.zeros(2, np.float32)
+    with pytest.raises(ValueError, match=said.replace("pfm", "csv")):
+        Matches(z, z, z, z, z, (8, 10)).save_csv(bad[:-3] + "csv")
+    assert list(tmp_path.iterdir()) == []

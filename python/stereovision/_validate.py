@@ -119,7 +119,7 @@ def as_path(path: object, name: str = "path", *, file: bool = False) -> Path:
     TypeError
         If ``path`` is bytes (the library's paths are str or os.PathLike) or no name at all.
     ValueError
-        If ``file`` and ``path`` is empty.
+        If ``file`` and ``path`` is empty, or ``path`` holds a null byte.
     """
     if isinstance(path, bytes):
         said = path_given(path)
@@ -135,6 +135,8 @@ def as_path(path: object, name: str = "path", *, file: bool = False) -> Path:
                 # Path("") is Path("."): a write said "cannot write .: it is a folder", a read
                 # "not a regular file: ."
                 raise ValueError(f"{name}: expected a file name, got ''")
+            if "\x00" in fs:  # the OS's bare "embedded null byte" named no argument
+                raise ValueError(f"{name}: expected a path without a null byte, got {fs!r}")
             return Path(fs)
     raise TypeError(f"{name}: expected a str or os.PathLike file name, got {type(path).__name__}")
 

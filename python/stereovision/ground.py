@@ -1101,11 +1101,7 @@ class OccupancyGrid:
         from stereovision._validate import as_path
 
         # Path(str(...)): b"/tmp/maps" wrote into a folder named "b'", None into "None"
-        d = as_path(directory, "directory")
-        if "\x00" in str(d):
-            raise ValueError(
-                f"directory: expected a folder name without a null byte, got {str(d)!r}"
-            )
+        d = as_path(directory, "directory")  # a null byte too, in the argument's name
         if d.exists() and not d.is_dir():  # mkdir's "[Errno 17] File exists: 'maps'"
             raise FileExistsError(f"cannot write the map into {d}: it is a file, not a folder")
         from stereovision.io import make_folder
