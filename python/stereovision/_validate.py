@@ -1734,6 +1734,26 @@ HELD_WARNINGS: contextvars.ContextVar[list[tuple[str, type[Warning]]] | None] = 
 )
 
 
+def points_as_float32(raw: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """``raw`` (N, 3) points cast to float32, and how many became inf in the cast (a finite
+    coordinate beyond float32's range, ``1e39``), with an example, or None.
+
+    The cast itself is silent (NumPy's "overflow encountered in cast" named nothing); the
+    caller says the words (``read_ply``'s file, ``point_cloud``'s points)."""
+    with np.errstate(over="ignore"):
+        pts = np.asarray(raw, dtype=np.float32)
+    if raw.dtype.kind == "f" and raw.dtype.itemsize > 4:
+        with np.errstate(invalid="ignore"):
+            lost = np.isfinite(raw) & ~np.isfinite(pts)
+        if lost.any():
+            n = int(lost.any(axis=-1).sum()) if lost.ndim > 1 else int(lost.sum())
+            return pts, (
+                f"{n} point(s) with a coordinate beyond float32's range "
+                f"(e.g. {float(raw[lost][0])!r})"
+            )
+    return pts, None
+
+
 def source_warning(message: str, category: type[Warning] = UserWarning) -> None:
     """Warn at the first line outside the package (:func:`user_stacklevel`), or, in a thread
     reading a source for the caller (:data:`HELD_WARNINGS` set), hold the warning for the

@@ -1757,18 +1757,11 @@ def _float32_coordinates(xyz: npt.NDArray[Any], path: Path, kind: str) -> npt.ND
     as before; it is said in one warning naming the file (``read_ply``'s and
     ``export.read_pcd``'s), where NumPy's "overflow encountered in cast" named nothing.
     """
-    with np.errstate(over="ignore"):
-        pts = xyz.astype(np.float32, copy=False)
-    if xyz.dtype.kind == "f" and xyz.dtype.itemsize > 4:
-        with np.errstate(invalid="ignore"):
-            lost = np.isfinite(xyz) & ~np.isfinite(pts)
-        if lost.any():
-            from stereovision._validate import source_warning
+    from stereovision._validate import points_as_float32, source_warning
 
-            source_warning(
-                f"{kind} file {path}: {int(lost.any(axis=1).sum())} point(s) with a coordinate "
-                f"beyond float32's range (e.g. {float(xyz[lost][0])!r}) read as inf (no point)"
-            )
+    pts, lost = points_as_float32(xyz)
+    if lost is not None:
+        source_warning(f"{kind} file {path}: {lost} read as inf (no point)")
     return pts
 
 

@@ -927,21 +927,13 @@ def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> p
         they become inf in the cast and are dropped.
     """
     pv = _pv()
-    raw = np.asarray(points)
-    with np.errstate(over="ignore"):  # NumPy's "overflow encountered in cast" named nothing
-        pts = np.asarray(raw, dtype=np.float32)
+    from stereovision._validate import points_as_float32, source_warning
+
+    pts, lost = points_as_float32(np.asarray(points))
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
-    if raw.dtype.kind == "f" and raw.dtype.itemsize > 4:
-        with np.errstate(invalid="ignore"):
-            lost = np.isfinite(raw) & ~np.isfinite(pts)
-        if lost.any():
-            from stereovision._validate import source_warning
-
-            source_warning(
-                f"points: {int(lost.any(axis=1).sum())} point(s) with a coordinate beyond "
-                f"float32's range (e.g. {float(raw[lost][0])!r}) dropped (not shown)"
-            )
+    if lost is not None:
+        source_warning(f"points: {lost} dropped (not shown)")
     keep = np.isfinite(pts).all(axis=1)
     if not keep.any():
         raise ValueError("empty point cloud: no finite 3-D point to show")
