@@ -1598,6 +1598,23 @@ def test_load_of_a_ros2_camera_info_echo_says_what_it_is(tmp_path: Path) -> None
         Calibration.load(left)
 
 
+def test_load_of_a_flow_style_ros2_camera_info_echo_says_what_it_is(tmp_path: Path) -> None:
+    """load of a ROS 2 echo in flow style (ros2 topic echo --flow-style: "{header: ..., width:
+    640, ...}") said 'cannot parse left.yaml as JSON: Expecting property name enclosed in double
+    quotes', where its block style is named as one camera's ROS camera_info. It is named alike."""
+    left = tmp_path / "left.yaml"
+    left.write_text(
+        "{header: {frame_id: cam}, height: 480, width: 640, distortion_model: plumb_bob, "
+        "d: [0.0, 0.0, 0.0, 0.0, 0.0], k: [500.0, 0.0, 320.0, 0.0, 500.0, 240.0, 0.0, 0.0, 1.0], "
+        "r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], "
+        "p: [500.0, 0.0, 320.0, 0.0, 0.0, 500.0, 240.0, 0.0, 0.0, 0.0, 1.0, 0.0]}\n---\n"
+    )
+    with pytest.raises(
+        ValueError, match=r"left\.yaml is one camera's ROS camera_info: .*Calibration\.from_ros"
+    ):
+        Calibration.load(left)
+
+
 # ------------------------------------------------------ rectification geometry (mutation audit)
 
 

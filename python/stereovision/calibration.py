@@ -1568,6 +1568,10 @@ class Calibration:
                 calib = cls._from_plain_yaml(text, str(p), unit)
                 if calib is not None:
                     return calib
+                if all(r.search(text) for r in _ROS_MESSAGE):
+                    # a ROS 2 echo in flow style (ros2 topic echo --flow-style, "{header: ...,
+                    # width: 640, ...}") was "cannot parse ... as JSON: Expecting property name"
+                    raise ValueError(_one_ros_camera_info(str(p))) from None
             return cls._from_json_text(text, str(p), unit)
         calib = cls._from_plain_yaml(text, str(p), unit)
         if calib is not None:
