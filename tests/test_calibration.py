@@ -318,6 +318,22 @@ def test_damaged_json_fields_are_named(
         Calibration.load(tmp_path / "e.json")
 
 
+def test_a_matrix_entry_past_a_float_is_named(tmp_path: Path) -> None:
+    """An int past a float in a matrix (a K1 entry of 10**400, a damaged file) was a bare
+    'OverflowError: int too large to convert to float' from load (and the constructor),
+    where image_width's (7c64ac6d) is named. It is named by its matrix and file."""
+    rec = json.loads(raw_calib().save(tmp_path / "c.json").read_text())
+    rec["K1"][0][2] = 10**400
+    (tmp_path / "e.json").write_text(json.dumps(rec))
+    with pytest.raises(
+        ValueError,
+        match=r"e\.json: K1: contains an integer of 401 digits \(too large for a float\)",
+    ):
+        Calibration.load(tmp_path / "e.json")
+    with pytest.raises(ValueError, match=r"^T: contains a negative integer of 401 digits"):
+        dataclasses.replace(raw_calib(), T=[-(10**400), 0, 0])
+
+
 def test_damaged_opencv_yaml_is_a_value_error_naming_the_problem(tmp_path: Path) -> None:
     """OpenCV's parser raises cv2.error (or a SystemError around it) on a damaged file: each
     reaches the user as a ValueError with the file, the field and OpenCV's reason (it was an

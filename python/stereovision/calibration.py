@@ -95,6 +95,11 @@ def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...
         arr = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{name}: expected a real array, got {type(value).__name__}") from None
+    except OverflowError:
+        # an int past a float (a K1 entry of 10**400 in a damaged JSON file) was a bare
+        # "OverflowError: int too large to convert to float" naming no matrix (7c64ac6d named
+        # image_width's only)
+        raise ValueError(f"{name}: contains {_too_large_entry(value)}") from None
     for shape in shapes:
         if arr.shape == shape:
             break
@@ -110,6 +115,16 @@ def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...
         raise ValueError(f"{name}: contains NaN or inf: {arr.tolist()}")
     arr.setflags(write=False)
     return arr
+
+
+def _too_large_entry(value: object) -> str:
+    """What a message says of the first int past a float's range in ``value`` (nested
+    lists): ``too_large_for_float``'s words."""
+    try:
+        flat = np.array(value, dtype=object).ravel().tolist()
+    except ValueError:  # ragged
+        flat = []
+    return next(filter(None, map(too_large_for_float, flat)), "an integer too large for a float")
 
 
 #: The plausible stereo baseline (metres), the one range every baseline message uses: a
