@@ -1491,6 +1491,34 @@ def test_ros_and_kalibr_files_pyyaml_fails_on_otherwise_are_named(tmp_path: Path
             Calibration.from_file(chain)
 
 
+def test_ros_and_kalibr_matrix_entries_past_a_float_are_named(tmp_path: Path) -> None:
+    """An int past a float in a ROS camera_info matrix or a Kalibr intrinsics list (10**400, a
+    damaged file) was a bare 'OverflowError: int too large to convert to float' naming no file.
+    Both name the file and the field."""
+    big = "1" + "0" * 400
+    ros = (
+        "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
+        "  data: [{}, 0, 320, 0, 500, 240, 0, 0, 1]\ndistortion_model: plumb_bob\n"
+        "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n"
+        "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+        "projection_matrix:\n  rows: 3\n  cols: 4\n"
+        "  data: [500, 0, 320, 0, 0, 500, 240, 0, 0, 0, 1, 0]\n"
+    )
+    (tmp_path / "left.yaml").write_text(ros.format(big))
+    (tmp_path / "right.yaml").write_text(ros.format(500))
+    with pytest.raises(
+        ValueError, match=r"left\.yaml: camera_matrix holds an integer of 401 digits \(too large"
+    ):
+        Calibration.from_file(tmp_path)
+    chain = tmp_path / "camchain.yaml"
+    cam = "  intrinsics: [{}, 500, 320, 240]\n  resolution: [640, 480]\n"
+    chain.write_text("cam0:\n" + cam.format(big) + "cam1:\n" + cam.format(500))
+    with pytest.raises(
+        ValueError, match=r"camchain\.yaml:cam0: intrinsics needs 4 finite numbers, got an integer"
+    ):
+        Calibration.from_file(chain)
+
+
 def test_a_text_without_a_field_as_a_key_is_not_parsed_as_yaml(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -2811,6 +2811,8 @@ def _ros_matrix(value: object, key: str, source: str, size: int | None) -> F64:
         arr = np.array([float(v) for v in value], dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{source}: {key} holds a value that is not a number") from None
+    except OverflowError:  # 10**400: a bare "int too large to convert to float", no file named
+        raise ValueError(f"{source}: {key} holds {_too_large_entry(value)}") from None
     if rows is not None and cols is not None:
         # cols: 0 with no data is what ROS writes for a camera without distortion (1 x 0)
         counts = all(
@@ -3228,6 +3230,10 @@ def _kalibr_numbers(value: object, key: str, source: str, size: int) -> F64:
         arr = np.array(value, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError):
         raise ValueError(f"{source}: {key} is not a list of numbers") from None
+    except OverflowError:  # 10**400: a bare "int too large to convert to float", no file named
+        raise ValueError(
+            f"{source}: {key} needs {size} finite numbers, got {_too_large_entry(value)}"
+        ) from None
     if arr.size != size or not np.all(np.isfinite(arr)):
         raise ValueError(f"{source}: {key} needs {size} finite numbers, got {value!r}")
     return arr
