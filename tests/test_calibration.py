@@ -334,6 +334,19 @@ def test_a_matrix_entry_past_a_float_is_named(tmp_path: Path) -> None:
         dataclasses.replace(raw_calib(), T=[-(10**400), 0, 0])
 
 
+def test_an_image_size_past_opencvs_int_is_refused(tmp_path: Path) -> None:
+    """image_size (2**70, 480) (or a damaged file's image_width of 2**70) was taken, and failed
+    later in OpenCV's words ("stereoRectify ... Can't parse 'imageSize'"). It is refused."""
+    with pytest.raises(ValueError, match=r"^image_size: at most 2147483647 px per side"):
+        dataclasses.replace(raw_calib(), image_size=(2**70, 480))
+    rec = json.loads(raw_calib().save(tmp_path / "c.json").read_text())
+    rec["image_width"] = 2**70
+    (tmp_path / "e.json").write_text(json.dumps(rec))
+    with pytest.raises(ValueError, match=r"e\.json: image_size: at most 2147483647 px per side"):
+        Calibration.load(tmp_path / "e.json")
+    assert dataclasses.replace(raw_calib(), image_size=(2**31 - 1, 480)).image_size[0] == 2**31 - 1
+
+
 def test_damaged_opencv_yaml_is_a_value_error_naming_the_problem(tmp_path: Path) -> None:
     """OpenCV's parser raises cv2.error (or a SystemError around it) on a damaged file: each
     reaches the user as a ValueError with the file, the field and OpenCV's reason (it was an

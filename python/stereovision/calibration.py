@@ -32,6 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    MAX_SIDE,
     NOT_NUMBERS,
     as_image_array,
     as_path,
@@ -590,6 +591,13 @@ class Calibration:
             if not isinstance(v, (int, np.integer)) or isinstance(v, NOT_NUMBERS) or v <= 0:
                 raise ValueError(
                     f"image_size: expected positive integers (width, height), got {size!r}"
+                )
+            if v > MAX_SIDE:
+                # (2**70, 480) or a damaged file's 10**400 was taken, and failed later in
+                # OpenCV's words ("stereoRectify ... Can't parse 'imageSize'")
+                raise ValueError(
+                    f"image_size: at most {MAX_SIDE} px per side (OpenCV's int), got "
+                    f"{number_shown(v)}"
                 )
             out.append(int(v))
         return out[0], out[1]
