@@ -1411,3 +1411,21 @@ def test_a_loop_of_links_in_a_data_folder_is_no_file_and_stops_nothing(tmp_path:
         folders.resolve("loop/x.png")
     assert not folders.contains("loop")
     assert folders.resolve_output("loop/x") == tmp_path.resolve() / "loop" / "x"
+
+
+def test_a_data_folder_or_video_link_whose_target_moved_names_it(tmp_path: Path) -> None:
+    # --data data -> moved/data (a disk since unmounted), VideoPair("v.avi") -> moved/v.avi:
+    # "not found" alone, of a name ls lists, where load_scene and StereoCamera name the target
+    (tmp_path / "data").symlink_to(Path("moved") / "data")
+    (tmp_path / "v.avi").symlink_to(Path("moved") / "v.avi")
+    with pytest.raises(FileNotFoundError) as err:
+        AllowedFolders([tmp_path / "data"])
+    assert str(err.value) == (
+        f"data folder not found: {tmp_path / 'data'} (a link to moved/data, which does not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as err:
+        VideoPair(str(tmp_path / "v.avi"), str(tmp_path / "v.avi"))
+    assert str(err.value) == (
+        f"left camera source not found: {tmp_path / 'v.avi'} (a link to moved/v.avi, which "
+        "does not exist)"
+    )

@@ -196,6 +196,12 @@ class AllowedFolders:
             p = expand_home(text)
             if not p.is_dir():  # a file that is there was said only as "not found"
                 there = " is a file, not a folder" if p.exists() else ""
+                if not there and p.is_symlink():
+                    from stereovision.io import _broken_link
+
+                    # a link whose target moved (a dataset on a disk since unmounted) was "not
+                    # found" alone, of a name ls lists: its target named, as load_scene's is
+                    there = f" ({_broken_link(p)})"
                 raise FileNotFoundError(f"data folder not found: {r}{there}")
             rp = p.resolve()
             if rp not in resolved:
@@ -466,8 +472,13 @@ class VideoPair:
                 device = not isinstance(src, str) or _camera_device(src) is not None
                 is_file = _is_file(src)
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
+                    from stereovision.io import _broken_link
+
+                    # a link whose target moved: its target named, as StereoCamera names it
+                    link = Path(str(src))
+                    gone = f" ({_broken_link(link)})" if link.is_symlink() else ""
                     raise FileNotFoundError(
-                        f"{side} camera source not found: {mask_url_secrets(str(src))}"
+                        f"{side} camera source not found: {mask_url_secrets(str(src))}{gone}"
                     )
                 # bounded, the size asked with it: a wedged device hung its open, or a set,
                 # forever (OpenCV's log of the open stays quiet: the error below says what failed)
