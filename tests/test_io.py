@@ -2951,6 +2951,25 @@ def test_a_link_target_holding_a_newline_is_escaped(
     assert capsys.readouterr().err == f"stereovision: error: {said}\n"
 
 
+def test_a_link_to_a_link_whose_target_moved_names_each_link(tmp_path: Path) -> None:
+    """data -> current -> moved/data (a disk since unmounted) was "a link to current, which
+    does not exist", of a name ls lists: each link is named, to the missing one."""
+    (tmp_path / "current").symlink_to(Path("moved") / "data")
+    link = tmp_path / "data"
+    link.symlink_to("current")
+    with pytest.raises(FileNotFoundError) as info:
+        read_image(link)
+    assert str(info.value) == (
+        f"image file not found: {link} (a link to current, a link to moved/data, which does "
+        "not exist)"
+    )
+    with pytest.raises(FileNotFoundError) as info:
+        load_scene(link)
+    assert str(info.value).endswith(
+        "(a link to current, a link to moved/data, which does not exist)"
+    )
+
+
 def test_a_path_holding_a_null_byte_is_refused_in_the_arguments_name(tmp_path: Path) -> None:
     """10c9107a named a null byte in OccupancyGrid.save's arguments only: write_pfm,
     Matches.save_csv, read_pfm (every as_path caller) still raised the OS's bare "ValueError:

@@ -926,7 +926,15 @@ def _broken_link(link: Path) -> str:
     except OSError as exc:
         if exc.errno == errno.ELOOP:
             return f"a link to {target}, one of a loop of links that never reaches a file"
-    return f"a link to {target}, which does not exist"
+    # a link to a link whose target moved (data -> current -> /mnt/disk2/data) was "a link to
+    # current, which does not exist", of a name ls lists: each link is named, to the missing one
+    hops = [target]
+    at = os.path.join(os.path.dirname(link), os.readlink(link))
+    while os.path.islink(at) and len(hops) < 40:  # 40: Linux's own limit (ELOOP past it)
+        step = os.readlink(at)
+        hops.append(escaped(step))
+        at = os.path.join(os.path.dirname(at), step)
+    return ", ".join(f"a link to {t}" for t in hops) + ", which does not exist"
 
 
 def _existing_file(path: PathLike, what: str) -> Path:
