@@ -2452,3 +2452,15 @@ def test_a_hand_made_plane_of_figures_not_finite_is_refused(
     with pytest.raises(ValueError) as exc:
         GroundPlane(**{**fields, field: value})
     assert str(exc.value) == says
+
+
+def test_a_hand_made_plane_of_an_int_past_a_floats_range_is_refused() -> None:
+    """disparity_plane (10**400, 0, 0) was NumPy's OverflowError "int too large to convert to
+    float", naming no field; it is infinite, refused as an infinity is (a height of 10**400
+    already was)."""
+    with pytest.raises(ValueError) as exc:
+        GroundPlane(
+            normal=[0.0, -1.0, 0.0], height=1.0, disparity_plane=(10**400, 0, 0),
+            inliers=np.zeros((2, 2), bool), inlier_share=0.5, rms_px=0.1,
+        )  # fmt: skip
+    assert str(exc.value).startswith("disparity_plane: expected 3 finite numbers (a, b, c), got (")

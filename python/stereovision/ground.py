@@ -211,6 +211,8 @@ class GroundPlane:
             coef = _real_array(self.disparity_plane)
         except ValueError:  # ragged
             coef = None
+        except OverflowError:  # an int past a float's range: infinite, as a height of 10**400 is
+            coef = np.full(3, math.inf)
         if coef is None or coef.dtype.kind == "b" or coef.shape != (3,):
             raise ValueError(
                 "disparity_plane: expected 3 numbers (a, b, c), got "
