@@ -2621,3 +2621,22 @@ def test_an_empty_bag_name_is_refused_not_the_current_folder(
             call()
         assert str(info.value) == "path: expected a bag file or folder name, got ''"
     assert [p.name for p in tmp_path.iterdir()] == ["metadata.yaml"]
+
+
+def test_cli_info_of_a_missing_bag_says_bag_not_found(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`info run.bag` of a missing bag (or a link to one since moved) said "calibration file
+    not found: run.bag", of a name a bag's; it is the bag reader's "bag not found"."""
+    from stereovision import cli
+
+    (tmp_path / "run.bag").symlink_to(Path("moved") / "run.bag")
+    assert cli.main(["info", str(tmp_path / "run.bag")]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: bag not found: {tmp_path / 'run.bag'} (a link to moved/run.bag, "
+        "which does not exist)\n"
+    )
+    assert cli.main(["info", str(tmp_path / "x.mcap")]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: bag not found: {tmp_path / 'x.mcap'}\n"
+    assert cli.main(["info", str(tmp_path / "rig.yaml")]) == 2  # a calibration's as before
+    assert "calibration file not found" in capsys.readouterr().err

@@ -1576,7 +1576,13 @@ def cmd_info(args: argparse.Namespace) -> int:
     if (args.hfov, args.baseline) != (None, None):
         raise CliError("--hfov and --baseline describe a rig on paper: give no calibration")
     topics = (args.left_topic, args.right_topic)
-    if not is_bag(args.calib):
+    # a missing bag (run.bag, or a link to one since moved) was "calibration file not found":
+    # a name a bag's is said as the bag reader says it ("bag not found: run.bag")
+    name = os.fspath(args.calib)
+    missing_bag = not os.path.exists(name) and name.endswith(
+        (".bag", ".db3", ".mcap", ".bag.active")
+    )
+    if not missing_bag and not is_bag(args.calib):
         if topics != (None, None):
             raise CliError("--left-topic and --right-topic are for a bag")
         from stereovision.calibration import _sizeless, _sizing_images
