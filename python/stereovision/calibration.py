@@ -1574,9 +1574,11 @@ class Calibration:
         """:meth:`load`, a file without ``unit`` given ``unit`` (:meth:`from_file`'s)."""
         p, text = cls._read_text(path)
         head = text.lstrip()
-        if head.startswith("%YAML") and not head.startswith("%YAML:"):
+        if head.startswith("%YAML") and "!!opencv-matrix" not in text:
             # PyYAML's directive (yaml.safe_dump(..., version=(1, 1)): "%YAML 1.1"), which
-            # OpenCV's parser refused ("line 4: Incorrect indentation"); its own is "%YAML:1.0"
+            # OpenCV's parser refused ("line 4: Incorrect indentation"). OpenCV writes
+            # "%YAML:1.0" (4.x) or "%YAML 1.2" (5.x) with its matrices tagged: those go to its
+            # parser alone (PyYAML refuses the tags: 8 of save()'s 10 ms load were that try)
             calib = cls._from_plain_yaml(text, str(p), unit)
             if calib is not None:
                 return calib
