@@ -153,7 +153,10 @@ FT_PER_M = 3.28084  # 1 m in feet (1 ft = 0.3048 m)
 
 
 def test_depth_unit_ft_labels_the_bar_and_the_summary_and_leaves_the_files(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """``depth --unit ft``: overview.png's depth bar and the printed depths in feet, read back
     against depth.npy x 3.28084 (and the floor's lines against ground.json and scan.json);
@@ -163,6 +166,15 @@ def test_depth_unit_ft_labels_the_bar_and_the_summary_and_leaves_the_files(
     argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--calib"]
     argv += [str(scene / "calib.txt"), "--method", "fast", "--max-disparity", "32", "--ground"]
     outs = {}
+    import stereovision.overview as overview_module
+
+    drawn: list[Any] = []  # the results the runs drew: no file holds their confidence
+
+    def recording(result: Any, title: str, unit: str = "m") -> Overview:
+        drawn.append(result)
+        return overview_image(result, title, unit)
+
+    monkeypatch.setattr(overview_module, "overview_image", recording)
     for unit in ("m", "ft"):
         outs[unit] = tmp_path / unit
         extra = [] if unit == "m" else ["--unit", "ft"]
@@ -190,7 +202,7 @@ def test_depth_unit_ft_labels_the_bar_and_the_summary_and_leaves_the_files(
     img_m = cv2.imread(str(outs["m"] / "overview.png"))
     img = cv2.imread(str(outs["ft"] / "overview.png"))
     depth = np.load(outs["ft"] / "depth.npy")
-    res = _result_of(outs["ft"], depth)
+    res = _result_of(outs["ft"], depth, drawn[-1].confidence)
     ov = overview_image(res, overview_title("terrace/left.png", res), "ft")
     # the file's depth cell (caption, map, bar and labels) is this one's
     px, py, _, ph = ov.panels["depth"]
@@ -225,15 +237,16 @@ def test_depth_unit_ft_labels_the_bar_and_the_summary_and_leaves_the_files(
     assert [t[1] for t in metres_ticks] != [t[1] for t in bar.ticks]
 
 
-def _result_of(out: Path, depth: np.ndarray) -> object:
+def _result_of(out: Path, depth: np.ndarray, confidence: np.ndarray) -> object:
     """The run's DepthResult as its files hold it (disparity.pfm, depth.npy), for
-    overview_image: the same maps the CLI drew."""
+    overview_image: the same maps the CLI drew; its ``confidence`` (0 where filled: the depth
+    caption's reasons read it), which no file holds."""
     import stereovision as sv
 
     disp = read_pfm(out / "disparity.pfm")
     return sv.DepthResult(
         disparity=disp,
-        confidence=np.zeros_like(disp),
+        confidence=confidence,
         depth=depth,
         points=np.zeros((0, 3), np.float32),
         colors=np.zeros((0, 3), np.uint8),
@@ -287,7 +300,8 @@ def test_the_depth_caption_says_where_there_is_depth(terrace_run: tuple) -> None
     assert ov.captions == {
         "left": "left image",
         "disparity": "disparity (px)",
-        "depth": f"depth (m) on {share:.1f} %, none where filled",
+        # 32492 filled pixels, and 16 measured ones within sigma_d of infinite depth
+        "depth": f"depth (m) on {share:.1f} %, none where filled or too far to tell",
         "confidence": "confidence (0-1)",
     }
     small = res.filtered(max_depth=float(np.nanmax(res.depth)))  # the same depths, a copy
@@ -459,7 +473,12 @@ def test_the_depth_caption_names_the_limits_and_no_fill_it_did_not_make(terrace_
     assert overview_image(near, "terrace").captions["depth"] == (
         f"depth (m) on {share:.1f} %, none where filled or beyond the limits"
     )
-    unfilled = dataclasses.replace(res, confidence=np.ones_like(res.confidence))
+    # the Gabor channel's: holes where the disparity has none, every measured pixel a depth
+    unfilled = dataclasses.replace(
+        res,
+        disparity=np.where(np.isfinite(res.depth), res.disparity, np.float32(np.nan)),
+        confidence=np.ones_like(res.confidence),
+    )
     share = 100 * float(np.isfinite(res.depth).mean())
     assert overview_image(unfilled, "terrace").captions["depth"] == f"depth (m) on {share:.1f} %"
 
@@ -654,6 +673,26 @@ def test_holes_of_the_disparity_are_not_called_filled() -> None:
     res.confidence[:15, :150] = 0.0  # no disparity there: not a filled pixel
     share = 100 * float(np.isfinite(res.depth).mean())
     assert overview_image(res, "t").captions["depth"] == f"depth (m) on {share:.1f} %"
+
+
+def test_measured_pixels_without_a_depth_are_called_too_far_to_tell() -> None:
+    """A measured disparity not above its sigma_d gets no depth (its one-sigma interval reaches
+    infinity: 5449 px of playground's gabor map, 12582 of its fast one); the caption gave the
+    share alone or blamed the fill for them. They are named; with limits, as before."""
+    res = _small_result(30, 500)  # wide enough for both reasons in the caption
+    res.depth[20:, 200:] = np.nan  # measured (confidence > 0), no depth
+    share = 100 * float(np.isfinite(res.depth).mean())
+    assert overview_image(res, "t").captions["depth"] == (
+        f"depth (m) on {share:.1f} %, none where too far to tell"
+    )
+    res.confidence[20:, 350:] = 0.0  # part of them filled
+    assert overview_image(res, "t").captions["depth"] == (
+        f"depth (m) on {share:.1f} %, none where filled or too far to tell"
+    )
+    res.limits = {"max_depth": 30.0}  # a filtered result's measured holes: one reason
+    assert overview_image(res, "t").captions["depth"] == (
+        f"depth (m) on {share:.1f} %, none where filled or beyond the limits"
+    )
 
 
 def test_a_unit_that_is_not_a_string_is_a_value_error() -> None:

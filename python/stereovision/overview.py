@@ -145,8 +145,10 @@ class Overview:
         Panel name -> the caption above it; the depth panel's says on what share of the pixels
         there is a depth (``"depth (m) on 83.8 %, none where filled"``: the disparity's filled
         pixels get none, so its holes are not the disparity's; ``"... none where filled or
-        beyond the limits"`` for a :meth:`~stereovision.depth.DepthResult.filtered` result;
-        the share alone when nothing was filled nor cut).
+        too far to tell"`` where measured pixels got none, their disparity not above its
+        uncertainty ``sigma_d``; ``"... none where filled or beyond the limits"`` for a
+        :meth:`~stereovision.depth.DepthResult.filtered` result; the share alone when every
+        pixel with a disparity has a depth).
     """
 
     image: npt.NDArray[np.uint8]
@@ -385,10 +387,15 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         # for a map with nothing filled nor cut), shortened where the panel is too narrow
         has_depth = np.isfinite(depth)
         share = f"depth ({unit}) on {100 * float(has_depth.mean()):.1f} %"
-        filled = valid & ~has_depth & (np.asarray(result.confidence) == 0)
+        lost = valid & ~has_depth
+        filled = lost & (np.asarray(result.confidence) == 0)
         why = ["filled"] if filled.any() else []
         if getattr(result, "limits", None):
-            why.append("beyond the limits")
+            why.append("beyond the limits")  # (and any of the measured ones below: one reason)
+        elif (lost & ~filled).any():
+            # measured, not above its sigma_d: a one-sigma depth interval reaching infinity
+            # (depth_counts' "dropped"; playground's gabor map: 5449 px, said nowhere)
+            why.append("too far to tell")
         caption_text = f"{share}, none where {' or '.join(why)}" if why else share
         # the reasons where the caption stays clear of the bar's labels (left of their column)
         reach = pw + _BAR_GAP + _BAR_W + _LABEL_X
