@@ -353,6 +353,28 @@ def test_an_8_or_16_bit_pair_is_taken_at_full_scale() -> None:
         assert np.nanmedian(got.disparity) == pytest.approx(2.0, abs=0.05)
 
 
+def test_a_colour_pair_is_refined_as_its_grey_one() -> None:
+    """cv2.imread's BGR pair, which depth_map and the matchers take, was refused ("left must be
+    a non-empty 2-D (H, W) array, got shape (30, 48, 3)"). A BGR, BGRA or (H, W, 1) pair is now
+    refined as its as_gray_float grey (depth_map's), bit for bit; a 12-bit one warned of."""
+    rng = np.random.default_rng(3)
+    left = (rng.random((30, 48, 3)) * 255).astype(np.uint8)
+    right = np.roll(left, -2, axis=1)
+    disp = np.full(left.shape[:2], 2.0, np.float32)
+    want = refine_disparity(as_gray_float(left), as_gray_float(right), disp, max_disparity=8)
+    assert np.nanmedian(want.disparity) == pytest.approx(2.0, abs=0.05)
+    bgra = np.concatenate([left, np.full((30, 48, 1), 255, np.uint8)], axis=2)
+    bgra_r = np.roll(bgra, -2, axis=1)
+    for lft, rgt in ((left, right), (bgra, bgra_r), (left[:, :, :1], right[:, :, :1])):
+        got = refine_disparity(lft, rgt, disp, max_disparity=8)
+        if lft.shape[2] == 1:
+            want = refine_disparity(lft[:, :, 0], rgt[:, :, 0], disp, max_disparity=8)
+        np.testing.assert_array_equal(got.disparity, want.disparity)
+        assert got.n_filled == want.n_filled
+    with pytest.warns(UserWarning, match=r"^left: uint16 image whose largest value is 4064 "):
+        refine_disparity(left.astype(np.uint16) * 16, right * np.uint16(257), disp, max_disparity=8)
+
+
 def test_a_12_bit_pair_in_uint16_is_warned_of_as_the_matchers_do() -> None:
     """A uint16 pair of 12-bit values was taken at /65535 without a word, where the matchers
     (as_gray_float) warn of it: 16 times darker, its contrast under var_floor (teddy as 12-bit

@@ -27,6 +27,7 @@ import numpy.typing as npt
 from stereovision import _core
 from stereovision._validate import (
     _warn_low_uint16,
+    as_gray_float,
     check_index_range,
     check_unit_range,
     disparity_range,
@@ -106,6 +107,10 @@ def _number(v: object, name: str, whole: bool = False) -> float:
     return out
 
 
+#: What a 12-bit image in uint16 does to the refinement (the matchers' warning's ending).
+_LOW_UINT16_EFFECT = ", its contrast then below the refinement's var_floor"
+
+
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
     if name in ("left", "right"):
         # "left must be real numbers, got dtype object" (a path: "<U8") of cv2.imread's None
@@ -114,9 +119,17 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
     # The float32 cast dropped a complex array's imaginary part with only NumPy's warning.
     if arr.dtype.kind not in "biuf":
         raise ValueError(f"{name} must be real numbers, got dtype {arr.dtype}")
+    image = name in ("left", "right")
+    if image and arr.ndim == 3 and arr.shape[2] in (1, 3, 4) and arr.size:
+        # a colour image, as the matchers take it (cv2.imread's BGR): grey by as_gray_float's
+        # luma weights, depth_map's grey of the pair; it was refused as "must be a non-empty
+        # 2-D (H, W) array" after depth_map had taken the same pair
+        check_index_range(arr.shape, name, "image")  # before the float32 copy
+        if arr.dtype == np.uint16:
+            _warn_low_uint16(arr, name, _LOW_UINT16_EFFECT)
+        return as_gray_float(arr, name, warn=False)
     if arr.ndim != 2 or arr.size == 0:
         raise ValueError(f"{name} must be a non-empty 2-D (H, W) array, got shape {arr.shape}")
-    image = name in ("left", "right")
     # before the float32 copy: a broadcast image past the kernel's limit may not fit in memory
     check_index_range(arr.shape, name, "image" if image else "map")
     if image and arr.dtype in (np.uint8, np.uint16):
@@ -125,7 +138,7 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
         if arr.dtype == np.uint16:
             # as the matchers warn (as_gray_float): 12-bit data scaled by 65535 lies 16 times
             # darker, its contrast below var_floor (teddy: 16 % fewer pixels kept), unsaid
-            _warn_low_uint16(arr, name, ", its contrast then below the refinement's var_floor")
+            _warn_low_uint16(arr, name, _LOW_UINT16_EFFECT)
         return np.ascontiguousarray(arr, dtype=np.float32) / np.float32(np.iinfo(arr.dtype).max)
     return np.ascontiguousarray(arr, dtype=np.float32)
 
@@ -146,7 +159,9 @@ def refine_disparity(
     ----------
     left, right : array_like
         Rectified grey images, ``(H, W)`` float in ``[0, 1]``, or ``uint8`` / ``uint16``
-        (divided by 255 / 65535; a ``uint16`` image below 4096, 12-bit data, is warned of).
+        (divided by 255 / 65535; a ``uint16`` image below 4096, 12-bit data, is warned of);
+        colour ones, ``(H, W, 3)`` BGR or ``(H, W, 4)`` BGRA (or ``(H, W, 1)``), are made grey
+        as the matchers and :func:`~stereovision.depth_map` make them.
     disparity : array_like
         ``(H, W)`` disparity of the left image (px), NaN = no estimate.
     confidence : array_like, optional
