@@ -39,8 +39,11 @@ __all__ = [
 #: algorithms.md E.2: ``< 1e-12``).
 UNDISTORT_TOL = 1e-12
 #: Iteration cap of the undistortion; points still moving after it are flagged (the toolbox
-#: runs 20 fixed rounds; strong distortion near the corners needs more or diverges).
-UNDISTORT_MAX_ITER = 100
+#: runs 20 fixed rounds; strong distortion near the corners needs more or diverges). Near the
+#: corners of a wide lens the iteration creeps: a StereoPi rig's 320x240 camera (k1 0.53, k2
+#: -3.09, k3 4.93) had 3.1 % of its pixels flagged at 100 rounds, 1.2 % at 1000 (all within
+#: 34 px of a corner). Points that converge stop where they did; only the others go on.
+UNDISTORT_MAX_ITER = 1000
 #: Rays whose squared sine of their angle is below this are treated as parallel (angle below
 #: 1e-6 rad: at a 0.1 m baseline that is beyond 100 km).
 PARALLEL_SIN2_TOL = 1e-12
@@ -202,25 +205,27 @@ def undistort_normalized(
         y[~ok] = np.nan
         return np.stack([x, y], axis=1), ok
     converged = np.zeros(len(x), dtype=bool)
-    active = np.isfinite(x) & np.isfinite(y)
+    # the points still moving, by index: each round costs what they are, not all N (a million
+    # points with a few creeping near a corner went through all N every round)
+    idx = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
+    xa, ya, xda, yda = x[idx], y[idx], xd[idx], yd[idx]
     with np.errstate(all="ignore"):
         for _ in range(max_iter):
-            if not active.any():
+            if not idx.size:
                 break
-            xa, ya = x[active], y[active]
             r2 = xa * xa + ya * ya
             r4 = r2 * r2
             radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
             dx = 2 * p1 * xa * ya + p2 * (r2 + 2 * xa * xa) + s1 * r2 + s2 * r4
             dy = p1 * (r2 + 2 * ya * ya) + 2 * p2 * xa * ya + s3 * r2 + s4 * r4
-            xn = (xd[active] - dx) / radial
-            yn = (yd[active] - dy) / radial
+            xn = (xda - dx) / radial
+            yn = (yda - dy) / radial
             step = np.hypot(xn - xa, yn - ya)
-            x[active], y[active] = xn, yn
+            x[idx], y[idx] = xn, yn
             done = step < tol
-            idx = np.flatnonzero(active)
             converged[idx[done]] = True
-            active[idx[done | ~np.isfinite(step)]] = False
+            going = ~(done | ~np.isfinite(step))
+            idx, xa, ya, xda, yda = idx[going], xn[going], yn[going], xda[going], yda[going]
     x[~converged] = np.nan
     y[~converged] = np.nan
     return np.stack([x, y], axis=1), converged
