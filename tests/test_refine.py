@@ -375,6 +375,33 @@ def test_a_colour_pair_is_refined_as_its_grey_one() -> None:
         refine_disparity(left.astype(np.uint16) * 16, right * np.uint16(257), disp, max_disparity=8)
 
 
+def test_a_map_mostly_outside_the_range_is_warned_of_as_fixed_point() -> None:
+    """OpenCV StereoSGBM's int16 map (d * 16, -16 = no match) was refined as pixels: every
+    value past max_disparity dropped, tsukuba's refined map kept 1 % of its pixels, without a
+    word. Most values above the range are warned of, at the caller's line; a map mostly in
+    it (or below it) is not."""
+    rng = np.random.default_rng(3)
+    left = (rng.random((30, 48)) * 255).astype(np.uint8)
+    right = np.roll(left, -2, axis=1)
+    fixed = np.full(left.shape, 32, np.int16)  # 2 px in sixteenths
+    fixed[:, :10] = -16
+    with pytest.warns(UserWarning) as caught:
+        res = refine_disparity(left, right, fixed, max_disparity=8)
+    assert [str(w.message) for w in caught] == [
+        "disparity: 1140 of its 1440 values (79.2 %) lie above max_disparity 8 px and are "
+        "dropped (the largest 32 px); fixed-point values? OpenCV StereoBM / StereoSGBM's int16 "
+        "map is d * 16 (divide by 16; its -16 is no match), a 16-bit disparity PNG d * 256 "
+        "(stereovision.export.read_disparity_png)"
+    ]
+    assert caught[0].filename == __file__
+    assert np.isfinite(res.disparity).mean() < 0.5  # what was refined is not the map
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        half = np.where(fixed > 0, np.float32(2.0), np.float32(40.0))  # 10 of 48 columns out
+        refine_disparity(left, right, half, max_disparity=8)
+        refine_disparity(left, right, np.full(left.shape, -3.0), max_disparity=8)
+
+
 def test_a_12_bit_pair_in_uint16_is_warned_of_as_the_matchers_do() -> None:
     """A uint16 pair of 12-bit values was taken at /65535 without a word, where the matchers
     (as_gray_float) warn of it: 16 times darker, its contrast under var_floor (teddy as 12-bit
