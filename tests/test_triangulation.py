@@ -259,6 +259,15 @@ def test_triangulate_input_errors() -> None:
         triangulate(np.zeros((2, 5)), np.zeros((2, 5)), c)
     with pytest.raises(ValueError, match=r"xl and xr must have the same shape"):
         triangulate(np.zeros((4, 2)), np.zeros((3, 2)), c)
+    # one correspondence as its pixel, (x, y): the shape alone did not say to pass [[x, y]]
+    with pytest.raises(ValueError) as err:
+        triangulate((320, 240), (300, 240), c)
+    assert str(err.value) == (
+        "xl: expected an (N, 2) real array of (x, y) pixels, got shape (2,) dtype int64 "
+        "(one point: [[x, y]])"
+    )
+    with pytest.raises(ValueError, match=r"^pts: .* got shape \(2,\) dtype float64 \(one point"):
+        undistort_normalized([320.0, 240.0], c.K1, None)
 
 
 def test_rectified_triangulation_equals_shortcut() -> None:

@@ -85,6 +85,9 @@ def _points(x: npt.ArrayLike, name: str) -> F64:
         hint = (
             " (transpose a (2, N) array)"
             if a.ndim == 2 and a.shape[0] == 2 and a.shape[1] != 2
+            # one correspondence given as its pixel: the shape alone did not say what to pass
+            else " (one point: [[x, y]])"
+            if a.shape == (2,) and a.dtype.kind in "iuf"
             else ""
         )
         raise ValueError(
