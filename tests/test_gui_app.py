@@ -7037,6 +7037,7 @@ def test_image_sequences_typed_as_cameras_that_start_apart_are_said_paired_in_or
     import warnings
 
     from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import short_paths
 
     img = np.zeros((24, 40, 3), np.uint8)
     (tmp_path / "seq").mkdir()
@@ -7076,11 +7077,28 @@ def test_image_sequences_typed_as_cameras_that_start_apart_are_said_paired_in_or
     finally:
         started.source.close()
     cv2.imwrite(str(tmp_path / "seq" / "left01.png"), img)  # now both start at 01
+    # ... and both have a gap (04 deleted): 05 is never read. They ended at it and started
+    # again without a word (the chessboard pairs without their 10: 11-14 never shown), where
+    # capture and stream say it; the Capture that starts them again says it now
+    for name in ("right03.png", "left05.png", "right05.png"):
+        cv2.imwrite(str(tmp_path / "seq" / name), img)
     _open_cameras(app)
     try:
         assert app.state.error == "" and app.state.rows_label == ""
+        said = []
+        for _ in range(4):
+            _capture(app)
+            said.append(app.state.rows_label)
     finally:
         app.source.close()
+    gap = (
+        "{0} source '{1}/{0}%02d.png' ended after 3 images: {0}04.png is missing, so the 1 "
+        "image numbered after it was not read (renumber them without the gap)"
+    )
+    folder = short_paths(str(tmp_path / "seq"), tmp_path / "seq")
+    restarted = "; ".join(gap.format(side, folder) for side in ("left", "right"))
+    assert app.state.error == ""
+    assert said == ["", "", f"warning: started again from the first pair: {restarted}", ""]
 
 
 def test_a_max_disparity_refused_while_a_pair_computes_stays_said_after_it():

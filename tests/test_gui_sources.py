@@ -655,6 +655,8 @@ def test_capture_adapter_reads_every_shape_of_pair() -> None:
 
 
 def test_capture_adapter_reopens_files_not_cameras() -> None:
+    from stereovision import capture
+
     log: list[str] = []
     made: list[FakeCamera] = []
 
@@ -673,6 +675,12 @@ def test_capture_adapter_reopens_files_not_cameras() -> None:
     files = sources._CaptureAdapter(factory([OSError("end"), (_frame(7), _frame(8))]), files=True)
     left, _ = files.read()
     assert left[0, 0, 0] == 7 and len(made) == 2 and log == ["close"]  # close, not also release
+    assert files.restarted is None  # both ended together: nothing to say
+    # one that ended early (a gap in its numbers): said by the read that started them again
+    early = capture.SourceError("left source ended after 2 images: left03.png is missing", gap="x")
+    files = sources._CaptureAdapter(factory([early, (_frame(1),) * 2, (_frame(2),) * 2]), True)
+    assert files.read()[0][0, 0, 0] == 1 and files.restarted == str(early)
+    assert files.read()[0][0, 0, 0] == 2 and files.restarted is None
     with pytest.raises(ValueError):  # only an ended source is reopened
         sources._CaptureAdapter(factory([ValueError("bad")]), files=True).read()
 

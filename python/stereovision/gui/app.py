@@ -1292,6 +1292,9 @@ class _Frames:
     folder: str = ""
     #: `` (8.0 frames averaged)`` when averaged, else "".
     averaged: str = ""
+    #: Why the files were started again from their first pair during this read, when one
+    #: ended early (a gap in a numbered sequence: :attr:`_CaptureAdapter.restarted`), else "".
+    restarted: str = ""
 
 
 def _read_pair(source: StereoSource, average: bool) -> _Frames:
@@ -1308,13 +1311,14 @@ def _read_pair(source: StereoSource, average: bool) -> _Frames:
         As the source's read raises them (a read given up after ``read_timeout``).
     """
     left, right = source.read()
+    restarted = getattr(source, "restarted", None)
     folder = source if isinstance(source, FolderPairs) else None
     if left.shape != right.shape:
         from stereovision.io import image_size_text
 
         what = folder.describe() if folder else "the cameras give different sizes"
         raise ValueError(f"{what}: left {image_size_text(left)}, right {image_size_text(right)}")
-    got = _Frames(left, right)
+    got = _Frames(left, right, restarted=restarted or "")
     if folder:  # one pair after another, not frames of one view: nothing to average
         got.folder = folder.describe()
         job = folder.current
@@ -1333,6 +1337,7 @@ def _read_pair(source: StereoSource, average: bool) -> _Frames:
         got.left, got.right = tf(left, right)
         for _ in range(AVERAGE_FRAMES - 1):
             got.left, got.right = tf(*source.read())
+            got.restarted = got.restarted or getattr(source, "restarted", None) or ""
         moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
         got.averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
     return got
@@ -1930,6 +1935,15 @@ class StereoApp:
         label = self._source_label or "cameras " + " / ".join(names)
         self.state.source_label = (got.folder or label) + got.averaged
         self.state.rows_label = ""
+        if got.restarted:
+            # the images after a gap in a sequence were never shown, the files started again
+            # without a word (capture and stream say it): said under the pair, paths as the
+            # page shows them
+            said = got.restarted
+            for src in getattr(self.source, "sources", ()):
+                if isinstance(src, str) and "://" not in src:
+                    said = short_paths(said, Path(src).parent)
+            self.state.rows_label = f"warning: started again from the first pair: {said}"
         rect = self.homographies
         if rect is not None and rect.input_size == (left.shape[1], left.shape[0]):
             # the cameras rectified from their features: every new pair through the same

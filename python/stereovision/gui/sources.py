@@ -563,13 +563,26 @@ class _CaptureAdapter:
     ``read_timeout`` seconds (:func:`~stereovision.capture.read_within`; None: no limit).
     """
 
-    def __init__(self, factory: Any, files: bool, read_timeout: float | None = None) -> None:
+    def __init__(
+        self,
+        factory: Any,
+        files: bool,
+        read_timeout: float | None = None,
+        sources: tuple[int | str, ...] = (),
+    ) -> None:
         self._factory = factory
+        #: The sources as opened (the page shortens their paths in what it says of them).
+        self.sources = sources
         self._files = files
         self._read_timeout = read_timeout
         self._camera = factory()
+        #: What ``StereoCamera`` said of a file that ended early when the last read started the
+        #: files again (a gap in a numbered sequence, a video shorter than the other); None
+        #: when it did not, or they ended together.
+        self.restarted: str | None = None
 
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+        self.restarted = None
         try:
             return self._read()
         except OSError as exc:
@@ -579,7 +592,12 @@ class _CaptureAdapter:
                 raise
             self.close()
             self._camera = self._factory()
-            return self._read()
+            got = self._read()
+            if getattr(exc, "ended_early", False):
+                # the images after a gap (left10.jpg deleted: 11-14 never shown), a longer
+                # video's end: started again without a word, where capture and stream say it
+                self.restarted = str(exc)
+            return got
 
     def _read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
         # bounded as capture's and stream's reads are: a hung camera froze the page for good
@@ -731,7 +749,7 @@ def open_stereo_source(
         first[0] = False
         return StereoCamera(left, right, image_size=size, fourcc=code, open_timeout=timeout)
 
-    return _CaptureAdapter(make, files, read_timeout)
+    return _CaptureAdapter(make, files, read_timeout, sources=(left, right))
 
 
 def scale_pair(
