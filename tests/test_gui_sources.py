@@ -170,8 +170,7 @@ def test_resolve_accepts_the_root_and_refuses_nul_and_rootless(data: Path) -> No
     assert folders.resolve("scene") == (data / "scene").resolve()
     two = AllowedFolders([data / "scene", data])
     assert two.resolve("left.png") == (data / "scene" / "left.png").resolve()  # the first root
-    with pytest.raises(FileNotFoundError, match="no such file"):
-        two.resolve("a.ply")  # in the second root only
+    assert two.resolve("a.ply") == (data / "a.ply").resolve()  # in the second root only
     with pytest.raises(ValueError, match="empty or invalid path"):
         folders.resolve("a\x00.ply")
     with pytest.raises(ValueError, match=r"^path outside the allowed folders: a\.ply$"):
@@ -1235,6 +1234,36 @@ def test_a_data_folder_inside_another_is_listed_once(data: Path) -> None:
 
 
 # ----------------------------------------------------------------------------- allowed folders
+
+
+def test_a_relative_path_is_taken_in_the_data_folder_it_is_in(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A relative path was taken under the first root alone, which with ``--data`` is the
+    bundled demo data: a pattern typed in a camera field (``seq/left%02d.png``) or a file
+    named as the page's lists name it (``scenes/data/seq/left01.png``) was "no such file"
+    of a file in the --data folder. It is now taken under the first root it is in (as
+    labelled, relative to a root or to the current folder), the first root first."""
+    bundled, data = tmp_path / "stereovision" / "data", tmp_path / "scenes" / "data"
+    for root in (bundled, data):
+        (root / "cones").mkdir(parents=True)
+        (root / "cones" / "left.png").write_bytes(b"x")
+    (data / "seq").mkdir()
+    (data / "seq" / "left01.png").write_bytes(b"x")
+    (tmp_path / "secret.png").write_bytes(b"x")
+    folders = AllowedFolders([bundled, data])
+    seq = (data / "seq" / "left01.png").resolve()
+    assert folders.label(seq) == "scenes/data/seq/left01.png"
+    assert folders.resolve("seq/left01.png") == seq
+    assert folders.resolve("scenes/data/seq/left01.png") == seq
+    assert folders.resolve("seq") == seq.parent  # a camera field's pattern, by its folder
+    assert folders.resolve("cones/left.png") == (bundled / "cones" / "left.png").resolve()
+    monkeypatch.chdir(tmp_path / "scenes")
+    assert folders.resolve("data/seq/left01.png") == seq  # as the page's messages show it
+    with pytest.raises(FileNotFoundError, match=r"^no such file: seq/left02\.png$"):
+        folders.resolve("seq/left02.png")
+    with pytest.raises(ValueError, match=r"^path outside the allowed folders: \.\./secret"):
+        folders.resolve("../secret.png")  # under the current folder's parent: still refused
 
 
 @pytest.fixture

@@ -223,8 +223,10 @@ class AllowedFolders:
     def resolve(self, path: str | os.PathLike[str]) -> Path:
         """The real path of ``path`` if it lies inside an allowed folder.
 
-        Relative paths are taken relative to the first root. Symbolic links and ``..`` are
-        resolved before the check, so neither can lead outside.
+        A relative path is taken under the first root where it is (the first root when it is
+        under none): as the page's lists name files (``<root label>/...``), relative to a root,
+        or to the current folder (as the page's messages show paths). Symbolic links and
+        ``..`` are resolved before the check, so neither can lead outside.
 
         Raises
         ------
@@ -243,13 +245,33 @@ class AllowedFolders:
         if not p.is_absolute():
             if not self.roots:
                 raise ValueError(f"path outside the allowed folders: {said}")
-            p = self.roots[0] / p
+            p = self._under_a_root(p)
         real = real_path(p)
         if not any(real == r or real.is_relative_to(r) for r in self.roots):
             raise ValueError(f"path outside the allowed folders: {said}")
         if not real.exists():
             raise FileNotFoundError(f"no such file: {said}{_loop_note(p)}")
         return real
+
+    def _under_a_root(self, p: Path) -> Path:
+        """The relative path ``p`` under the first root it is in (that root's lists label it
+        so, or it is relative to the root or to the current folder), else under the first
+        root. Only the first root was tried: with ``--data`` that is the bundled demo data, so
+        a pattern typed in a camera field ("seq/left%02d.png") or a file name as the lists
+        show it ("data/seq/left01.png") was "no such file" of a file in the ``--data``
+        folder."""
+        found = [r / p for r in self.roots]
+        for r in self.roots:  # as the page's lists name it: the root's label, then the rest
+            label = Path(self._names[r]).parts
+            if p.parts[: len(label)] == label:
+                found.append(r.joinpath(*p.parts[len(label) :]))
+        with contextlib.suppress(OSError):  # no current folder (removed): not tried
+            found.append(Path.cwd() / p)
+        for c in found:
+            real = real_path(c)
+            if os.path.lexists(c) and any(real == r or real.is_relative_to(r) for r in self.roots):
+                return c
+        return found[0]
 
     def resolve_output(
         self, path: str | os.PathLike[str], roots: Sequence[Path] | None = None
