@@ -602,6 +602,30 @@ def test_info_on_paper_refuses_a_bad_value_in_one_line(capsys: pytest.CaptureFix
     assert out == "" and err.startswith("stereovision: error: --baseline: expected a positive")
 
 
+@pytest.mark.parametrize(
+    ("given", "left_out"),
+    [
+        (["--size", "1280x720", "--hfov", "90"], " (--baseline missing)"),
+        (["--size", "1280x720", "--baseline", "0.12"], " (--hfov missing)"),
+        (["--baseline", "0.12"], " (--size and --hfov missing)"),
+        ([], ""),
+    ],
+)
+def test_info_on_paper_names_the_option_left_out(
+    given: list[str], left_out: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``info --size 1280x720 --hfov 90`` (the baseline forgotten) was told to give a
+    calibration, or --size, --hfov and --baseline, as if it had given none of them; the ones
+    left out are named now. Nothing given: said as before."""
+    assert main(["info", *given]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err == (
+        "stereovision: error: give a calibration (or a bag), or a rig on paper: --size, --hfov "
+        f"and --baseline{left_out}\n"
+    )
+
+
 @pytest.mark.parametrize("baseline", ["1e308", "1000001"])
 def test_info_on_paper_refuses_a_baseline_past_1000_km(
     baseline: str, capsys: pytest.CaptureFixture[str]

@@ -1548,8 +1548,13 @@ def cmd_info(args: argparse.Namespace) -> int:
         if args.calib_unit is not None:
             raise CliError("--calib-unit is the unit of a calibration file: give one, or none")
         if None in design:
+            flags = ("--size", "--hfov", "--baseline")
+            missing = [f for f, v in zip(flags, design, strict=True) if v is None]
+            # two of the three given read as if none were: the one left out is named
+            left_out = f" ({' and '.join(missing)} missing)" if len(missing) < len(flags) else ""
             raise CliError(
-                "give a calibration (or a bag), or a rig on paper: --size, --hfov and --baseline"
+                "give a calibration (or a bag), or a rig on paper: --size, --hfov and "
+                f"--baseline{left_out}"
             )
         from stereovision.calibration import Calibration
         from stereovision.capture import parse_size
