@@ -2541,6 +2541,11 @@ def test_commit_outputs_keeps_a_link_the_user_put_under_an_earlier_output_name(
             ["info", "BAG", "--size", "640x480"],
             "--size and --calib-unit are for a calibration file, not a bag",
         ),
+        # a rig on paper printed its figures, the topic dropped without a word
+        (
+            "info --size 640x480 --hfov 60 --baseline 0.1 --left-topic /l".split(),
+            "--left-topic and --right-topic are for a bag",
+        ),
     ],
 )
 def test_rectify_and_info_refuse_options_that_do_not_fit_in_one_line(

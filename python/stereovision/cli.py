@@ -1556,6 +1556,8 @@ def cmd_info(args: argparse.Namespace) -> int:
                 "give a calibration (or a bag), or a rig on paper: --size, --hfov and "
                 f"--baseline{left_out}"
             )
+        if (args.left_topic, args.right_topic) != (None, None):  # dropped without a word
+            raise CliError("--left-topic and --right-topic are for a bag")
         from stereovision.calibration import Calibration
         from stereovision.capture import parse_size
 
