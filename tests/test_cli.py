@@ -3333,7 +3333,7 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
         (
             ["info", "--size", "640x480", "--hfov", "60", "--baseline", "10cm"],
             "stereovision info: error: argument --baseline: expected a number of metres without "
-            "a unit (5 for 5 m), got '10cm' (see stereovision info --help)",
+            "a unit (10 cm is 0.1 m: give 0.1), got '10cm' (see stereovision info --help)",
         ),
         # told to write --tolerance=-1px, which is no number either (then: no word of the unit)
         (
@@ -3442,13 +3442,29 @@ def test_a_bad_option_value_is_said_in_the_option_s_name(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
 
 
-@pytest.mark.parametrize("text", ["5M", "2FT", ".5m", "1e3mm", "+5m", "5 cm", '5"', "-.5 in"])
+@pytest.mark.parametrize(
+    ("text", "hint"),
+    [
+        ("5M", "5 for 5 m"),
+        ("2FT", "2 ft is 0.6096 m: give 0.6096"),
+        (".5m", "5 for 5 m"),
+        ("1e3mm", "1000 mm is 1 m: give 1"),
+        ("+5m", "5 for 5 m"),
+        ("5 cm", "5 cm is 0.05 m: give 0.05"),
+        ('5"', "5 in is 0.127 m: give 0.127"),
+        ("5'", "5 ft is 1.524 m: give 1.524"),
+        ("-.5 in", "5 for 5 m"),
+        ("5km", "5 for 5 m"),
+    ],
+)
 def test_every_way_of_typing_a_unit_after_a_metre_value_is_told_to_leave_it_out(
-    text: str,
+    text: str, hint: str
 ) -> None:
     """A mutation audit found the unit pattern's cases untested: an upper-case unit, a value
     without its leading 0, an exponent, a '+' sign and inches (a ") each lost the "without a
-    unit" hint, which said only "expected a number of metres"."""
+    unit" hint, which said only "expected a number of metres". A length in feet, inches, cm or
+    mm was told "(5 for 5 m)": --max-depth 5ft read as "type 5", 5 m for 1.5; such a length is
+    now said in metres (the unit of every metre option, whatever depth --unit prints in)."""
     import argparse
 
     from stereovision.cli import metres, positive_metres
@@ -3457,7 +3473,7 @@ def test_every_way_of_typing_a_unit_after_a_metre_value_is_told_to_leave_it_out(
         with pytest.raises(argparse.ArgumentTypeError) as err:
             kind(text)
         assert str(err.value) == (
-            f"expected a number of metres{above} without a unit (5 for 5 m), got {text!r}"
+            f"expected a number of metres{above} without a unit ({hint}), got {text!r}"
         )
     with pytest.raises(argparse.ArgumentTypeError) as err:  # a word is no unit-suffixed number
         positive_metres("far")

@@ -838,8 +838,8 @@ def test_a_bad_size_is_named_by_its_option(
          "got 'two' (see stereovision batch --help)"),
         # a value holding a ' is in double quotes in argparse's words: it kept them all
         (["depth", "l.png", "r.png", "-o", "out", "--max-depth=5'"], "--max-depth: expected a "
-         "number of metres above 0 without a unit (5 for 5 m), got \"5'\" (see stereovision "
-         "depth --help)"),
+         "number of metres above 0 without a unit (5 ft is 1.524 m: give 1.524), got \"5'\" (see "
+         "stereovision depth --help)"),
         (["batch", "in", "-o", "out", "--workers", "2'"], "--workers: expected a whole number "
          "without a unit, got \"2'\" (see stereovision batch --help)"),
     ],

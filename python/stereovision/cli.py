@@ -2284,9 +2284,9 @@ def positive_metres(text: str) -> float:
     except ValueError:
         value = math.nan
     if not (math.isfinite(value) and value > 0):
-        # "5m": the value is metres already; a unit word is what to leave out
-        unit = " without a unit (5 for 5 m)" if _UNIT_SUFFIXED.match(text) else ""
-        raise argparse.ArgumentTypeError(f"expected a number of metres above 0{unit}, got {text!r}")
+        raise argparse.ArgumentTypeError(
+            f"expected a number of metres above 0{_metres_hint(text)}, got {text!r}"
+        )
     return value
 
 
@@ -2296,10 +2296,31 @@ def metres(text: str) -> float:
     try:
         return float(text)
     except ValueError:
-        unit = " without a unit (5 for 5 m)" if _UNIT_SUFFIXED.match(text) else ""
         raise argparse.ArgumentTypeError(
-            f"expected a number of metres{unit}, got {text!r}"
+            f"expected a number of metres{_metres_hint(text)}, got {text!r}"
         ) from None
+
+
+#: The length units typed as a mark: 5' is 5 ft, 5" 5 in.
+_UNIT_MARKS = {"'": "ft", '"': "in"}
+
+
+def _metres_hint(text: str) -> str:
+    """The hint of a metre option's refusal of ``text`` typed with a unit: a positive length in
+    another unit of :data:`~stereovision.calibration.UNIT_TO_METRES` said in metres
+    (``5ft`` -> `` without a unit (5 ft is 1.524 m: give 1.524)``), since "5 for 5 m" sent the
+    user to 5 m; any other unit word ``(5 for 5 m)``; no unit, nothing."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    typed = _UNIT_SUFFIXED.match(text)
+    if typed is None:
+        return ""
+    unit = _UNIT_MARKS.get(typed[3], typed[3].lower())
+    value = float(text.strip()[: -len(typed[3])])
+    if unit == "m" or unit not in UNIT_TO_METRES or not (math.isfinite(value) and value > 0):
+        return " without a unit (5 for 5 m)"
+    shown = f"{value * UNIT_TO_METRES[unit]:g}"
+    return f" without a unit ({value:g} {unit} is {shown} m: give {shown})"
 
 
 def positive_rate(text: str) -> float:
