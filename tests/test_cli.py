@@ -3154,6 +3154,11 @@ def test_calib_help_lists_the_same_formats_for_every_command() -> None:
         said = option_help(command, "--calib")
         assert all(f in said for f in (*formats, "Q.dat", "calibrationdata.tar.gz")), said
     assert ".yaml, .yml, .xml or .json" in option_help("calibrate", "-o")
+    # depth --rectification searches the range rectify stored (rect.max_disparity), which
+    # --max-disparity's help said was estimated from the images
+    assert option_help("depth", "--max-disparity").endswith(
+        "(default: estimated from the images; with --rectification, the search range it holds)"
+    )
 
 
 @pytest.mark.parametrize(

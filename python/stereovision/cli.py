@@ -2650,7 +2650,9 @@ def build_parser() -> argparse.ArgumentParser:
         type=positive_pixels,
         default=None,
         metavar="N",
-        help="disparity range to search, in pixels (default: estimated from the images)",
+        # with --rectification the default is its own range (cmd_depth), not an estimate
+        help="disparity range to search, in pixels (default: estimated from the images; with "
+        "--rectification, the search range it holds)",
     )
     d.add_argument("--method", default=METHODS[0], choices=METHODS, help=_METHOD_HELP)
     # one or the other: both given, the last silently won
