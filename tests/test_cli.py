@@ -3485,6 +3485,29 @@ def test_every_way_of_typing_a_unit_after_a_metre_value_is_told_to_leave_it_out(
     assert str(err.value) == "expected a number of metres above 0, got 'far'"
 
 
+@pytest.mark.parametrize(
+    ("value", "hint"),
+    [
+        ("2ft", "2 ft is 0.6096 m: give 0.6096"),
+        ("-2ft", "-2 ft is -0.6096 m: give -0.6096"),
+        ("50cm", "50 cm is 0.5 m: give 0.5"),
+        ("2m", "5 for 5 m"),
+    ],
+)
+def test_a_view_move_typed_in_feet_is_said_in_metres(
+    value: str, hint: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``view --forward 2ft`` was told "without a unit (5 for 5 m)", 2 m for 0.61; a move
+    either way in another length unit is said in metres, as the metre options say it."""
+    with pytest.raises(SystemExit) as exc:
+        main(["view", "cloud.ply", f"--forward={value}", "-o", "shot.png"])
+    assert exc.value.code == 2
+    assert capsys.readouterr().err == (
+        "stereovision view: error: argument --forward: expected metres from -1e+06 to 1e+06 "
+        f"without a unit ({hint}), got '{value}' (see stereovision view --help)\n"
+    )
+
+
 def _number_options() -> list[tuple[str, str]]:
     """Every (command, option) of the CLI whose value is converted to a number."""
     import argparse

@@ -2246,6 +2246,8 @@ def _with_unit_hint(message: str) -> str:
     if not (isinstance(typed, str) and _UNIT_SUFFIXED.match(typed)):
         return message
     unit = _OPTION_UNITS.get(m[1].split("/")[-1])
+    if unit == "m":  # view's moves, either way: 2ft said in metres, as the metre options say it
+        return f"argument {m[1]}: {m[2]}{_metres_hint(typed, signed=True)}, got {m[3]}"
     example = f" (5 for 5 {unit})" if unit else ""
     return f"argument {m[1]}: {m[2]} without a unit{example}, got {m[3]}"
 
@@ -2305,11 +2307,12 @@ def metres(text: str) -> float:
 _UNIT_MARKS = {"'": "ft", '"': "in"}
 
 
-def _metres_hint(text: str) -> str:
-    """The hint of a metre option's refusal of ``text`` typed with a unit: a positive length in
-    another unit of :data:`~stereovision.calibration.UNIT_TO_METRES` said in metres
-    (``5ft`` -> `` without a unit (5 ft is 1.524 m: give 1.524)``), since "5 for 5 m" sent the
-    user to 5 m; any other unit word ``(5 for 5 m)``; no unit, nothing."""
+def _metres_hint(text: str, signed: bool = False) -> str:
+    """The hint of a metre option's refusal of ``text`` typed with a unit: a positive length
+    (any nonzero one for a ``signed`` option: ``view --forward -2ft``) in another unit of
+    :data:`~stereovision.calibration.UNIT_TO_METRES` said in metres (``5ft`` -> `` without a
+    unit (5 ft is 1.524 m: give 1.524)``), since "5 for 5 m" sent the user to 5 m; any other
+    unit word ``(5 for 5 m)``; no unit, nothing."""
     from stereovision.calibration import UNIT_TO_METRES
 
     typed = _UNIT_SUFFIXED.match(text)
@@ -2317,7 +2320,8 @@ def _metres_hint(text: str) -> str:
         return ""
     unit = _UNIT_MARKS.get(typed[3], typed[3].lower())
     value = float(text.strip()[: -len(typed[3])])
-    if unit == "m" or unit not in UNIT_TO_METRES or not (math.isfinite(value) and value > 0):
+    length = math.isfinite(value) and (value != 0 if signed else value > 0)
+    if unit == "m" or unit not in UNIT_TO_METRES or not length:
         return " without a unit (5 for 5 m)"
     shown = f"{value * UNIT_TO_METRES[unit]:g}"
     return f" without a unit ({value:g} {unit} is {shown} m: give {shown})"
