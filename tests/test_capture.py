@@ -863,6 +863,32 @@ def test_open_failures_name_the_source(tmp_path: Path) -> None:
     assert issubclass(SourceError, OSError)
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX file names are bytes")
+def test_a_source_whose_name_is_not_utf8_is_refused_not_a_crash(tmp_path: Path) -> None:
+    """A video or image sequence whose name holds a byte that is not UTF-8 (a Latin-1 0xFF,
+    os.fsdecode's lone surrogate) crashed the process in OpenCV's argument conversion
+    (SIGSEGV, exit 139, not a word): it is refused, named, before OpenCV sees it."""
+    left, right = _videos(tmp_path, 2, 2)
+    odd = tmp_path / os.fsdecode(b"l\xff.avi")
+    left.rename(odd)
+    folder = Path(_write_sequence(tmp_path / "seq", "right", [_numbered(0)])).parent
+    seq = folder.rename(tmp_path / os.fsdecode(b"s\xff")) / "right_%03d.png"
+    why = "its name holds a byte that is not UTF-8, which OpenCV cannot take; rename it, or "
+    why += "give a link to it with a UTF-8 name"
+    with pytest.raises(SourceError) as info:
+        StereoCamera(odd, right)
+    assert str(info.value) == f"cannot open left source {str(odd)!r}: {why}"
+    assert (info.value.side, info.value.end) == ("left", False)
+    with pytest.raises(SourceError) as info:
+        StereoCamera(right, seq)
+    assert str(info.value) == f"cannot open right source {str(seq)!r}: {why}"
+    with pytest.raises(SourceError, match=r"^cannot open source .*: its name holds a byte"):
+        capmod._open_path(str(seq), (0, str(seq)))  # the GUI's opener too
+    (tmp_path / "l.avi").symlink_to(odd)  # the advice works
+    with StereoCamera(tmp_path / "l.avi", right) as cam:
+        assert cam.read().left.shape == (SMALL[1], SMALL[0], 3)
+
+
 def test_a_second_capture_on_one_camera_reports_its_own_pairs(tmp_path: Path) -> None:
     """A camera kept open for captures one after another (a pair per pose of a script) had
     each result say the camera's pairs since its open: the second capture of 3 pairs said

@@ -1265,6 +1265,23 @@ class _ImageSequence:
         self._open, self._frame = False, None
 
 
+def _refuse_non_utf8(path: str, what: str) -> None:
+    """Raise :class:`SourceError` for a ``path`` that is not UTF-8 text: a file or folder name
+    with a byte of another encoding (a Latin-1 ``\xff``, which :func:`os.fsdecode` gives as the
+    lone surrogate ``\udcff``) crashed the process in OpenCV's conversion of the argument
+    (``cv2.VideoCapture``, ``cv2.imread``: SIGSEGV, exit 139, not a word). ``what`` names the
+    source (``left source``)."""
+    try:
+        path.encode("utf-8")
+    except UnicodeEncodeError:
+        raise SourceError(
+            f"cannot open {what} {_describe_source(path)}: its name holds a byte that is not "
+            "UTF-8, which OpenCV cannot take; rename it, or give a link to it with a UTF-8 name",
+            side=what.split()[0] if what.split()[0] in ("left", "right") else None,
+            end=False,
+        ) from None
+
+
 def _open_path(path: str, first: tuple[int, str] | None) -> Any:
     """``cv2.VideoCapture`` of a file, a URL or an image-sequence pattern (``first``: its
     :func:`_sequence_first`).
@@ -1276,8 +1293,10 @@ def _open_path(path: str, first: tuple[int, str] | None) -> Any:
     ``CAP_IMAGES`` starts a pattern at number 0 or 1 and refuses any ``%`` besides the number's
     (a literal ``%%``, a folder ``100%``): a sequence that starts later, or names a percent
     sign, is read by :class:`_ImageSequence` the same way.
-    The default backend remains for what neither reader opens.
+    The default backend remains for what neither reader opens. A name that is not UTF-8
+    is refused (:func:`_refuse_non_utf8`).
     """
+    _refuse_non_utf8(path, "source")
     # any other "%" (a literal "%%", or a lone one as in a folder "100%") CAP_IMAGES refuses:
     # it takes the path's first "%" for the number and allows no second
     if first is not None and (first[0] > 1 or path.count("%") > 1):
@@ -1728,6 +1747,8 @@ class StereoCamera(PairSource):
                 # found" alone, of a name ls lists: its target is named, as io's readers name it
                 gone = f" ({_broken_link(Path(path))})" if os.path.islink(path) else ""
                 raise FileNotFoundError(f"{side} source not found: {path}{gone}")
+            # before any OpenCV call: such a name crashed the process there
+            _refuse_non_utf8(path, f"{side} source")
             if os.path.isdir(path):  # "cannot open" said nothing of what to give instead
                 raise SourceError(_folder_hint(side, path), side=side, end=False)
             # looked for once: each look at a late start lists the whole folder (0.2 s for
