@@ -1527,6 +1527,30 @@ def test_chessboard_autocapture_saves_distinct_poses_only(
     assert len(list((tmp_path / "cb3").glob("*.png"))) == 6
 
 
+def test_a_board_capture_that_saved_no_pair_says_why(tmp_path: Path) -> None:
+    """capture --chessboard 10x7 of a 9x6 board (its squares counted, the most common slip)
+    said "0 pairs saved (end of stream)" alone; a line now says why no pair was saved and,
+    when the left image shows a board of one corner fewer each way, names that pattern."""
+    # one view for both (the left image decides), at half size: a quick search
+    board = cv2.resize(_board(POSE_A, 0, False), (320, 240), interpolation=cv2.INTER_AREA)
+    left = _write_sequence(tmp_path / "seq", "left", [board])
+    right = _write_sequence(tmp_path / "seq", "right", [board])
+    lines: list[str] = []
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, tmp_path / "a", chessboard="10x7", log=lines.append)
+    assert (result.saved, result.ended) == ([], "end of stream")
+    assert lines == [
+        "no pair saved of the 1 pair judged: no board in left (1 pair); the last left image "
+        "shows a board of 9x6 inner corners: the pattern counts the points where four squares "
+        "meet, one fewer each way than the squares (chessboard=(9, 6), --chessboard 9x6)"
+    ]
+    blank = _write_sequence(tmp_path / "blank", "right", [np.full((240, 320), 60, np.uint8)])
+    lines.clear()
+    with StereoCamera(left, blank) as cam:
+        capture(cam, tmp_path / "b", chessboard="9x6", log=lines.append)
+    assert lines == ["no pair saved of the 1 pair judged: no board in right (1 pair)"]
+
+
 def _still_noisy_sequence(
     data_dir: Path, directory: Path, n: int, shift_per_frame: int = 0
 ) -> tuple[str, str]:

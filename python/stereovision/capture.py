@@ -3147,7 +3147,9 @@ def capture(
     log : callable, optional
         Receives one line per saved pair (with coverage in chessboard mode) and, with
         ``temporal``, one for a mean the source's end (or an interrupt) left unfinished (not
-        saved).
+        saved); with a board, one at the end when no pair was saved, saying why (``no board in
+        left``, counted) and naming the pattern of one corner fewer each way when the last
+        left image shows it (squares counted: ``10x7`` for a board of 9x6 inner corners).
     temporal : int, optional
         Save each pair as the mean of ``temporal`` (2-255) frames of a still view
         (:class:`~stereovision.temporal.TemporalFilter`: a moving rig or board starts the mean
@@ -3248,14 +3250,21 @@ def capture(
     # temporal: how many frames the mean being built holds while it is short of a pair's
     # (None once a pair is taken from it, or without temporal)
     unfinished: float | None = None
+    # with a board, while no pair is saved: why the pairs judged were not, and the last left
+    # image (a capture that found no board said "0 pairs saved" alone, naming no cause)
+    missed: dict[str, int] = {}
+    last_left: np.ndarray | None = None
 
-    def say_unfinished(when: str) -> None:
-        """The frames read since the last pair, dropped without a word before: said."""
+    def say_unsaid(when: str) -> None:
+        """The frames read since the last pair, dropped without a word before, and with a
+        board, why no pair was saved: said."""
         if unfinished is not None and log is not None:
             log(
                 f"not saved: the last mean, of {unfinished:.1f} frames of the {temporal} "
                 f"asked, was unfinished when {when}"
             )
+        if collector is not None and missed and not saved and log is not None:
+            log(_no_board_note(collector, missed, last_left))
 
     def kept_note() -> str:
         if count is not None:
@@ -3276,11 +3285,11 @@ def capture(
             # file read nothing and said "0 pairs saved (end of stream)", exit 0
             if count is None and exc.end and read > 0 and not _device_ended(camera, exc):
                 ended = _end_reason(exc, saved, last_index)
-                say_unfinished("the source ended")
+                say_unsaid("the source ended")
                 break
             # with count too (the end is then an error), or a source's failure: the mean was
             # dropped without a word ("1 of 4 pairs were saved" of 5 frames at temporal=3)
-            say_unfinished("the source ended" if exc.end else "the source failed")
+            say_unsaid("the source ended" if exc.end else "the source failed")
             if exc.end and read == 0 and read_before > 0:
                 raise exc.with_message(
                     f"{exc}, before this capture read a pair (an earlier read of this camera "
@@ -3288,12 +3297,12 @@ def capture(
                 ) from exc
             raise exc.with_message(f"{exc}; {kept_note()}") from exc
         except KeyboardInterrupt:  # Ctrl-C while a frame is awaited (SIGTERM in the CLI)
-            say_unfinished("the capture was interrupted")
+            say_unsaid("the capture was interrupted")
             raise
         except ValueError as exc:
             # a recording's frame that does not decode (BagCamera names its topic and stamp):
             # the pairs saved before it stay, and are said as for a video's failing frame
-            say_unfinished("a frame could not be read")
+            say_unsaid("a frame could not be read")
             if not saved:
                 raise
             raise ValueError(f"{exc}; {kept_note()}") from exc
@@ -3309,7 +3318,7 @@ def capture(
                 left, right = temporal_average(tf, frame)
             except KeyboardInterrupt:
                 # Ctrl-C while a frame was averaged (not awaited) dropped the mean unsaid
-                say_unfinished("the capture was interrupted")
+                say_unsaid("the capture was interrupted")
                 raise
             averaged = tf.mean_frames()
             # Every pixel's mean full but a few that something crossed (or noise beyond 3
@@ -3322,6 +3331,11 @@ def capture(
         if collector is not None:
             decision = collector.consider(frame)
             if not decision.save:
+                if not saved:
+                    # "only 12 corners seen by both cameras": one reason, whatever the count
+                    why = re.sub(r"^only \d+ corners", "too few corners", decision.reason)
+                    missed[why] = missed.get(why, 0) + 1
+                    last_left = frame.left
                 continue
         elif frame.index % every:
             continue
@@ -3372,6 +3386,34 @@ def capture(
         ended=ended,
         removed_temps=stale,
     )
+
+
+def _no_board_note(
+    collector: ChessboardCollector, missed: dict[str, int], last_left: np.ndarray | None
+) -> str:
+    """:func:`capture`'s line for a board capture that saved no pair: why the pairs judged
+    were not saved (``missed``: each reason's count) and, when no left image showed the
+    chessboard, whether the last one shows a board of one corner fewer each way: the pattern
+    counted the squares (10x7 for a board of 9x6 inner corners), the most common slip, which
+    ``calibrate`` names too."""
+    judged = sum(missed.values())
+    reasons = ", ".join(f"{why} ({_pairs(n)})" for why, n in missed.items())
+    note = f"no pair saved of the {_pairs(judged)} judged: {reasons}"
+    cols, rows = collector.pattern
+    fewer = (cols - 1, rows - 1)
+    if (
+        collector.board is None
+        and set(missed) == {"no board in left"}
+        and last_left is not None
+        and min(fewer) >= 3  # calibrate's MIN_PATTERN_CORNERS
+        and detect_board_live(last_left, fewer) is not None
+    ):
+        note += (
+            f"; the last left image shows a board of {fewer[0]}x{fewer[1]} inner corners: the "
+            "pattern counts the points where four squares meet, one fewer each way than the "
+            f"squares (chessboard=({fewer[0]}, {fewer[1]}), --chessboard {fewer[0]}x{fewer[1]})"
+        )
+    return note
 
 
 def _reads_own_output(sources: Any, out: PathLike, ext: str = ".png") -> str | None:
