@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import itertools
 import math
 import os
@@ -1527,12 +1528,17 @@ def test_chessboard_autocapture_saves_distinct_poses_only(
     assert len(list((tmp_path / "cb3").glob("*.png"))) == 6
 
 
+@functools.cache
+def _half_board() -> np.ndarray:
+    """The 9x6 board at POSE_A at half size (320x240): a quick search, rendered once."""
+    return cv2.resize(_board(POSE_A, 0, False), (320, 240), interpolation=cv2.INTER_AREA)
+
+
 def test_a_board_capture_that_saved_no_pair_says_why(tmp_path: Path) -> None:
     """capture --chessboard 10x7 of a 9x6 board (its squares counted, the most common slip)
     said "0 pairs saved (end of stream)" alone; a line now says why no pair was saved and,
     when the left image shows a board of one corner fewer each way, names that pattern."""
-    # one view for both (the left image decides), at half size: a quick search
-    board = cv2.resize(_board(POSE_A, 0, False), (320, 240), interpolation=cv2.INTER_AREA)
+    board = _half_board()  # one view for both (the left image decides)
     left = _write_sequence(tmp_path / "seq", "left", [board])
     right = _write_sequence(tmp_path / "seq", "right", [board])
     lines: list[str] = []
@@ -1549,6 +1555,32 @@ def test_a_board_capture_that_saved_no_pair_says_why(tmp_path: Path) -> None:
     with StereoCamera(left, blank) as cam:
         capture(cam, tmp_path / "b", chessboard="9x6", log=lines.append)
     assert lines == ["no pair saved of the 1 pair judged: no board in right (1 pair)"]
+
+
+def test_a_board_capture_resumed_into_its_folder_judges_against_the_pairs_there(
+    tmp_path: Path,
+) -> None:
+    """A board capture run again into its folder ("run again to add more", as an interrupted
+    one says) judged new poses against none: the pose saved before was saved again, the
+    coverage from 0 %. The pairs there are counted now, and said."""
+    board = _half_board()
+    left = _write_sequence(tmp_path / "seq", "left", [board])
+    right = _write_sequence(tmp_path / "seq", "right", [board])
+    out = tmp_path / "pairs"
+    with StereoCamera(left, right) as cam:
+        assert len(capture(cam, out, chessboard="9x6").saved) == 1
+    lines: list[str] = []
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, out, chessboard="9x6", log=lines.append)
+    assert result.saved == [] and sorted(p.name for p in out.iterdir()) == [
+        "left_0001.png",
+        "right_0001.png",
+    ]
+    bars = "  ".join(f"{k} [----------]   0%" for k in ("x", "y", "size", "skew"))
+    assert lines == [
+        f"1 pair already in {out} with the board: new poses must differ from it too  {bars}",
+        "no pair saved of the 1 pair judged: pose too close to a saved one (1 pair)",
+    ]
 
 
 def _still_noisy_sequence(

@@ -2985,6 +2985,38 @@ class ChessboardCollector:
         except ValueError as exc:
             return str(exc)
 
+    def _pose(self, frame: StereoFrame) -> tuple[float, float, float, float] | str:
+        """The board's ``(x, y, size, skew)`` in ``frame``, or why there is none."""
+        if self.board is not None:
+            return self._charuco_pose(frame)
+        cl = detect_board_live(frame.left, self.pattern)
+        if cl is None:
+            return "no board in left"
+        if detect_board_live(frame.right, self.pattern) is None:
+            return "no board in right"
+        h, w = frame.left.shape[:2]
+        return board_pose_params(cl, self.pattern, (w, h))
+
+    def remember(self, frame: StereoFrame) -> bool:
+        """Count the board's pose in ``frame`` as kept, new or not (a pair saved before, by an
+        earlier capture into the folder).
+
+        Parameters
+        ----------
+        frame : StereoFrame
+            The pair.
+
+        Returns
+        -------
+        bool
+            Whether the board was found in both images (its pose then remembered).
+        """
+        pose = self._pose(frame)
+        if isinstance(pose, str):
+            return False
+        self.kept.append(pose)
+        return True
+
     def consider(self, frame: StereoFrame) -> Decision:
         """Decide whether ``frame`` is worth saving; a kept pose is remembered.
 
@@ -3000,19 +3032,10 @@ class ChessboardCollector:
             board in a view, too few corners, a pose too close to a kept one); ``params`` the
             pose's ``(x, y, size, skew)`` when the board was found.
         """
-        if self.board is not None:
-            pose = self._charuco_pose(frame)
-            if isinstance(pose, str):
-                return Decision(False, pose)
-            p = pose
-        else:
-            cl = detect_board_live(frame.left, self.pattern)
-            if cl is None:
-                return Decision(False, "no board in left")
-            if detect_board_live(frame.right, self.pattern) is None:
-                return Decision(False, "no board in right")
-            h, w = frame.left.shape[:2]
-            p = board_pose_params(cl, self.pattern, (w, h))
+        pose = self._pose(frame)
+        if isinstance(pose, str):
+            return Decision(False, pose)
+        p = pose
         if self.kept:
             nearest = min(sum(abs(a - b) for a, b in zip(p, q, strict=True)) for q in self.kept)
             if nearest <= self.min_distance:
@@ -3123,7 +3146,9 @@ def capture(
     camera : StereoCamera
     directory : str or os.PathLike
         Created if missing; numbering continues after pairs already there (none is overwritten).
-        Temporary files a killed capture left there are removed first (said to ``log``).
+        With a board, their poses count as saved ones (a capture resumed into its folder saves
+        only poses new to it; said to ``log``). Temporary files a killed capture left there
+        are removed first (said to ``log``).
     count : int, optional
         Pairs to save. Without it, capture runs until a source ends (normal for files); when
         one ends before the other, or a video file before the frames its header announces
@@ -3239,6 +3264,16 @@ def capture(
             f"capture left in {escaped(str(out))}: {', '.join(stale)}"
         )
     index = next_pair_index(out)
+    if collector is not None and index > 1:
+        # a capture resumed into its folder ("run again to add more") judged new poses
+        # against none: the poses saved before were saved again, the coverage from 0 %
+        seen = _remember_saved_poses(collector, out)
+        if seen and log is not None:
+            log(
+                f"{_pairs(seen)} already in {escaped(str(out))} with the board: new poses "
+                f"must differ from {'it' if seen == 1 else 'them'} too  "
+                + collector.format_progress()
+            )
     saved: list[tuple[Path, Path]] = []
     ended = "count reached"
     last_index = -1  # the frame index of the pair saved last
@@ -3332,8 +3367,10 @@ def capture(
             decision = collector.consider(frame)
             if not decision.save:
                 if not saved:
-                    # "only 12 corners seen by both cameras": one reason, whatever the count
+                    # "only 12 corners seen by both cameras", "pose too close to a saved one
+                    # (0.012)" (one resumed): one reason each, whatever the number
                     why = re.sub(r"^only \d+ corners", "too few corners", decision.reason)
+                    why = re.sub(r" \([\d.]+\)$", "", why)
                     missed[why] = missed.get(why, 0) + 1
                     last_left = frame.left
                 continue
@@ -3386,6 +3423,27 @@ def capture(
         ended=ended,
         removed_temps=stale,
     )
+
+
+def _remember_saved_poses(collector: ChessboardCollector, out: Path) -> int:
+    """Give ``collector`` the board poses of the pairs already in ``out`` (saved by an earlier
+    capture: ``left_0001.png`` with ``right_0001.png``); the number of pairs whose board it
+    found. An image that does not read is passed over."""
+    from stereovision.io import read_image
+
+    names = {p.name for p in out.iterdir()}
+    found = 0
+    for name in sorted(names):
+        m = _PAIR_RE.match(name)
+        other = "right" + name[len("left") :]
+        if m is None or m.group(1) != "left" or other not in names:
+            continue
+        try:
+            left, right = read_image(out / name), read_image(out / other)
+        except (OSError, ValueError):  # damaged, or not an image: no pose to count
+            continue
+        found += collector.remember(StereoFrame(left, right, 0.0, 0.0, 0))
+    return found
 
 
 def _no_board_note(
