@@ -174,6 +174,23 @@ def test_compressed_images(cones: Any) -> None:
         decode_image(_Msg(format="jpeg", data=np.zeros(50, np.uint8)))
 
 
+def test_messages_holding_their_data_as_bytes_decode() -> None:
+    # rospy's messages hold uint8[] as bytes: np.asarray read them as one number ("invalid
+    # literal for int()", the whole image quoted)
+    small = np.random.default_rng(3).integers(0, 256, (6, 8, 3), dtype=np.uint8)
+    f = _image_fields(small, "bgr8", pad=3)
+    out = decode_image(_Msg(**{**f, "data": f["data"].tobytes()}))
+    np.testing.assert_array_equal(out, small)
+    assert out.flags.writeable
+    g16 = small[..., 1].astype(np.uint16) << 4
+    f16 = _image_fields(g16, "mono16", big=True)
+    out16 = decode_image(_Msg(**{**f16, "data": bytearray(f16["data"].tobytes())}))
+    np.testing.assert_array_equal(out16[..., 0], g16)
+    _ok, png = cv2.imencode(".png", small)
+    out_png = decode_image(_Msg(format="bgr8; png compressed bgr8", data=png.tobytes()))
+    np.testing.assert_array_equal(out_png, small)
+
+
 def test_bad_image_messages(cones: Any) -> None:
     f = _image_fields(cones.left, "bgr8")
     with pytest.raises(ValueError, match="'32FC1' is not a camera image"):

@@ -1022,13 +1022,23 @@ def bag_topics(path: str | os.PathLike[str]) -> str:
         reader.close()
 
 
+def _message_bytes(data: Any) -> np.ndarray:
+    """A message's ``data`` as a flat ``uint8`` array: rosbags' arrays, and the ``bytes`` of
+    rospy's messages (np.asarray read those as one number: "invalid literal for int()", the
+    whole image quoted)."""
+    if isinstance(data, (bytes, bytearray, memoryview)):
+        return np.frombuffer(data, np.uint8).copy()  # a copy: the image comes out writable
+    return np.asarray(data, np.uint8).reshape(-1)
+
+
 def decode_image(msg: Any) -> np.ndarray:
     """A ``sensor_msgs/Image`` or ``CompressedImage`` message as a BGR image.
 
     Parameters
     ----------
     msg : object
-        The deserialised message (``rosbags``' classes, or anything with the same fields).
+        The deserialised message (``rosbags``' classes, or anything with the same fields:
+        rospy's and rclpy's messages, ``data`` as ``bytes`` or an array of bytes).
 
     Returns
     -------
@@ -1050,7 +1060,7 @@ def decode_image(msg: Any) -> np.ndarray:
             raise ValueError(f"compressed image format {fmt!r} is a depth image, not a camera's")
         from stereovision.io import _imdecode  # cv2.error for a header of an impossible size
 
-        buf = np.asarray(msg.data, np.uint8).reshape(-1)
+        buf = _message_bytes(msg.data)
         img = _imdecode(buf, cv2.IMREAD_UNCHANGED) if buf.size else None
         if img is None:
             raise ValueError(f"compressed image ({fmt!r}, {buf.size} bytes) does not decode")
@@ -1074,7 +1084,7 @@ def decode_image(msg: Any) -> np.ndarray:
         )
     ch, nbytes, code = spec
     h, w, step = int(msg.height), int(msg.width), int(msg.step)
-    data = np.asarray(msg.data, np.uint8).reshape(-1)
+    data = _message_bytes(msg.data)
     row = w * ch * nbytes
     if h <= 0 or w <= 0 or step < row or data.size < step * h:
         raise ValueError(
