@@ -1780,6 +1780,32 @@ def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
         assert found == {"old/0002", "out/0001/disparity", "out/0001/overview"}
 
 
+def test_outputs_written_into_the_input_are_not_reported_as_half_pairs(tmp_path: Path) -> None:
+    """``batch 00 -o 00`` (-o given as the input) over a KITTI sequence of two rigs: each
+    pair's folder lies in its left camera folder (00/image_0/000000/), and the next run
+    reported its disparity.png and overview.png as images without their pair ("no
+    00/image_1/000000/disparity.png for ..."), exit 1 every run. They are the run's own; an
+    image there under another name, and the same files with another -o, are reported."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "00"
+    img = np.zeros((4, 6), np.uint8)
+    for cam in range(4):
+        (root / f"image_{cam}").mkdir(parents=True)
+        cv2.imwrite(str(root / f"image_{cam}/000000.png"), img)
+    for cam in (0, 2):
+        (root / f"image_{cam}/000000").mkdir()
+        for f in ("disparity.png", "overview.png", "mine.png"):
+            cv2.imwrite(str(root / f"image_{cam}/000000/{f}"), img)
+    jobs, unpaired, _ = _scan(root, output=root)
+    assert [j.name for j in jobs] == ["image_0/000000", "image_2/000000"]
+    assert [u.name for u in unpaired] == ["image_0/000000/mine", "image_2/000000/mine"]
+    # the same files with the outputs elsewhere: images of the input, reported as before
+    found = sorted(u.name for u in _scan(root, output=tmp_path / "o")[1])
+    assert found == [f"image_{c}/000000/{f}" for c in (0, 2) for f in ("disparity", "mine",
+                                                                        "overview")]  # fmt: skip
+
+
 def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_listed(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, in_process_dask: None
 ) -> None:

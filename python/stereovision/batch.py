@@ -409,6 +409,17 @@ def _scan(
         used.add(name)
         unique.append(j if n == 1 else PairJob(name, j.left, j.right, j.calib))
     unique.sort(key=lambda j: j.name)
+    if output is not None:
+        # -o given as the input (or above it): a pair's output folder inside a camera folder
+        # (KITTI's 00/image_0/000000/, a sequence of two rigs) held its disparity.png and
+        # overview.png, each reported on the next run as an image without its pair (exit 1)
+        from stereovision.cli import DEPTH_OUTPUTS
+
+        outs = {os.path.realpath(Path(output) / j.name) for j in unique}
+        mine = [u for u in unpaired + cam_unpaired if u.present.name in DEPTH_OUTPUTS]
+        ours = {id(u) for u in mine if os.path.realpath(u.present.parent) in outs}
+        unpaired = [u for u in unpaired if id(u) not in ours]
+        cam_unpaired = [u for u in cam_unpaired if id(u) not in ours]
     # the pairs keep the names they had before these were reported; these take the next ones
     taken = {j.name for j in unique}
     named: list[_Unpaired] = []
