@@ -1780,6 +1780,37 @@ def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
         assert found == {"old/0002", "out/0001/disparity", "out/0001/overview"}
 
 
+def test_a_folder_that_cannot_be_listed_is_warned_of(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A sub-folder of the input that cannot be listed (no permission: a copy from another
+    user, mode 700) was passed over by os.walk without a word, its pairs left out of a run
+    that said '1 processed' and exit 0. It is warned of, naming it; the others pair as before."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "in"
+    img = np.zeros((4, 6), np.uint8)
+    for scene in ("a", "locked"):
+        (root / scene).mkdir(parents=True)
+        for side in ("left", "right"):
+            cv2.imwrite(str(root / scene / f"{side}.png"), img)
+    listing = os.scandir
+
+    def scandir(path: Any = ".") -> Any:
+        if os.fspath(path) == str(root / "locked"):  # root may read any folder: as a user can't
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    with pytest.warns(UserWarning) as said:
+        jobs, unpaired, _ = _scan(root)
+    assert [j.name for j in jobs] == ["a"] and unpaired == []
+    assert [str(w.message) for w in said] == [
+        f"cannot search folder {root / 'locked'}: Permission denied; the pairs in it, if any, "
+        "are left out"
+    ]
+
+
 def test_outputs_written_into_the_input_are_not_reported_as_half_pairs(tmp_path: Path) -> None:
     """``batch 00 -o 00`` (-o given as the input) over a KITTI sequence of two rigs: each
     pair's folder lies in its left camera folder (00/image_0/000000/), and the next run

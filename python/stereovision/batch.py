@@ -271,6 +271,12 @@ def find_pairs(
         If ``root`` (or ``calib``) does not exist.
     NotADirectoryError
         If ``root`` is not a folder.
+
+    Warns
+    -----
+    UserWarning
+        For a folder under ``root`` that cannot be listed (no permission), named: its pairs,
+        if any, are left out.
     """
     return _scan(root, calib)[0]
 
@@ -518,6 +524,18 @@ def _output_below(root: Path, output: str | os.PathLike[str] | None) -> frozense
     return frozenset({out}) if below else frozenset()
 
 
+def _not_listed(err: OSError) -> None:
+    """Warn of a folder :func:`_walk` cannot list: os.walk passed over it (no permission, an
+    I/O error) without a word, its pairs left out of a run that said nothing was missing."""
+    from stereovision._validate import escaped
+
+    warnings.warn(
+        f"cannot search folder {escaped(str(err.filename))}: {err.strerror or err}; the pairs "
+        "in it, if any, are left out",
+        stacklevel=2,
+    )
+
+
 def _walk(
     top: Path, skip: frozenset[str] = frozenset()
 ) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
@@ -531,10 +549,11 @@ def _walk(
     search is their own). Hidden folders (``.git``, ``.Trash``) are not entered: a hidden
     link sorted first claimed the folder a visible link also named, and the caller's skip of
     hidden folders then dropped the folder's scenes (``.cache -> /d/s`` beside ``s -> /d/s``).
-    Folders whose real path is in ``skip`` (the output folder) are not entered either."""
+    Folders whose real path is in ``skip`` (the output folder) are not entered either. A
+    folder that cannot be listed is warned of (:func:`_not_listed`)."""
     top_real = os.path.realpath(top)
     seen = {top_real}
-    for d, dirs, files in os.walk(top, followlinks=True):
+    for d, dirs, files in os.walk(top, followlinks=True, onerror=_not_listed):
         listed = list(dirs)
         keep = []
         # in name order, so that of two links to one folder the same one names its pairs on
