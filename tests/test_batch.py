@@ -1780,6 +1780,35 @@ def test_an_output_folder_inside_the_input_is_not_searched_for_pairs(
         assert found == {"old/0002", "out/0001/disparity", "out/0001/overview"}
 
 
+def test_a_left_camera_folder_without_its_right_one_is_reported(tmp_path: Path) -> None:
+    """seq/left/ without seq/right/ at all (a copy cut short) was passed over without a word,
+    where a right/ short of some images has each reported; its images are half pairs now.
+    A lone cam0/ or image_2/ (a mono recording, KITTI's object benchmark) still is no pair."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "in"
+    img = np.zeros((4, 6), np.uint8)
+    for f in (
+        "a/left.png",
+        "a/right.png",
+        "seq/left/0001.png",
+        "seq/left/0002.png",
+        "mono/cam0/0001.png",
+        "kitti/image_2/000000_10.png",
+        "tartan/image_Right/9.png",
+    ):
+        (root / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(root / f), img)  # fmt: skip
+    jobs, unpaired, _ = _scan(root)
+    assert [j.name for j in jobs] == ["a"]
+    assert [(u.name, u.error) for u in unpaired] == [
+        ("seq/0001", f"unpaired image: no {root}/seq/right/0001.png for {root}/seq/left/0001.png"),
+        ("seq/0002", f"unpaired image: no {root}/seq/right/0002.png for {root}/seq/left/0002.png"),
+        ("tartan/9", f"unpaired image: no {root}/tartan/image_Left/9.png for "
+                     f"{root}/tartan/image_Right/9.png"),
+    ]  # fmt: skip
+
+
 def test_a_folder_that_cannot_be_listed_is_warned_of(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -113,6 +113,10 @@ CAMERA_FOLDERS = (
     # paired by number): each image was "unpaired" (no 000000_right.png beside it)
     ("image_left", "image_right"),
 )
+#: Camera folders named for their side, whose images are reported as half pairs when the
+#: other side's folder is not there (the other :data:`CAMERA_FOLDERS` alone may be a mono
+#: recording's: EuRoC's cam0/, KITTI's image_2/ of its object benchmark).
+_SIDED_FOLDERS = ("left", "right", "image_left", "image_right")
 _GONE = "its outputs were gone at the end of the run (the output folder moved or deleted?)"
 
 
@@ -323,6 +327,7 @@ def _scan(
     cam_unpaired: list[_Unpaired] = []
     cam_taken: set[Path] = set()  # named images paired (or reported) across camera folders
     cam_images: set[Path] = set()  # every image of a camera folder's pair or half pair
+    lone_unpaired: list[_Unpaired] = []  # the images of a left/ without its right/ (or so)
     skip = _output_below(r, output)
     for d, _dirs, files, listed in _walk(r, skip):
         dirs = sorted(_dirs)
@@ -398,9 +403,29 @@ def _scan(
             cam_taken |= by_number
             cam_images |= {x for j in pairs for x in (j.left, j.right)}
             cam_images |= {u.present for u in alone}
+        # a folder named for its camera's side (left/, image_left/) without its sibling at all
+        # (a copy cut short): its images were left out without a word, where a right/ folder
+        # short of some of them has each reported. Not cam0/, L/, image_2/ alone: a mono
+        # recording, KITTI's left images alone (its object benchmark), are no half pairs
+        spelt = {x.lower(): x for x in listed if not x.startswith(".")}
+        for lone in (x for x in _SIDED_FOLDERS if x in spelt):
+            cam = spelt[lone]
+            m = _last_left(cam) or _last(_RIGHT_RE, cam)
+            assert m is not None
+            side = "left" if m.group(0).lower() == "left" else "right"
+            other = _swap(Path(cam), m, "right" if side == "left" else "left").name
+            if other.lower() in spelt or sum(x.lower() == lone for x in listed) > 1:
+                continue  # paired above (or two spellings, not guessed)
+            for f in sorted(_camera_images(here / cam, skip)):
+                short = f.rsplit(".", 1)[0]
+                name = "/".join(x for x in (rel, short) if x not in ("", "."))
+                lone_unpaired.append(_Unpaired(name, here / cam / f, here / other / f, side))
     # after the other layouts' pairs, so that those keep their names in a clash (the sort is
     # stable): camera folders' images were not pairs before
     found += cam_found
+    # an image of a lone left/ that is a pair of its own (left/im0.png + im1.png) is no half
+    in_pairs = {x for j in found for x in (j.left, j.right)}
+    cam_unpaired += [u for u in lone_unpaired if u.present not in in_pairs]
     found.sort(key=lambda j: j.name)
     # a clash takes the next suffix no pair has: x~2 beside a folder x~2 of its own made two
     # pairs x~2, one output folder and one summary entry
