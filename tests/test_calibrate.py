@@ -2274,6 +2274,71 @@ def test_calibration_from_a_camera_checks_min_distance_before_opening_it(
     assert opened == []
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "error", "words"),
+    [
+        ({}, ValueError, "square_size: required for a chessboard (the side of one square)"),
+        (
+            {"square_size": 1.0, "unit": "parsec"},
+            ValueError,
+            "unit: expected one of ['m', 'mm', 'cm', 'ft', 'in'], got 'parsec'",
+        ),
+        (
+            {"square_size": 1e12, "unit": "mm"},
+            ValueError,
+            "square_size: 1e+12 mm is 1e+09 m; expected a board square between 1 nm and 100 m",
+        ),
+        (
+            {"square_size": 1.0, "distortion": "k3"},
+            ValueError,
+            "distortion: expected 'auto', 'fisheye' or one of ['k1k2', 'k1k2p1p2', "
+            "'k1k2p1p2k3', 'rational'], got 'k3'",
+        ),
+        (
+            {"square_size": 1.0, "pattern": "9x"},
+            ValueError,
+            "pattern: expected inner corners as COLSxROWS (e.g. 9x6), got '9x'",
+        ),
+        (
+            {"square_size": 1.0, "drop_outlier": True},
+            TypeError,
+            "{}() got an unexpected keyword argument 'drop_outlier'",
+        ),
+        (
+            {"square_size": 1.0, "names": ["a"]},
+            TypeError,
+            "{}() got an unexpected keyword argument 'names'",
+        ),
+    ],
+)
+def test_calibration_from_a_camera_checks_calibrates_arguments_before_opening_it(
+    monkeypatch: pytest.MonkeyPatch, kwargs: dict[str, Any], error: type, words: str
+) -> None:
+    """calibrate_from_video and calibrate_from_bag passed pattern, square_size, unit and
+    distortion on to calibrate, which refused a square_size left out (or a unit, a model, a
+    keyword mistyped) only once every frame of the recording was read: the board waved in front
+    of live cameras for nothing. They are refused first, in calibrate's words."""
+    import stereovision.capture as capmod
+    import stereovision.rosbag as rosmod
+
+    opened: list[object] = []
+
+    def opener(*args: Any, **kw: Any) -> Any:
+        opened.append(args)
+        raise AssertionError("opened")
+
+    monkeypatch.setattr(capmod, "StereoCamera", opener)
+    monkeypatch.setattr(rosmod, "BagCamera", opener)
+    for name, call in (
+        ("calibrate_from_video", lambda: calibrate_from_video(0, 1, **kwargs)),
+        ("calibrate_from_bag", lambda: calmod.calibrate_from_bag("x.bag", **kwargs)),
+    ):
+        with pytest.raises(error) as err:
+            call()
+        assert str(err.value) == words.format(name)
+    assert opened == []
+
+
 class _HungDevice:
     """A ``cv2.VideoCapture`` stand-in of a hung camera: its open (``opens`` False) or its grab
     never returns until ``unplug`` is set (3 s at most, so that the old code's test ends)."""

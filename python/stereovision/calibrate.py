@@ -1558,40 +1558,10 @@ def calibrate(
     >>> len(rep.used_pairs), rep.rms < 0.3
     (4, True)
     """
-    from stereovision._validate import known_unit, positive_finite
-    from stereovision.calibration import UNIT_TO_METRES, Calibration
+    from stereovision.calibration import Calibration
     from stereovision.charuco import corners_span_plane, find_charuco_corners
 
-    if board is not None:
-        _check_board(board)
-        if square_size is not None and positive_finite(square_size, "square_size") != float(
-            board.square_size
-        ):
-            raise ValueError(
-                f"square_size: {square_size:g} differs from the board's {board.square_size:g}; "
-                "give the size once, in the board"
-            )
-        pat = board.inner
-        square = float(board.square_size)
-    else:
-        pat = parse_pattern(pattern)
-        if square_size is None:
-            raise ValueError("square_size: required for a chessboard (the side of one square)")
-        square = positive_finite(square_size, "square_size")
-    unit = known_unit(unit, UNIT_TO_METRES)
-    # The board's corners are float32 for OpenCV: 1e308 overflowed them into inf and the solver
-    # failed an assertion. No printed or built board has squares outside these bounds.
-    metres = square * UNIT_TO_METRES[unit]
-    if not 1e-9 <= metres <= 100.0:
-        raise ValueError(
-            f"square_size: {square:g} {unit} is {metres:g} m; expected a board square between "
-            "1 nm and 100 m"
-        )
-    if distortion not in ("auto", "fisheye") and distortion not in DISTORTION_MODELS:
-        raise ValueError(
-            f"distortion: expected 'auto', 'fisheye' or one of {list(DISTORTION_MODELS)}, got "
-            f"{distortion!r}"
-        )
+    pat, square, unit = _board_setup(pattern, square_size, board, unit, distortion)
     for name, given in (("left_images", left_images), ("right_images", right_images)):
         if isinstance(given, (str, bytes, os.PathLike)):  # one path: list() would split it
             raise TypeError(
@@ -2021,6 +1991,83 @@ def calibrate(
     return cal, report
 
 
+def _board_setup(
+    pattern: tuple[int, int] | str,
+    square_size: float | None,
+    board: CharucoBoard | None,
+    unit: str,
+    distortion: str,
+) -> tuple[tuple[int, int], float, str]:
+    """:func:`calibrate`'s checks of its board, square, unit and distortion model.
+
+    Returns
+    -------
+    tuple
+        The inner corners ``(cols, rows)``, the square side and the unit (a plain str).
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`calibrate` says of these arguments.
+    """
+    from stereovision._validate import known_unit, positive_finite
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if board is not None:
+        _check_board(board)
+        if square_size is not None and positive_finite(square_size, "square_size") != float(
+            board.square_size
+        ):
+            raise ValueError(
+                f"square_size: {square_size:g} differs from the board's {board.square_size:g}; "
+                "give the size once, in the board"
+            )
+        pat = board.inner
+        square = float(board.square_size)
+    else:
+        pat = parse_pattern(pattern)
+        if square_size is None:
+            raise ValueError("square_size: required for a chessboard (the side of one square)")
+        square = positive_finite(square_size, "square_size")
+    unit = known_unit(unit, UNIT_TO_METRES)
+    # The board's corners are float32 for OpenCV: 1e308 overflowed them into inf and the solver
+    # failed an assertion. No printed or built board has squares outside these bounds.
+    metres = square * UNIT_TO_METRES[unit]
+    if not 1e-9 <= metres <= 100.0:
+        raise ValueError(
+            f"square_size: {square:g} {unit} is {metres:g} m; expected a board square between "
+            "1 nm and 100 m"
+        )
+    if distortion not in ("auto", "fisheye") and distortion not in DISTORTION_MODELS:
+        raise ValueError(
+            f"distortion: expected 'auto', 'fisheye' or one of {list(DISTORTION_MODELS)}, got "
+            f"{distortion!r}"
+        )
+    return pat, square, unit
+
+
+def _check_calibrate_args(
+    caller: str,
+    pattern: tuple[int, int] | str,
+    square_size: float | None,
+    board: CharucoBoard | None,
+    kwargs: dict[str, Any],
+) -> None:
+    """The arguments a recording's frames are given to :func:`calibrate` with, checked before
+    the recording is opened: a square_size left out, a unit or a distortion model mistyped (or
+    a keyword calibrate does not take) was refused by calibrate once every frame was read, the
+    board waved in front of live cameras for nothing."""
+    import inspect
+
+    params = inspect.signature(calibrate).parameters
+    ours = {"left_images", "right_images", "pattern", "square_size", "board", "names"}
+    for key in kwargs:
+        if key not in params or key in ours:  # names: the frames are named frame_NNNNN
+            raise TypeError(f"{caller}() got an unexpected keyword argument {key!r}")
+    unit, distortion = (kwargs.get(k, params[k].default) for k in ("unit", "distortion"))
+    _board_setup(pattern, square_size, board, unit, distortion)
+
+
 def _weighted_rms(per_view: npt.ArrayLike, counts: Sequence[int]) -> float:
     """The RMS over all points of views whose own RMS are ``per_view``, ``counts`` points each.
 
@@ -2097,12 +2144,15 @@ def calibrate_from_video(
         If a source cannot be opened, or does not open or deliver a pair within
         ``read_timeout`` s (:class:`stereovision.capture.SourceError`, an OSError).
     TypeError
-        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`.
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, or a
+        keyword is not one of :func:`calibrate`'s (``names`` included: the frames name the
+        pairs), before a camera is opened.
     ValueError
         As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
         a ``max_pairs`` below :data:`MIN_PAIRS`, a ``min_distance`` that is not a finite number
         of 0 or more, or a ``read_timeout`` that is not a positive number of seconds (or None),
-        each before a camera is opened.
+        each before a camera is opened, as are calibrate's checks of ``pattern``,
+        ``square_size`` (required for a chessboard), ``unit`` and ``distortion``.
     """
     from stereovision.capture import StereoCamera, check_min_distance, check_read_timeout
 
@@ -2113,6 +2163,8 @@ def calibrate_from_video(
     if min_distance is not None:  # as board: a negative one was refused once both were open
         check_min_distance(min_distance)
     check_read_timeout(read_timeout)
+    # a square_size left out (a unit mistyped) was refused once the whole recording was read
+    _check_calibrate_args("calibrate_from_video", pattern, square_size, board, kwargs)
 
     # as given: StereoCamera takes paths and indexes (a str() made np.int64(1) the file "1")
     cam = StereoCamera(left, right, open_timeout=read_timeout)
@@ -2167,9 +2219,11 @@ def calibrate_from_bag(
     FileNotFoundError
         If the bag does not exist.
     TypeError
-        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`.
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, or a
+        keyword is not one of :func:`calibrate`'s, before the bag is opened.
     ValueError
-        As :class:`~stereovision.rosbag.BagCamera` and :func:`calibrate`.
+        As :class:`~stereovision.rosbag.BagCamera` and :func:`calibrate` (its checks of
+        ``pattern``, ``square_size``, ``unit`` and ``distortion`` before the bag is opened).
     """
     from stereovision.capture import check_min_distance
     from stereovision.rosbag import BagCamera
@@ -2178,6 +2232,8 @@ def calibrate_from_bag(
     max_pairs = _check_max_pairs(max_pairs)
     if min_distance is not None:  # before the bag is read, as board
         check_min_distance(min_distance)
+    # a square_size left out (a unit mistyped) was refused once the whole bag was read
+    _check_calibrate_args("calibrate_from_bag", pattern, square_size, board, kwargs)
     cam = BagCamera(path, left_topic=left_topic, right_topic=right_topic, max_skew_ms=max_skew_ms)
     return _calibrate_from_camera(
         cam,
