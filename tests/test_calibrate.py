@@ -1959,6 +1959,27 @@ def test_cli_an_output_fifo_is_refused_before_the_work(
     assert sorted(os.listdir(tmp_path)) == ["link.yaml", "pipe.yaml"] and not fifo.is_file()
 
 
+def test_names_of_another_count_are_refused_before_the_boards_are_looked_for(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """names= of another length than the pairs was refused only after every pair's board
+    search (8.8 s for 4 of OpenCV's pairs, a minute for 30), and one string named the pairs by
+    its letters ('abc' for 3 pairs: 'a', 'b', 'c'). Both are refused before any image is read."""
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the boards were looked for before names was checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    monkeypatch.setattr(calmod, "_load_gray", no_work)
+    blank = np.full((120, 160), 128, np.uint8)
+    with pytest.raises(ValueError) as err:
+        calibrate([blank] * 4, [blank] * 4, square_size=1.0, names=["a"])
+    assert str(err.value) == "names: expected 4 names (one per pair), got 1"
+    with pytest.raises(TypeError) as terr:
+        calibrate([blank] * 3, [blank] * 3, square_size=1.0, names="abc")  # type: ignore[arg-type]
+    assert str(terr.value) == "names: expected one name per pair, got one name 'abc'"
+
+
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:
     """A third mutation audit found unasserted: "9*6" read as 9x6, a square of exactly 100 m and
     1 nm taken (the refusal is outside them), names= of another length than the pairs refused by

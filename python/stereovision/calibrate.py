@@ -1509,7 +1509,8 @@ def calibrate(
         Drop the outlier pairs (error > :data:`OUTLIER_FACTOR` x median and >
         :data:`OUTLIER_MIN_PX`) and solve again; otherwise they are only reported.
     names : sequence of str, optional
-        Pair names for the report (default: the file names, or ``pair_NN`` for arrays).
+        Pair names for the report, one per pair (default: the file names, or ``pair_NN`` for
+        arrays).
     progress : callable, optional
         Called as ``progress(stage, done, total)`` while the work goes on (``stereovision
         calibrate`` draws its progress bars with it): stage :data:`PROGRESS_BOARDS` after each
@@ -1529,7 +1530,7 @@ def calibrate(
         If an image file does not exist (the message names it).
     TypeError
         If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard` (a
-        chessboard's ``"9x6"`` goes in ``pattern``).
+        chessboard's ``"9x6"`` goes in ``pattern``), or ``names`` is one string.
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
@@ -1575,6 +1576,13 @@ def calibrate(
         )
     if not lefts:
         raise ValueError("no image pairs given")
+    if names is not None:
+        # before the boards are looked for (a minute for 30 pairs), not after, as it was
+        if isinstance(names, (str, bytes)):  # list() would name the pairs by its letters
+            raise TypeError(f"names: expected one name per pair, got one name {names!r}")
+        names = list(names)
+        if len(names) != len(lefts):
+            raise ValueError(f"names: expected {len(lefts)} names (one per pair), got {len(names)}")
 
     size: tuple[int, int] | None = None
     first_name = ""
