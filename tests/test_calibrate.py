@@ -411,6 +411,27 @@ def test_outlier_reported_but_kept_without_drop(
     assert "outlier kept" in rep.summary()
 
 
+def test_the_reports_rectified_pair_is_one_the_solution_uses(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
+    synthetic_dropped: tuple[Calibration, CalibrationReport],  # its corners cached
+    cached_corners: None,
+) -> None:
+    """The report's rectified pair was the first pair whose boards were found, even when
+    drop_outliers then dropped it: report.html showed 'rectified pair shifted', its rows 8 mm of
+    rig apart, as if the calibration did not rectify. It is the first pair used now."""
+    left, right, names = synthetic
+    keep = [-1, 0, 1, 2, 3, 4]  # the shifted pair first, five good ones
+    _, rep = calibrate(
+        [left[k] for k in keep], [right[k] for k in keep], pattern=SYN_PATTERN,
+        square_size=SYN_SQUARE, drop_outliers=True, names=[names[k] for k in keep],
+        distortion="k1k2p1p2", refine=False,
+    )  # fmt: skip
+    assert list(rep.rejected_pairs) == ["shifted"] and rep.used_pairs[0] == "good00"
+    assert rep._sample is not None and rep._sample[0] == "good00"
+    np.testing.assert_array_equal(rep._sample[1], left[0])
+    np.testing.assert_array_equal(rep._sample[2], right[0])
+
+
 def test_find_corners_matches_projection() -> None:
     rv, tv = np.array([0.3, -0.2, 0.1]), np.array([-0.12, -0.07, 0.5])
     img = render_chessboard(

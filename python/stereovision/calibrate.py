@@ -1953,6 +1953,11 @@ def calibrate(
     cov_l = _coverage_mask(used_l, pat, size)
     cov_r = _coverage_mask(used_r, pat, size)
     names_used = [pair_names[i] for i in used]
+    if sample is not None and sample[0] not in used:
+        # the report's rectified pair was an outlier dropped (or a view the fisheye solver
+        # could not start from): its misaligned rows looked like the calibration's failure
+        first = used[0]
+        sample = (first, _load_gray(lefts[first], "")[0], _load_gray(rights[first], "")[0])
     report = CalibrationReport(
         rms=sol.rms,
         rms_left=sol.rms_left,
