@@ -1837,6 +1837,25 @@ def test_an_outlier_is_dropped_when_exactly_the_minimum_remains(
     assert "outlier kept" not in rep.summary()
 
 
+def test_an_outlier_drop_outliers_keeps_is_said_why_not_to_drop_it(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """drop_outliers=True (--drop-outliers) keeps an outlier whose drop would leave fewer than
+    MIN_PAIRS pairs; the summary told the reader to 'drop it with --drop-outliers', the option
+    given. It says why it was kept now (without drop_outliers the advice stays: see
+    test_outlier_rule_and_per_pair_figures_on_given_errors)."""
+    left, right = _chessboard_paths()
+    _solve_with_errors(monkeypatch, {3: np.array([[0.2, 0.2]] * 2 + [[4.0, 4.0]])})
+    _, rep = calibrate(
+        left[:3], right[:3], square_size=1.0, distortion="k1k2p1p2", refine=False,
+        drop_outliers=True, names=["a", "b", "c"],
+    )  # fmt: skip
+    assert rep.used_pairs == ["a", "b", "c"] and rep.outlier_pairs == ["c"]
+    assert rep.summary(drop_option="--drop-outliers").endswith(
+        "  outlier kept: c (dropping it would leave 2 pairs, fewer than the 3 needed)"
+    )
+
+
 def test_report_square_sides_yml_and_the_unit_of_t(
     chessboard: tuple[Calibration, CalibrationReport], tmp_path: Path
 ) -> None:
@@ -2674,7 +2693,10 @@ def test_outliers_are_dropped_for_three_rounds_then_kept(
     assert list(rep.rejected_pairs) == ["p12", "p11", "p10"]
     assert rep.used_pairs == names[:10]
     assert rep.outlier_pairs == ["p12", "p11", "p10", "p09"]
-    assert rep.summary().endswith("  outlier kept: p09 (drop it with drop_outliers=True)")
+    # (it said "drop it with drop_outliers=True", the option given)
+    assert rep.summary().endswith(
+        "  outlier kept: p09 (still an outlier after 3 rounds of dropping)"
+    )
 
 
 def test_a_mispairing_refusal_names_no_rejected_pair_among_the_numbers_that_differ(

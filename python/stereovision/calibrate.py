@@ -697,6 +697,9 @@ class CalibrationReport:
     _sample: tuple[str, np.ndarray, np.ndarray] | None = field(
         default=None, repr=False, compare=False
     )
+    # why drop_outliers kept an outlier (the summary told the reader to drop it with the very
+    # option given)
+    _kept_why: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def square_size_error(self) -> float:
@@ -766,7 +769,8 @@ class CalibrationReport:
             lines.append(f"  rejected {name}: {reason}")
         for name in self.outlier_pairs:
             if name not in self.rejected_pairs:
-                lines.append(f"  outlier kept: {name} (drop it with {drop_option})")
+                why = self._kept_why.get(name, f"drop it with {drop_option}")
+                lines.append(f"  outlier kept: {name} ({why})")
         return "\n".join(lines)
 
     def save(self, path: PathLike) -> None:
@@ -1812,6 +1816,7 @@ def calibrate(
                 f"needed (rejected: {_rejected_words(rejected)})"
             )
     outliers: list[str] = []
+    kept_why: dict[str, str] = {}  # outliers drop_outliers kept, and why
     for rnd in range(MAX_OUTLIER_ROUNDS + 1):
         obj = [obj_pts[corner_ids[i]] for i in used]  # type: ignore[index]
         pl = [corners_l[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
@@ -1827,6 +1832,14 @@ def calibrate(
         # no rounds left: the outliers are kept (dropping them now would leave `used` and
         # the solution's per-pair errors out of step)
         last = rnd == MAX_OUTLIER_ROUNDS
+        if bad and drop_outliers and (last or len(used) - len(bad) < MIN_PAIRS):
+            why = (
+                f"still an outlier after {MAX_OUTLIER_ROUNDS} rounds of dropping"
+                if last
+                else f"dropping it would leave {len(used) - len(bad)} pairs, fewer than the "
+                f"{MIN_PAIRS} needed"
+            )
+            kept_why = {pair_names[used[k]]: why for k in bad}
         if not bad or not drop_outliers or last or len(used) - len(bad) < MIN_PAIRS:
             break
         for k in bad:
@@ -2000,6 +2013,7 @@ def calibrate(
         _corners={pair_names[i]: (corners_l[i], corners_r[i]) for i in used},  # type: ignore[misc]
         _ids={pair_names[i]: corner_ids[i] for i in used},  # type: ignore[misc]
         _sample=None if sample is None else (pair_names[sample[0]], sample[1], sample[2]),
+        _kept_why=kept_why,
     )
     return cal, report
 
