@@ -837,6 +837,28 @@ def test_rectify_uses_the_interpolation_given() -> None:
     assert set(np.unique(near)) <= {0, 100}
 
 
+def test_rectify_keeps_a_float_pair_in_its_range_under_cubic_and_lanczos() -> None:
+    """Cubic and Lanczos overshoot an edge: a [0.1, 0.9] checkerboard came out -0.10 .. 1.10,
+    and depth_map refused the pair rectify had given ("float image values must lie in [0, 1]").
+    The warp stays within the image's own range and the border's 0, as align_rows keeps it;
+    a linear warp, which never left it, is unchanged."""
+    yy, xx = np.mgrid[:24, :32]
+    img = (((xx // 4) + (yy // 4)) % 2 * 0.8 + 0.1).astype(np.float32)
+    shift = np.array([[1.0, 0.01, 0.5], [0.0, 1.0, 0.3], [0.0, 0.0, 1.0]])
+    rect = UncalibratedRectification(
+        shift, shift, (32, 24), (32, 24), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16, (0.0, 0.0),
+        (1.0, 1.0),
+    )  # fmt: skip
+    for method in (cv2.INTER_CUBIC, cv2.INTER_LANCZOS4):
+        for out in rect.rectify(img, img, interpolation=method):
+            assert out.dtype == np.float32 and out.min() >= 0.0 and out.max() == np.float32(0.9)
+        half = rect.rectify(img.astype(np.float16), img, interpolation=method)[0]
+        assert half.dtype == np.float16 and half.max() == np.float16(0.9)
+    lin = rect.rectify(img, img)[0]
+    np.testing.assert_array_equal(lin, cv2.warpPerspective(img, shift, (32, 24)))
+    assert lin.min() >= 0.0 and lin.max() <= np.float32(0.9)
+
+
 @pytest.mark.parametrize(
     "interpolation",
     [True, "linear", None, 5, -1, 99, cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, 1.5],

@@ -408,7 +408,8 @@ class UncalibratedRectification:
         -------
         tuple of ndarray
             The rectified left and right images, of :attr:`size`, the input's dtype and
-            channels (an ``(H, W, 1)`` image stays one).
+            channels (an ``(H, W, 1)`` image stays one); a float image within its own range
+            and the black border's 0 (cubic and Lanczos's overshoot clipped).
 
         Raises
         ------
@@ -439,6 +440,12 @@ class UncalibratedRectification:
             if arr.dtype.kind == "f" and arr.dtype.itemsize not in (4, 8):  # float16, long double
                 work = arr.astype(np.float32 if arr.dtype.itemsize == 2 else np.float64)
             warped = np.asarray(cv2.warpPerspective(work, hom, self.size, flags=method))
+            if arr.dtype.kind == "f" and np.isfinite(arr).any():
+                # cubic and Lanczos overshoot an edge (a [0, 1] pair: -0.10 .. 1.10), which
+                # depth_map then refused as out of range: kept within the image's own range and
+                # the black border's 0 (a linear warp never leaves it), as align_rows keeps it
+                lo, hi = min(0.0, float(np.nanmin(arr))), max(0.0, float(np.nanmax(arr)))
+                warped = np.clip(warped, lo, hi)
             if arr.ndim == 3 and warped.ndim == 2:  # OpenCV drops an (H, W, 1) image's channel
                 warped = warped[..., None]
             out.append(warped if warped.dtype == arr.dtype else warped.astype(arr.dtype))
