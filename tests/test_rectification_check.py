@@ -511,6 +511,44 @@ def test_cli_check_names_a_bad_tolerance_before_the_work(
         )
 
 
+def test_cli_check_and_rectify_of_homographies_as_calib_name_what_they_take(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rectify's rectification.json given as ``check --calib`` or ``rectify --calib`` was told
+    "give it as --rectification", an option neither command has (argparse then refused it).
+    Each now says what it takes; depth, which has the option, still names it."""
+    from stereovision.cli import main
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (40, 30), (40, 30), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    js = str(rect.save(tmp_path / "rectification.json"))
+    img = np.random.default_rng(0).integers(0, 256, (30, 40), np.uint8)
+    cv2.imwrite(str(tmp_path / "l.png"), img)
+    cv2.imwrite(str(tmp_path / "r.png"), np.roll(img, -2, axis=1))
+    pair = [str(tmp_path / "l.png"), str(tmp_path / "r.png")]
+    head = f"stereovision: error: {js} holds the homographies `stereovision rectify` found for "
+    head += "a rig without a calibration (disparity only): "
+    assert main(["check", *pair, "--calib", js]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == (
+        f"{head}check takes no homographies: give the pair they rectified (rectify's "
+        "left_rect.png and right_rect.png) without --calib (in Python: stereovision."
+        "uncalibrated.UncalibratedRectification.load(path).check(left, right))\n"
+    )
+    assert main(["rectify", *pair, "--calib", js, "-o", str(tmp_path / "out")]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == (
+        f"{head}rectify takes no homographies (without --calib it finds them anew); "
+        "`stereovision depth LEFT RIGHT --rectification FILE` rectifies a raw pair with them\n"
+    )
+    assert not (tmp_path / "out").exists()
+    assert main(["depth", *pair, "--calib", js, "-o", str(tmp_path / "d")]) == 2
+    assert "give it as --rectification (in Python" in capsys.readouterr().err
+
+
 # ------------------------------------------------------------- mutation audit: the rule on
 # matched points (_judge_rows, shared with stereovision.uncalibrated) against closed forms
 

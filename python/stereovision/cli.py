@@ -211,6 +211,7 @@ def load_calibration(
     pair: np.ndarray | None = None,
     size: tuple[int, int] | None = None,
     size_words: str | None = None,
+    homographies: str | None = None,
 ) -> Any:
     """A command's calibration, its refusals in the CLI's words.
 
@@ -229,6 +230,9 @@ def load_calibration(
     size_words : str, optional
         How the command's user gives an image size, for the refusal of a calibration that
         holds none when there is no ``pair`` (default: the Python call that converts it).
+    homographies : str, optional
+        What to do with ``rectify``'s ``rectification.json`` given as ``--calib`` in a command
+        that has no ``--rectification`` (default: give it as ``--rectification``).
 
     Returns
     -------
@@ -256,6 +260,8 @@ def load_calibration(
         text = text.replace("unit='m'/'mm'/...", "--calib-unit (m, mm, cm, ft or in)")
         text = re.sub(r"the unit '(\w+)' given", r"--calib-unit \1", text)
         text = text.replace("leave unit out", "leave --calib-unit out")
+        if homographies is not None:  # "give it as --rectification", an option it has not
+            text = re.sub(r": give it as --rectification .*", f": {homographies}", text)
         if "lacks field 'unit'" in text:  # a YAML/JSON without it: the option says it too
             text += " (or give --calib-unit)"
         how = size_words or (
@@ -1060,7 +1066,15 @@ def cmd_check(args: argparse.Namespace) -> int:
     )
     if same:
         warnings.warn(same, stacklevel=1)
-    calib = load_calibration(args.calib, args.calib_unit, left)
+    # check has no --rectification, which the refusal of rectify's homographies named
+    calib = load_calibration(
+        args.calib,
+        args.calib_unit,
+        left,
+        homographies="check takes no homographies: give the pair they rectified (rectify's "
+        "left_rect.png and right_rect.png) without --calib (in Python: "
+        "stereovision.uncalibrated.UncalibratedRectification.load(path).check(left, right))",
+    )
     fix = Path(args.fix) if args.fix else None
     if fix is not None:
         if calib is None:
@@ -1291,7 +1305,13 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     )
     if same:
         warnings.warn(same, stacklevel=1)
-    calib = load_calibration(args.calib, args.calib_unit, left)
+    calib = load_calibration(
+        args.calib,
+        args.calib_unit,
+        left,
+        homographies="rectify takes no homographies (without --calib it finds them anew); "
+        "`stereovision depth LEFT RIGHT --rectification FILE` rectifies a raw pair with them",
+    )
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise CliError(f"-o {args.output}: is a file; give a folder")
