@@ -421,6 +421,31 @@ def test_a_calibration_file_name_and_numpy_tolerances() -> None:
             check_rectification(flat, flat, tolerance=bad)  # type: ignore[arg-type]
 
 
+def test_homographies_given_as_calib_are_told_where_their_check_is() -> None:
+    """depth_map takes an UncalibratedRectification as calib, so it was passed to
+    check_rectification and refine_rectification too: "calib: expected a
+    stereovision.Calibration, got UncalibratedRectification", no word of its own check."""
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (80, 60), (80, 60), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    flat = np.zeros((60, 80), np.uint8)
+    head = (
+        "calib: expected a stereovision.Calibration, got an UncalibratedRectification "
+        "(homographies found without a calibration): "
+    )
+    with pytest.raises(TypeError) as exc:
+        check_rectification(flat, flat, rect)  # type: ignore[arg-type]
+    assert str(exc.value) == f"{head}its own check(left, right) checks a raw pair through them"
+    with pytest.raises(TypeError) as exc:
+        refine_rectification(flat, flat, rect)  # type: ignore[arg-type]
+    assert str(exc.value) == (
+        f"{head}they have no rig to correct; rectify_uncalibrated finds them anew from a pair"
+    )
+
+
 def test_an_unrectified_pair_is_not_called_swapped(data_dir: Path) -> None:
     """OpenCV's hand-held books pair (no calibration, rows 36 px apart): most of its matches lie
     within 10 % of the height of their rows at negative disparities, and the check said 'the

@@ -251,7 +251,8 @@ def check_rectification(
     ------
     TypeError
         If ``calib`` is given and is not a :class:`~stereovision.Calibration` (a file name:
-        load it with ``Calibration.load``).
+        load it with ``Calibration.load``; homographies of
+        :func:`~stereovision.uncalibrated.rectify_uncalibrated`: their own ``check``).
     ValueError
         Images that are not images, of different sizes or of the wrong size for ``calib``, or
         a tolerance that is not a positive number (Python or NumPy real).
@@ -267,6 +268,7 @@ def check_rectification(
         )
     _check_alpha(alpha)  # also without a calibration (it took any alpha without a word)
     if calib is not None:
+        _not_homographies(calib, "its own check(left, right) checks a raw pair through them")
         _require_type(calib, "Calibration", "calib")
         left, right = calib.rectify(left, right, alpha=alpha)
     gl, gr = _grey_pair(left, right)
@@ -298,6 +300,20 @@ def check_rectification(
     xl, yl = pl[pairs[:, 0]].T
     xr, yr = pr[pairs[:, 1]].T
     return _judge_rows(np.column_stack([xl, yl, xr, yr]), w, h, tol)
+
+
+def _not_homographies(calib: object, what: str) -> None:
+    """A TypeError saying ``what`` to do with an
+    :class:`~stereovision.uncalibrated.UncalibratedRectification` given as ``calib``: "expected
+    a stereovision.Calibration, got UncalibratedRectification" did not say where its check is
+    (``depth_map`` takes one as ``calib``, so it was passed here too)."""
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    if isinstance(calib, UncalibratedRectification):
+        raise TypeError(
+            "calib: expected a stereovision.Calibration, got an UncalibratedRectification "
+            f"(homographies found without a calibration): {what}"
+        )
 
 
 def _two_sizes(wl: int, hl: int, wr: int, hr: int) -> str:
@@ -578,11 +594,17 @@ def refine_rectification(
 
     Raises
     ------
+    TypeError
+        If ``calib`` is not a :class:`~stereovision.Calibration` (homographies of
+        :func:`~stereovision.uncalibrated.rectify_uncalibrated` included: no rig to correct).
     ValueError
         Too little texture, a pair that looks swapped or fits no row model, a correction of
         more than :data:`MAX_CORRECTION_DEG` degrees (not a drift: calibrate again), or a
         ``check`` made on a pair of another size than the calibration's images.
     """
+    _not_homographies(
+        calib, "they have no rig to correct; rectify_uncalibrated finds them anew from a pair"
+    )
     _require_type(calib, "Calibration", "calib")
     # before rectified_calibration(alpha), which takes any finite scaling (OpenCV's -1)
     _check_alpha(alpha)
