@@ -1384,6 +1384,54 @@ def test_cli_check_fix_of_rectified_images_with_the_raw_rig_says_they_may_be_rec
     assert fixed.is_file()
 
 
+def test_cli_check_of_raw_images_with_a_rectified_calibration_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Raw images checked with a calibration of rectified images (rectify's calib_rect.yaml:
+    R = I, no distortion, so nothing is rectified): the line said only to recalibrate or --fix,
+    and --fix wrote a distortion-free "correction" of the raw images (StereoPi: 0.441 degrees)
+    without a word. Both now name the calibration as one of rectified images; a raw rig's line
+    is as before."""
+    w, h = 64, 48
+    rect_rig = dataclasses.replace(_rig(w, h, (0.0, 0.0, 0.0)), rectified=True)
+    raw_rig = _rig(w, h, (0.0, 0.0, 0.0))
+    img = np.random.default_rng(0).integers(0, 256, (h, w), np.uint8)
+    pair = [str(tmp_path / "l.png"), str(tmp_path / "r.png")]
+    cv2.imwrite(pair[0], img)
+    cv2.imwrite(pair[1], np.roll(img, -2, axis=1))
+    failing = RectificationCheck(100, 0.6, 1.5, 0.5, 0.0, 0.0, False, 0.5, size=(w, h))
+    passing = RectificationCheck(100, 0.1, 0.5, 0.0, 0.0, 0.0, True, 0.5, size=(w, h))
+    monkeypatch.setattr(
+        "stereovision.rectification_check.check_rectification", lambda *a, **k: failing
+    )
+    monkeypatch.setattr(
+        "stereovision.rectification_check.refine_rectification",
+        lambda *a, **k: (raw_rig, passing),
+    )
+    said = (
+        "--calib is a calibration of rectified images (R = I, no distortion: rectify's "
+        "calib_rect.yaml, a dataset's): if these are the raw images, give the raw rig's "
+        "calibration"
+    )
+    advice = (
+        "  the calibration no longer rectifies this rig: recalibrate, or correct the right "
+        "camera's pitch and roll with --fix OUT"
+    )
+    rectified = str(rect_rig.save(tmp_path / "calib_rect.yaml"))
+    assert sv.cli.main(["check", *pair, "--calib", rectified]) == 1
+    assert capsys.readouterr().out.splitlines()[1] == f"{advice}; but {said}"
+    fixed = tmp_path / "fixed.yaml"
+    assert sv.cli.main(["check", *pair, "--calib", rectified, "--fix", str(fixed)]) == 0
+    assert capsys.readouterr().err == (
+        f"stereovision: warning: {said} (the correction fits them as given)\n"
+    )
+    assert fixed.is_file()
+    raw = str(raw_rig.save(tmp_path / "rig.yaml"))
+    # a raw rig (its images as given failing too): the line as before
+    assert sv.cli.main(["check", *pair, "--calib", raw]) == 1
+    assert capsys.readouterr().out.splitlines()[1] == advice
+
+
 def test_cli_check_json_without_fix_does_not_check_the_images_as_given(
     data_dir: Path,
     tmp_path: Path,

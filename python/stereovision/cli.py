@@ -1147,6 +1147,17 @@ def cmd_check(args: argparse.Namespace) -> int:
         if twice is None
         else f"; but {twice}, the raw rig's calibration rectifies them again: give the raw images"
     )
+    # The other mix-up: raw images with a calibration of rectified images (rectify's
+    # calib_rect.yaml), which rectifies nothing: the line said only to recalibrate or --fix
+    raw_with_rectified = (
+        "--calib is a calibration of rectified images (R = I, no distortion: rectify's "
+        "calib_rect.yaml, a dataset's): if these are the raw images, give the raw rig's "
+        "calibration"
+        if calib is not None and calib.rectified and res.ok is False and not res.swapped
+        else None
+    )
+    if raw_with_rectified is not None:
+        again = f"; but {raw_with_rectified}"
     if args.plot:
         from stereovision.io import keep_previous
         from stereovision.rectification_check import draw_rectification_check
@@ -1236,6 +1247,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             "raw images",
             stacklevel=1,
         )
+    if raw_with_rectified is not None:  # written all the same: a rectified rig drifts too
+        warnings.warn(f"{raw_with_rectified} (the correction fits them as given)", stacklevel=1)
     from stereovision.io import keep_previous, replaced_words
 
     # the same correction again (a rerun) replaces nothing: no copy is kept
