@@ -1307,6 +1307,21 @@ def test_cli_check_of_one_file_twice_cannot_tell(data_dir: Path, tmp_path: Path)
     assert "are the same file" in run.stderr
 
 
+def test_cli_check_help_names_one_image_twice_as_exit_3(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """check exits 3 for one image twice too (above), where its --help named too little
+    texture alone: a script reading 3 as "point the cameras at texture" missed a camera
+    opened twice."""
+    with pytest.raises(SystemExit):
+        sv.cli.main(["check", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert (
+        "3 when the pair has too little texture to tell, or its two images are the same pixels "
+        "(one file or camera twice; with --fix: nothing is written)." in text
+    )
+
+
 def test_draw_rectification_check_refuses_a_check_of_a_pair_of_another_size(
     data_dir: Path,
 ) -> None:

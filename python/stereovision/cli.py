@@ -42,7 +42,7 @@ from stereovision._validate import (
 )
 
 EXIT_ERROR = 2
-EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
+EXIT_CANNOT_TELL = 3  # `check`: too little texture (or one image twice) to tell the rows
 EXIT_INTERRUPTED = 130
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for `yes | head`
 EXIT_TERMINATED = 143  # 128 + SIGTERM
@@ -2762,8 +2762,9 @@ def build_parser() -> argparse.ArgumentParser:
         "after rectification, to catch a calibration that a bump or heat has spoiled. Exit "
         "status 0 when the median is within --tolerance (with --fix: the corrected calibration "
         "is), 1 when not (with --fix: or when this pair cannot correct the calibration; nothing "
-        "is written), 2 on an error, 3 when the pair has too little texture to tell (with "
-        "--fix: nothing is written).",
+        "is written), 2 on an error, 3 when the pair has too little texture to tell, or its "
+        "two images are the same pixels (one file or camera twice; with --fix: nothing is "
+        "written).",
     )
     d.add_argument("left", help="left image: raw with --calib, else rectified")
     d.add_argument("right", help="right image, the same size")
