@@ -2776,6 +2776,27 @@ def test_a_plain_yaml_reads_numbers_written_without_a_point(tmp_path: Path) -> N
     assert c.doffs == 1e-3 and c.K1[1, 1] == 500.0 and c.T[0] == -0.1
 
 
+def test_a_plain_yaml_field_that_holds_itself_is_refused(tmp_path: Path) -> None:
+    """A recursive YAML alias (``K1: &a [*a, *a]``) hung load: NumPy's cast of the list that
+    holds itself went 32 levels deep. It is refused naming the field; an alias used twice
+    (no cycle) reads as before."""
+    body = (
+        "image_width: 640\nimage_height: 480\nunit: m\nD1: &z [0, 0, 0, 0, 0]\nD2: *z\n"
+        "K2: [[500, 0, 320], [0, 500, 240], [0, 0, 1]]\n"
+        "R: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\nT: [-0.1, 0, 0]\n"
+    )
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(body + "K1: &a [*a, *a]\n")
+    with pytest.raises(ValueError) as exc:
+        Calibration.from_file(rig)
+    assert str(exc.value) == (
+        f"calibration file {rig}: K1 holds itself (a YAML alias inside its own anchor, "
+        "'K1: &a [*a]'): write its numbers out"
+    )
+    rig.write_text(body + "K1: &k [&r [500, 0, 320], [0, 500, 240], [0, 0, 1]]\nM2: *k\n")
+    assert Calibration.from_file(rig).K1[0, 0] == 500.0
+
+
 def test_a_calibrate_report_given_as_a_calibration_is_named(tmp_path: Path) -> None:
     """``stereovision calibrate``'s report.json / report.yaml, given for the calibration beside
     them, was "is not a calibration: it has none of the fields ..." (JSON) or "unrecognised

@@ -1640,6 +1640,14 @@ class Calibration:
             raise ValueError(_not_a_calibration_keys(list(doc), source))
         if not isinstance(doc, dict) or not any(k in doc for k in _CALIBRATION_FIELDS):
             return None
+        for key, value in doc.items():
+            if _holds_itself(value):
+                # "K1: &a [*a, *a]": NumPy's cast of the list that holds itself looked 32
+                # levels deep, 2**32 entries: from_file / load hung
+                raise ValueError(
+                    f"calibration file {source}: {key} holds itself (a YAML alias inside its "
+                    f"own anchor, '{key}: &a [*a]'): write its numbers out"
+                )
         ros = "camera_matrix" in doc or "distortion_model" in doc  # a file, a message echo
         if ros and not any(k in doc for k in ("K1", "M1", "K2", "M2")):
             # a ROS camera_info (load(left.yaml)): its image_width made it "lacks field 'K1'"
@@ -3011,6 +3019,29 @@ def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, 
         + mat("rectification_matrix", R)
         + mat("projection_matrix", P)
     )
+
+
+def _holds_itself(obj: object) -> bool:
+    """Whether a list or dict PyYAML built holds itself (a recursive alias), at any depth.
+
+    A node is walked once (an alias used many times is no cycle): linear in the file."""
+    done: set[int] = set()
+    on_path: set[int] = set()
+    stack: list[tuple[object, bool]] = [(obj, False)]
+    while stack:
+        node, leaving = stack.pop()
+        if leaving:
+            on_path.discard(id(node))
+            done.add(id(node))
+            continue
+        if not isinstance(node, (list, dict)) or id(node) in done:
+            continue
+        if id(node) in on_path:
+            return True
+        on_path.add(id(node))
+        stack.append((node, True))
+        stack.extend((v, False) for v in (node.values() if isinstance(node, dict) else node))
+    return False
 
 
 def _yaml_loader() -> Any:
