@@ -2776,6 +2776,21 @@ def test_a_plain_yaml_reads_numbers_written_without_a_point(tmp_path: Path) -> N
     assert c.doffs == 1e-3 and c.K1[1, 1] == 500.0 and c.T[0] == -0.1
 
 
+def test_a_plain_yaml_ending_in_a_document_marker_is_read(tmp_path: Path) -> None:
+    """A plain YAML calibration ending in ``---`` (a second, empty document, as a topic echo
+    or a concatenation leaves it) was "not a stereovision calibration file": yaml.load wants a
+    single document. The first document is read."""
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(
+        "image_width: 640\nimage_height: 480\nunit: m\nD1: [0, 0, 0, 0, 0]\n"
+        "D2: [0, 0, 0, 0, 0]\nK1: [[500, 0, 320], [0, 500, 240], [0, 0, 1]]\n"
+        "K2: [[500, 0, 320], [0, 500, 240], [0, 0, 1]]\n"
+        "R: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\nT: [-0.1, 0, 0]\n---\n"
+    )
+    c = Calibration.load(rig)
+    assert c.K1[0, 0] == 500.0 and c.T[0] == -0.1
+
+
 def test_a_plain_yaml_field_that_holds_itself_is_refused(tmp_path: Path) -> None:
     """A recursive YAML alias (``K1: &a [*a, *a]``) hung load: NumPy's cast of the list that
     holds itself went 32 levels deep. It is refused naming the field; an alias used twice

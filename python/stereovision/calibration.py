@@ -1620,7 +1620,10 @@ class Calibration:
         import yaml
 
         try:
-            doc = yaml.load(text, Loader=_yaml_loader())  # a SafeLoader
+            # the first document: a file ending in "---" (a second, empty one) was "expected a
+            # single document" to yaml.load, so "not a stereovision calibration file"
+            docs = yaml.load_all(text, Loader=_yaml_loader())  # a SafeLoader
+            doc = next((d for d in docs if d is not None), None)
         except (yaml.YAMLError, ValueError, RecursionError, LookupError, AttributeError):
             if "!!python/" in text:  # a field is a key: _PLAIN_YAML_KEY, in flow style too
                 # yaml.dump of the NumPy arrays, the first way a script writes them: it was
