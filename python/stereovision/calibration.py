@@ -1545,9 +1545,9 @@ class Calibration:
 
         The format is recognised from the content; JSON is :meth:`save`'s nested lists or
         ``cv::FileStorage``'s JSON (matrices as ``opencv-matrix`` objects); a YAML file without
-        OpenCV's ``%YAML:1.0`` header (a script's ``yaml.safe_dump``) is read as the JSON's
-        nested lists. ``M1``/``M2`` (OpenCV's ``stereo_calib`` sample names) are accepted for
-        ``K1``/``K2``.
+        OpenCV's header (``%YAML:1.0`` from 4.x, ``%YAML 1.2`` from 5.x) and matrix tags (a
+        script's ``yaml.safe_dump``) is read as the JSON's nested lists. ``M1``/``M2``
+        (OpenCV's ``stereo_calib`` sample names) are accepted for ``K1``/``K2``.
 
         Parameters
         ----------
@@ -1609,10 +1609,11 @@ class Calibration:
 
     @classmethod
     def _from_plain_yaml(cls, text: str, source: str, unit: str | None) -> Calibration | None:
-        """A YAML mapping of :meth:`save`'s fields without OpenCV's ``%YAML:1.0`` header and
-        ``!!opencv-matrix`` tags (a script's ``yaml.safe_dump`` of nested lists, a hand-written
-        file), read as its JSON twin is; None when the text is no such mapping. It was
-        'unrecognised calibration format ... expected OpenCV YAML/XML, JSON, ...'."""
+        """A YAML mapping of :meth:`save`'s fields without OpenCV's ``!!opencv-matrix`` tags
+        (nor its ``%YAML:1.0`` / ``%YAML 1.2`` header): a script's ``yaml.safe_dump`` of nested
+        lists, a hand-written file, read as its JSON twin is; None when the text is no such
+        mapping. It was 'unrecognised calibration format ... expected OpenCV YAML/XML, JSON,
+        ...'."""
         if not _PLAIN_YAML_KEY.search(text):
             # no field as a key: not parsed (PyYAML's pure-Python parser took 5.5 s on a 2.7 MB
             # point list given as --calib by mistake, which this comes to unrecognised)
@@ -2862,11 +2863,11 @@ def _snap_rotation(rot: F64, what: str) -> F64:
 def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     """Parse one camera's ROS ``camera_info`` YAML (as written by ROS ``camera_calibration``).
 
-    Accepts ``{rows, cols, data}`` matrices or flat lists, OpenCV's ``%YAML:1.0`` header and
-    ``!!opencv-matrix`` tags, the old spellings ``distortion_coefficents`` and
-    ``camera_model``, and a ``sensor_msgs/CameraInfo`` message as a topic echo prints it
-    (``width``, ``height``, ``k d r p`` or ROS 1's ``K D R P``; the first of several; on one
-    line with ``ros2 topic echo --flow-style``).
+    Accepts ``{rows, cols, data}`` matrices or flat lists, OpenCV's header (4.x's
+    ``%YAML:1.0``, 5.x's ``%YAML 1.2``) and ``!!opencv-matrix`` tags, the old spellings
+    ``distortion_coefficents`` and ``camera_model``, and a ``sensor_msgs/CameraInfo`` message
+    as a topic echo prints it (``width``, ``height``, ``k d r p`` or ROS 1's ``K D R P``; the
+    first of several; on one line with ``ros2 topic echo --flow-style``).
 
     Parameters
     ----------
@@ -2890,7 +2891,8 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     """
     import yaml
 
-    # OpenCV writes "%YAML:1.0", which PyYAML reads as a bad directive, and tags its matrices.
+    # OpenCV 4.x writes "%YAML:1.0", which PyYAML reads as a bad directive (5.x's "%YAML 1.2"
+    # it reads), and both tag their matrices.
     clean = re.sub(r"^%YAML:1\.0[^\n]*\n", "", text.lstrip("\ufeff"))
     clean = re.sub(r"!!opencv-matrix\b", "", clean)
     try:
