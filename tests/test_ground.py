@@ -2454,6 +2454,32 @@ def test_a_hand_made_plane_of_figures_not_finite_is_refused(
     assert str(exc.value) == says
 
 
+@pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("inlier_share", 5.0, "inlier_share: expected a share from 0 to 1, got 5.0"),
+        ("below_share", -0.1, "below_share: expected a share from 0 to 1, got -0.1"),
+        ("rms_px", -1, "rms_px: expected a number of pixels >= 0, got -1"),
+        ("disparity_plane", (True, 0.1, -5.0),
+         "disparity_plane: expected 3 numbers (a, b, c), got (True, 0.1, -5.0)"),
+    ],
+)  # fmt: skip
+def test_a_hand_made_plane_of_figures_out_of_range_is_refused(
+    field: str, value: object, says: str
+) -> None:
+    """A share of 5.0 or -0.1, an RMS of -1 and a bool among disparity_plane's numbers (taken
+    as 1) built a plane that went to describe() and as_dict as given; each is refused naming
+    the field."""
+    fields = {
+        "normal": [0.0, -1.0, 0.0], "height": 1.0, "disparity_plane": (0.0, 0.1, -5.0),
+        "inliers": np.zeros((2, 2), bool), "inlier_share": 0.5, "rms_px": 0.1,
+    }  # fmt: skip
+    GroundPlane(**{**fields, "inlier_share": 1, "below_share": 0, "rms_px": 0})  # the limits
+    with pytest.raises(ValueError) as exc:
+        GroundPlane(**{**fields, field: value})
+    assert str(exc.value) == says
+
+
 def test_a_hand_made_plane_of_an_int_past_a_floats_range_is_refused() -> None:
     """disparity_plane (10**400, 0, 0) was NumPy's OverflowError "int too large to convert to
     float", naming no field; it is infinite, refused as an infinity is (a height of 10**400

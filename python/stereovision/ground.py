@@ -207,13 +207,26 @@ class GroundPlane:
         for name in ("inlier_share", "rms_px", "below_share"):
             if not math.isfinite(_number(getattr(self, name), name)):
                 raise ValueError(f"{name}: expected a finite number, got {getattr(self, name)!r}")
+        # a share of 5.0 or an RMS of -1 built and went to describe() and as_dict as they were
+        # (a fitted plane's shares are in [0, 1], its RMS not negative)
+        for name in ("inlier_share", "below_share"):
+            if not 0.0 <= _number(getattr(self, name), name) <= 1.0:
+                raise ValueError(
+                    f"{name}: expected a share from 0 to 1, got {getattr(self, name)!r}"
+                )
+        if _number(self.rms_px, "rms_px") < 0:
+            raise ValueError(f"rms_px: expected a number of pixels >= 0, got {self.rms_px!r}")
         try:
             coef = _real_array(self.disparity_plane)
         except ValueError:  # ragged
             coef = None
         except OverflowError:  # an int past a float's range: infinite, as a height of 10**400 is
             coef = np.full(3, math.inf)
-        if coef is None or coef.dtype.kind == "b" or coef.shape != (3,):
+        # a bool among numbers ((True, 0, 0): NumPy's int array) was taken as 1
+        mixed = isinstance(self.disparity_plane, (list, tuple)) and any(
+            isinstance(v, NOT_NUMBERS) for v in self.disparity_plane
+        )
+        if coef is None or coef.dtype.kind == "b" or mixed or coef.shape != (3,):
             raise ValueError(
                 "disparity_plane: expected 3 numbers (a, b, c), got "
                 + reprlib.repr(self.disparity_plane)
