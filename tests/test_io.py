@@ -2914,6 +2914,20 @@ def test_load_scene_of_a_file_says_its_folder_is_the_scene(tmp_path: Path) -> No
         load_scene(tmp_path / "nothing")
 
 
+def test_load_scene_of_a_device_says_it_is_no_folder(tmp_path: Path) -> None:
+    """``load_scene('/dev/null')`` (or a pipe: there, neither a file nor a folder) said "scene
+    directory not found" of a path that is there; it says it is not a folder."""
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    for path in (Path("/dev/null"), pipe):
+        with pytest.raises(NotADirectoryError) as info:
+            load_scene(path)
+        assert str(info.value) == (
+            f"{path} is not a folder (a device or a pipe), not a scene directory: a scene is "
+            "the folder holding left.png and right.png"
+        )
+
+
 def test_a_scene_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     """A scene folder (or scene root) given as a link whose target moved (a dataset on a disk
     since unmounted) was "scene directory not found: data" / "scene root not found: data", of

@@ -2093,7 +2093,8 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
         ``Right.png``, saying the names are lower case), or ``gt_disp.pfm``,
         ``calib.txt`` or ``Q.dat`` is a link to a file that does not exist.
     NotADirectoryError
-        If ``directory`` is a file (``cones/left.png``: the scene is its folder).
+        If ``directory`` is a file (``cones/left.png``: the scene is its folder) or another
+        thing that is no folder (``/dev/null``, a pipe).
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
         its size differs from the left image, or the calibration file is invalid (an
@@ -2107,6 +2108,13 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
         raise NotADirectoryError(
             f"{d} is a file, not a scene directory: a scene is the folder holding left.png and "
             f"right.png ({d.parent}?)"
+        )
+    if d.exists() and not d.is_dir():
+        # load_scene('/dev/null') (a device, a pipe: there, neither file nor folder) was
+        # "scene directory not found" of a path that is there
+        raise NotADirectoryError(
+            f"{d} is not a folder (a device or a pipe), not a scene directory: a scene is the "
+            "folder holding left.png and right.png"
         )
     if not d.is_dir():
         # a link whose target moved (a dataset on a disk since unmounted) was "not found" alone,
