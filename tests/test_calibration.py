@@ -1532,6 +1532,29 @@ def test_ros_and_kalibr_matrix_entries_past_a_float_are_named(tmp_path: Path) ->
         Calibration.from_file(chain)
 
 
+def test_a_ros_size_past_a_float_is_said_by_its_digits(tmp_path: Path) -> None:
+    """An image_width of 10**400 (a damaged file) in one ROS camera_info printed its 401 digits
+    in the check that the two cameras have one size; the number of digits is said (Kalibr's
+    resolution is refused before its check)."""
+    ros = (
+        "image_width: {}\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
+        "  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\ndistortion_model: plumb_bob\n"
+        "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n"
+        "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+        "projection_matrix:\n  rows: 3\n  cols: 4\n"
+        "  data: [500, 0, 320, 0, 0, 500, 240, 0, 0, 0, 1, 0]\n"
+    )
+    big = "1" + "0" * 400
+    (tmp_path / "left.yaml").write_text(ros.format(big))
+    (tmp_path / "right.yaml").write_text(ros.format(640))
+    with pytest.raises(ValueError) as exc:
+        Calibration.from_file(tmp_path)
+    assert str(exc.value) == (
+        f"ROS camera_info: {tmp_path / 'left.yaml'} is (an integer of 401 digits, 480) px, "
+        f"{tmp_path / 'right.yaml'} is (640, 480) px (width, height); a rig needs one size"
+    )
+
+
 def test_a_text_without_a_field_as_a_key_is_not_parsed_as_yaml(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -2317,8 +2317,8 @@ class Calibration:
         cams = [parse_ros_camera_info(ltext, lsrc), parse_ros_camera_info(rtext, rsrc)]
         if cams[0]["image_size"] != cams[1]["image_size"]:
             raise ValueError(
-                f"ROS camera_info: {lsrc} is {cams[0]['image_size']} px, {rsrc} is "
-                f"{cams[1]['image_size']} px (width, height); a rig needs one size"
+                f"ROS camera_info: {lsrc} is {_size_shown(cams[0]['image_size'])} px, {rsrc} is "
+                f"{_size_shown(cams[1]['image_size'])} px (width, height); a rig needs one size"
             )
         rots, ts = [], []
         for cam, src in zip(cams, (lsrc, rsrc), strict=True):
@@ -3024,6 +3024,12 @@ def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, 
         + mat("rectification_matrix", R)
         + mat("projection_matrix", P)
     )
+
+
+def _size_shown(size: Any) -> str:
+    """A file's image size for a message, ``(640, 480)``: an int past a float's range as its
+    number of digits (10**400 printed its 401 digits)."""
+    return f"({', '.join(too_large_for_float(v, why=False) or repr(v) for v in size)})"
 
 
 def _holds_itself(obj: object) -> bool:
