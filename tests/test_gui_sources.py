@@ -1450,6 +1450,21 @@ def test_a_loop_of_links_in_a_data_folder_is_no_file_and_stops_nothing(tmp_path:
     assert folders.resolve_output("loop/x") == tmp_path.resolve() / "loop" / "x"
 
 
+def test_a_link_to_a_missing_file_typed_on_the_page_names_its_target(tmp_path: Path) -> None:
+    """_loop_note looked for "loop" in _broken_link's words: a link to a missing file was
+    "no such file: y.png" of a name ls lists, unless its target's name held "loop"
+    (x.png -> loops/none.png). Every link that reaches no file names its target, as --data's
+    words do (e55e27d1)."""
+    (tmp_path / "loops").mkdir()
+    (tmp_path / "x.png").symlink_to(Path("loops") / "none.png")
+    (tmp_path / "y.png").symlink_to("none.png")
+    folders = AllowedFolders([tmp_path])
+    for name, target in (("x.png", "loops/none.png"), ("y.png", "none.png")):
+        with pytest.raises(FileNotFoundError) as err:
+            folders.resolve(name)
+        assert str(err.value) == f"no such file: {name} (a link to {target}, which does not exist)"
+
+
 def test_a_data_folder_or_video_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     # --data data -> moved/data (a disk since unmounted), VideoPair("v.avi") -> moved/v.avi:
     # "not found" alone, of a name ls lists, where load_scene and StereoCamera name the target

@@ -151,8 +151,9 @@ def real_path(p: Path) -> Path:
 
 
 def _loop_note(p: Path) -> str:
-    """`` (a link to b.png, one of a loop of links that never reaches a file)`` when ``p``
-    (as typed, not resolved) is such a link, else ""."""
+    """`` (a link to b.png, one of a loop of links that never reaches a file)`` or `` (a link
+    to moved/a.png, which does not exist)`` when ``p`` (as typed, not resolved) is a link that
+    reaches no file, else ""."""
     with contextlib.suppress(OSError):
         os.stat(p)
         return ""
@@ -160,8 +161,9 @@ def _loop_note(p: Path) -> str:
         if p.is_symlink():
             from stereovision.io import _broken_link
 
-            why = _broken_link(p)
-            return f" ({why})" if "loop" in why else ""
+            # every such link, as --data's and the readers' words (e55e27d1): "loop" looked for
+            # in the words noted a missing loops/a.png, and no other missing target
+            return f" ({_broken_link(p)})"
     return ""
 
 
