@@ -1941,6 +1941,22 @@ def test_cli_capture(
         run("--from-bag", str(tmp_path), "--fourcc", "MJPG", "-o", str(out))
 
 
+def test_capture_temporal_of_a_fraction_is_said_as_its_range(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """capture --temporal 8.5 said "expected a whole number, got '8.5'" where 1 and 256 are
+    "expected 2-255 frames a pair": two wordings of one refusal; the range is said for both."""
+    from stereovision.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["capture", "--left", "0", "--right", "1", "--temporal", "8.5", "-o", "out"])
+    assert exc.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        "stereovision capture: error: argument --temporal: expected 2-255 frames a pair, "
+        "got '8.5' (see stereovision capture --help)"
+    )
+
+
 def test_a_folder_a_glob_or_a_misnumbered_pattern_names_the_source_that_would_work(
     tmp_path: Path,
 ) -> None:

@@ -3764,6 +3764,16 @@ def board_side(text: str) -> float:
     return value
 
 
+def _temporal_frames(text: str) -> int:
+    """argparse type of ``capture --temporal``: a whole number, refused in the words of
+    :func:`cmd_capture`'s range check (``8.5`` was "expected a whole number", ``1`` "expected
+    2-255 frames a pair": two wordings of one refusal). The range is checked there."""
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected 2-255 frames a pair, got {text!r}") from None
+
+
 def add_cli(subparsers: Any) -> None:
     """Register the ``capture`` subcommand on an ``argparse`` subparsers object."""
     from stereovision.cli import positive_count, positive_rate  # cli builds its parser with these
@@ -3806,7 +3816,7 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--temporal",
-        type=int,
+        type=_temporal_frames,
         metavar="N",
         help="save each pair as the mean of N frames of a still view (low light; hold the "
         "board or rig still)",
