@@ -5372,3 +5372,12 @@ def test_a_source_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError) as info:
         StereoCamera(tmp_path / "none.mp4", link)
     assert str(info.value) == f"left source not found: {tmp_path / 'none.mp4'}"
+
+
+def test_a_source_path_with_a_null_byte_is_named(tmp_path: Path) -> None:
+    """A path holding a null byte (a name pasted from a C string) was "left source not found:
+    a<NUL>b.mp4", the byte printed raw; it is refused as the io writers refuse it (34a60829)."""
+    bad = str(tmp_path / "a\x00b.mp4")
+    with pytest.raises(ValueError) as info:
+        StereoCamera(bad, str(tmp_path / "b.mp4"))
+    assert str(info.value) == f"left source: expected a path without a null byte, got {bad!r}"

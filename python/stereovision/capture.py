@@ -1740,6 +1740,11 @@ class StereoCamera(PairSource):
         configure = functools.partial(self._configure, side, fps)
         if isinstance(src, (str, os.PathLike)):
             path = os.fspath(src)
+            if "\x00" in path:
+                # exists() is False of it: "left source not found: a<NUL>b.mp4", the byte raw
+                raise ValueError(
+                    f"{side} source: expected a path without a null byte, got {path!r}"
+                )
             if "%" not in path and "://" not in path and not os.path.exists(path):
                 if re.search(r"[*?[]", path):  # "not found" said nothing of the pattern
                     raise FileNotFoundError(_glob_hint(side, path))
