@@ -2413,6 +2413,23 @@ def test_point_cloud_names_points_beyond_float32s_range():
     np.testing.assert_array_equal(cloud.points, pts[[0, 3]])
 
 
+def test_point_cloud_names_python_ints_beyond_float32s_range() -> None:
+    """A list holding an int past int64 (10**39) is NumPy's object array, whose float32 cast
+    made it inf and dropped the point without a word (and 10**400 was a bare OverflowError);
+    both are counted as a float64's 1e39 is."""
+    import warnings
+
+    for big, shown in ((10**39, "1e+39"), (-(10**400), "a negative integer of 401 digits")):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            cloud = render.point_cloud([[0, 0, 1], [1, big, 2], [1, 1, 4]])
+        assert [str(w.message) for w in caught] == [
+            f"points: 1 point(s) with a coordinate beyond float32's range (e.g. {shown}) "
+            "dropped (not shown)"
+        ]
+        np.testing.assert_array_equal(cloud.points, [[0, 0, 1], [1, 1, 4]])
+
+
 def test_view_names_a_link_whose_target_moved(tmp_path: Path) -> None:
     """``view data`` of a link whose target moved (an output folder on a disk since unmounted)
     was "no such file or folder: data", of a name ls lists; the link's target is named, as

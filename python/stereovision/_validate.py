@@ -1740,6 +1740,27 @@ def points_as_float32(raw: np.ndarray) -> tuple[np.ndarray, str | None]:
 
     The cast itself is silent (NumPy's "overflow encountered in cast" named nothing); the
     caller says the words (``read_ply``'s file, ``point_cloud``'s points)."""
+    if raw.dtype == object:
+        # a list holding an int past int64 (10**39) is an object array: its cast made the int
+        # inf without a word, and one past a float64 (10**400) was NumPy's bare OverflowError
+        flat = list(raw.flat)
+        over_flat = np.zeros(len(flat), bool)
+        wide_flat = np.empty(len(flat))
+        for i, v in enumerate(flat):
+            try:
+                wide_flat[i] = float(v)  # what is no number: float32's cast raised as much
+            except OverflowError:
+                wide_flat[i], over_flat[i] = (math.inf if v > 0 else -math.inf), True
+        wide, over = wide_flat.reshape(raw.shape), over_flat.reshape(raw.shape)
+        with np.errstate(over="ignore"):
+            pts = wide.astype(np.float32)
+        lost = over | (np.isfinite(wide) & ~np.isfinite(pts))
+        if lost.any():
+            n = int(lost.any(axis=-1).sum()) if lost.ndim > 1 else int(lost.sum())
+            first = flat[int(np.flatnonzero(lost.ravel())[0])]
+            shown = too_large_for_float(first, why=False) or repr(float(first))
+            return pts, f"{n} point(s) with a coordinate beyond float32's range (e.g. {shown})"
+        return pts, None
     with np.errstate(over="ignore"):
         pts = np.asarray(raw, dtype=np.float32)
     if raw.dtype.kind == "f" and raw.dtype.itemsize > 4:
