@@ -1417,6 +1417,27 @@ def test_a_float_in_a_sequence_argument_float32_cannot_hold_is_named(
     assert _core.gray_u8(np.zeros((2, 3, 3), np.uint8), (0, 1, np.float64(0.5))).shape == (2, 3)
 
 
+def test_refine_disparity_reads_a_fill_given_as_a_list_pair() -> None:
+    """``_core.refine_disparity``'s fills were extracted as tuples: a list pair ([16, 0.3],
+    JSON's or a config's) was "element 0 ([16.0, 0.3]): expected a (sigma, min_score) pair" of
+    a pair. Any sequence of two reads as the tuple does; a string or three values do not."""
+    a = np.random.default_rng(0).random((8, 12), dtype=np.float32)
+
+    def run(fills: object) -> tuple[np.ndarray, np.ndarray, int]:
+        return _core.refine_disparity(a, a, a, a, *REFINE_ARGS[:10], fills, 0.1, True, 1.0)
+
+    want = run([(16.0, 0.3)])
+    for got in (run([[16.0, 0.3]]), run([np.array([16.0, 0.3])])):
+        np.testing.assert_array_equal(got[0], want[0])
+        assert got[2] == want[2]
+    for bad, shown in (("ab", "'ab'"), ([16.0, 0.3, 1.0], "[16.0, 0.3, 1.0]")):
+        with pytest.raises(ValueError) as err:
+            run([bad])
+        assert str(err.value) == (
+            f"invalid parameter `fills`: element 0 ({shown}): expected a (sigma, min_score) pair"
+        )
+
+
 def test_mcgm_curves_refuses_a_huge_image_before_copying_it() -> None:
     """``mcgm_curves`` copied ``img`` before its kernel's 32-bit size check, which
     ``mcgm_log`` (1eeb7ba4) and the matchers make from the shape first: a broadcast

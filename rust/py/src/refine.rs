@@ -134,14 +134,20 @@ fn fills_arg(ob: &Bound<'_, PyAny>) -> PyResult<Vec<(f32, f32)>> {
     let mut out = Vec::new();
     for (i, item) in ob.try_iter().map_err(|_| not_pairs())?.enumerate() {
         let item = item?;
-        let (sigma, min_score): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
-            item.extract().map_err(|_| {
-                PyValueError::new_err(format!(
-                    "invalid parameter `fills`: element {i} ({}): expected a (sigma, min_score) \
-                     pair",
-                    repr(&item)
-                ))
-            })?;
+        // any sequence of two, not a tuple alone: a list pair ([[16, 0.3]], JSON's) was
+        // "element 0 ([16, 0.3]): expected a (sigma, min_score) pair" of a pair
+        let pair = || -> Option<(Bound<'_, PyAny>, Bound<'_, PyAny>)> {
+            if item.is_instance_of::<pyo3::types::PyString>() || item.len().ok()? != 2 {
+                return None;
+            }
+            Some((item.get_item(0).ok()?, item.get_item(1).ok()?))
+        };
+        let (sigma, min_score) = pair().ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "invalid parameter `fills`: element {i} ({}): expected a (sigma, min_score) pair",
+                repr(&item)
+            ))
+        })?;
         out.push((
             f32::extract_named(&sigma, "fill sigma")?,
             f32::extract_named(&min_score, "fill min_score")?,
