@@ -20,6 +20,7 @@ from stereovision.evaluate import (
     dense_metrics,
     depth_metrics,
     gt_depth,
+    saturated_gt_depth,
     sparse_metrics,
     table1_report,
 )
@@ -127,6 +128,17 @@ def test_gt_depth_metres() -> None:
     np.testing.assert_allclose(z[0, [0, 4]], [1.0, 0.5], rtol=1e-7)
     assert np.isnan(z[0, 1:4]).all()
     assert z.dtype == np.float32
+
+
+def test_saturated_gt_depth_is_float16s_largest_value_through_the_disparity() -> None:
+    """TartanAir's sky: GT depth 65504 m (float16's largest) stored as a disparity of
+    f B / 65504 px reads back as 65503.996 m in float32; that is saturated, a depth a metre
+    nearer (or 65 km in mm) and unknown pixels are not."""
+    cal = _rect_calib(f=320.0, b_mm=250.0, doffs=0.0)
+    d = np.float32(80.0 / 65504.0)  # 0.0012213 px, as the scene's gt_disp.pfm holds it
+    z = gt_depth(np.array([[d, 80.0 / 65503.0, 80.0 / 65.504, NAN, INF, 8.0]]), cal)
+    assert float(z[0, 0]) != 65504.0  # the round trip moved it
+    assert saturated_gt_depth(z).tolist() == [[True, False, False, False, False, False]]
 
 
 # -------------------------------------------------------------------------------------- Table 1

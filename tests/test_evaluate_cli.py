@@ -439,6 +439,52 @@ def test_the_members_line_says_those_under_a_pixel_of_disparity_apart() -> None:
     assert _members_line("x", row).endswith("RMSE without them: none left)")
 
 
+@pytest.fixture(scope="module")
+def tartanair_sky(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A 96 x 48 crop of TartanAir oldtown's top edge (rows 0-47, columns 200-295) named
+    ``tartanair/sky``: 1097 of its 4608 GT pixels are sky, at a GT depth of 65504 m."""
+    import cv2
+
+    from stereovision.io import read_pfm, write_pfm
+
+    src = data_dir / "tartanair" / "oldtown_easy_p000_001116"
+    dst = tmp_path_factory.mktemp("sky") / "tartanair" / "sky"
+    dst.mkdir(parents=True)
+    rows, cols = slice(0, 48), slice(200, 296)
+    for name in ("left.png", "right.png"):
+        assert cv2.imwrite(str(dst / name), cv2.imread(str(src / name))[rows, cols])
+    write_pfm(dst / "gt_disp.pfm", read_pfm(src / "gt_disp.pfm")[rows, cols])
+    text = (src / "calib.txt").read_text()  # the principal point does not enter the depth
+    (dst / "calib.txt").write_text(
+        text.replace("width=640", "width=96").replace("height=480", "height=48")
+    )
+    return dst
+
+
+def test_eval_leaves_the_gt_depth_at_float16s_largest_value_out_and_says_so(
+    tartanair_sky: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """TartanAir's sky holds a GT depth of 65504 m (float16's largest value, GT disparity
+    0.0012 px), where validated matches measure ~8 m: the members' RMSE was 2060.75 % of the
+    mean depth on the scene, 398.85 % over 32 members on this crop. Those GT pixels are now
+    counted in a line and left out of the depth figures (30 members, 2.79 %; our depth over
+    2735 pixels, not 3105); the disparity figures keep them (13.9 / 21.0 as before)."""
+    assert main(["eval", str(tartanair_sky), "--no-opencv", "--method", "fast"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[2].split() == "tartanair/sky 16 | 13.9 21.0 100.0 | 13.9 21.0 100.0".split()
+    assert out[4] == (
+        "tartanair/sky: GT depth: 1097 of 4608 known pixels (23.8 %) are at 65504 m, float16's "
+        "largest value (sky: a clamp, not a distance); the depth figures and Table-1 tests "
+        "leave them out, the disparity figures keep them"
+    )
+    assert out[5].startswith("tartanair/sky: depth over our 2735 pixels: median |dZ|/Z 3.70 %")
+    members = [line for line in out if "validated matches" in line]
+    assert members == [
+        "tartanair/sky: validated matches (>= 2 of Gabor, MCGM, Hopfield agree) with GT depth: "
+        "30, RMSE 2.79 % of the mean depth, median |dZ|/Z 1.20 %"
+    ]
+
+
 def test_eval_scene_figures_are_the_metrics_of_each_output(terrace: Path) -> None:
     """Each block of an ``eval`` row is evaluation.md's metric of its own output, reproducible
     from the public functions: ``ours+fill`` of the row-filled map, ``members_depth`` of the

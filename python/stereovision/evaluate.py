@@ -459,6 +459,35 @@ def gt_depth(gt: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float32]:
     return _depth_from_disparity(gt, calib, "m", 3)
 
 
+#: float16's largest value (65504): a GT depth stored as float16 saturates there (TartanAir's
+#: sky), so a GT depth of that many metres is the format's clamp, not a measured distance.
+GT_DEPTH_SATURATED_M = float(np.finfo(np.float16).max)
+
+
+def saturated_gt_depth(gt: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+    """Pixels of a GT depth map (metres) at float16's largest value, 65504 m: unknown, not GT.
+
+    TartanAir's sky holds that depth (its GT disparity ~0.0012 px at f B = 80 m px), where the
+    validated matches measured ~10 px (7.9 m): scored as GT, those pixels took the matches'
+    depth RMSE to 2060.75 % of the mean depth. ``eval`` leaves them out of the depth figures
+    and Table-1 tests (evaluation.md: over pixels where the GT depth exists) and says how many.
+
+    Parameters
+    ----------
+    gt : array_like
+        GT depth in metres, as :func:`gt_depth` gives it (NaN = unknown).
+
+    Returns
+    -------
+    numpy.ndarray
+        Boolean map, True within 1e-6 (relative) of 65504 m: the float32 round trip through
+        the disparity moves the value by a few units in the last place.
+    """
+    z = np.asarray(gt, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        return np.abs(z - GT_DEPTH_SATURATED_M) <= 1e-6 * GT_DEPTH_SATURATED_M
+
+
 # -------------------------------------------------------------------------------------- Table 1
 
 
