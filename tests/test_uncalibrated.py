@@ -859,6 +859,23 @@ def test_rectify_keeps_a_float_pair_in_its_range_under_cubic_and_lanczos() -> No
     assert lin.min() >= 0.0 and lin.max() <= np.float32(0.9)
 
 
+def test_rectify_gives_a_float_pair_s_linear_warp_as_opencv_does() -> None:
+    """The clip of cubic and Lanczos's overshoot ran under every method: a float64 pair's linear
+    warp (the default) had pixels moved by an ulp (0.7000000000000001 -> 0.7, 34 of 768 here),
+    and a colour float pair's rectify took ~1.8x as long. Methods that stay within the pixels
+    (nearest, linear, area) give OpenCV's warp as it is."""
+    img = np.full((24, 32), 0.7)
+    shift = np.array([[1.01, 0.013, 0.37], [0.002, 0.99, 0.31], [1e-5, 0.0, 1.0]])
+    rect = UncalibratedRectification(
+        shift, shift, (32, 24), (32, 24), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16, (0.0, 0.0),
+        (1.0, 1.0),
+    )  # fmt: skip
+    for method in (cv2.INTER_NEAREST, cv2.INTER_LINEAR, cv2.INTER_AREA):
+        warp = cv2.warpPerspective(img, shift, (32, 24), flags=method)
+        assert warp.max() > 0.7 or method == cv2.INTER_NEAREST  # OpenCV's own ulp kept
+        np.testing.assert_array_equal(rect.rectify(img, img, interpolation=method)[0], warp)
+
+
 @pytest.mark.parametrize(
     "interpolation",
     [True, "linear", None, 5, -1, 99, cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, 1.5],
