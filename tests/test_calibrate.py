@@ -2018,6 +2018,16 @@ def test_names_of_another_count_are_refused_before_the_boards_are_looked_for(
     with pytest.raises(TypeError) as terr:
         calibrate([blank] * 3, [blank] * 3, square_size=1.0, names="abc")  # type: ignore[arg-type]
     assert str(terr.value) == "names: expected one name per pair, got one name 'abc'"
+    # no sequence at all was list()'s "'int' object is not iterable", naming no argument
+    for kw, words in (
+        ({"names": 5}, "names: expected a sequence of names, one per pair, got 5"),
+        ({"left_images": None}, "left_images: expected a sequence of images or paths, got None"),
+        ({"right_images": 2.5}, "right_images: expected a sequence of images or paths, got 2.5"),
+    ):
+        given: dict[str, Any] = {"left_images": [blank] * 3, "right_images": [blank] * 3, **kw}
+        with pytest.raises(TypeError) as nerr:
+            calibrate(square_size=1.0, **given)
+        assert str(nerr.value) == words
 
 
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:

@@ -1467,6 +1467,16 @@ def _first_shown(names: Sequence[str]) -> str:
     return f"{shown} and {extra} more" if extra > 0 else shown
 
 
+def _listed(given: Any, name: str, what: str) -> list[Any]:
+    """``given`` as a list; one that is no sequence (None, a number) a TypeError naming it
+    (list()'s "'int' object is not iterable" named no argument)."""
+    try:
+        items = iter(given)
+    except TypeError:
+        raise TypeError(f"{name}: expected a sequence of {what}, got {given!r}") from None
+    return list(items)
+
+
 # ------------------------------------------------------------------------------------- public
 
 
@@ -1534,7 +1544,8 @@ def calibrate(
         If an image file does not exist (the message names it).
     TypeError
         If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard` (a
-        chessboard's ``"9x6"`` goes in ``pattern``), or ``names`` is one string.
+        chessboard's ``"9x6"`` goes in ``pattern``), or ``left_images``, ``right_images`` or
+        ``names`` is no sequence (one path, one string, None, a number).
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
@@ -1573,7 +1584,8 @@ def calibrate(
                 f"{name}: expected a sequence of images or paths, got one path {given!r} "
                 "(a list of one, or a glob through stereovision calibrate --left 'left*.png')"
             )
-    lefts, rights = list(left_images), list(right_images)
+    lefts = _listed(left_images, "left_images", "images or paths")
+    rights = _listed(right_images, "right_images", "images or paths")
     if len(lefts) != len(rights):
         raise ValueError(
             f"left_images and right_images differ in length: {len(lefts)} vs {len(rights)}"
@@ -1584,7 +1596,7 @@ def calibrate(
         # before the boards are looked for (a minute for 30 pairs), not after, as it was
         if isinstance(names, (str, bytes)):  # list() would name the pairs by its letters
             raise TypeError(f"names: expected one name per pair, got one name {names!r}")
-        names = list(names)
+        names = _listed(names, "names", "names, one per pair")
         if len(names) != len(lefts):
             raise ValueError(f"names: expected {len(lefts)} names (one per pair), got {len(names)}")
 
