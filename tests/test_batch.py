@@ -1840,6 +1840,37 @@ def test_a_folder_that_cannot_be_listed_is_warned_of(
     ]
 
 
+def test_an_input_folder_that_cannot_be_listed_is_an_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The input folder itself that cannot be listed (no permission) was os.walk's warning
+    'cannot search folder in: ...; the pairs in it, if any, are left out' and then 'no pair
+    under in (scene folders with left.png + right.png ...)', as if it held none of the
+    layouts: an error now, naming it, and the CLI's one line."""
+    from stereovision import cli
+    from stereovision.batch import _scan
+
+    root = tmp_path / "in"
+    (root / "a").mkdir(parents=True)
+    listing = os.scandir
+
+    def scandir(path: Any = ".") -> Any:
+        if not isinstance(path, int) and os.fspath(path) == str(root):
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    said = f"cannot search input folder {root}: Permission denied"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the error alone, no warning before it
+        with pytest.raises(PermissionError) as err:
+            _scan(root)
+    assert str(err.value) == said
+    assert cli.main(["batch", str(root), "-o", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+    assert not (tmp_path / "out").exists()
+
+
 def test_outputs_written_into_the_input_are_not_reported_as_half_pairs(tmp_path: Path) -> None:
     """``batch 00 -o 00`` (-o given as the input) over a KITTI sequence of two rigs: each
     pair's folder lies in its left camera folder (00/image_0/000000/), and the next run

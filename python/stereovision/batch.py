@@ -275,6 +275,8 @@ def find_pairs(
         If ``root`` (or ``calib``) does not exist.
     NotADirectoryError
         If ``root`` is not a folder.
+    PermissionError
+        If ``root`` cannot be listed (an :class:`OSError` of its kind for another reason).
 
     Warns
     -----
@@ -314,6 +316,13 @@ def _scan(
         )
     if not r.is_dir():
         raise NotADirectoryError(f"input is not a folder: {r}")
+    try:
+        # one that cannot be listed (no permission) was os.walk's warning, then "no pair
+        # under" it naming the layouts, as if it held none of them
+        with os.scandir(r):
+            pass
+    except OSError as e:
+        raise type(e)(f"cannot search input folder {r}: {e.strerror or e}") from None
     cal = as_path(calib, "calib") if calib is not None else None
     if cal is not None and not cal.exists():
         # a link whose target moved: which file is missing is said, as depth --calib says it
@@ -1881,7 +1890,7 @@ def run_batch(
         A ``fill`` that is not True, False or None, a ``ground`` or ``retry_failed`` that is
         not True or False, a ``max_disparity`` or ``grid`` that is not a number.
     PermissionError
-        If the output folder cannot be written.
+        If the output folder cannot be written, or the input folder cannot be listed.
     OSError
         The scheduler cannot be reached.
     BatchInterrupted
