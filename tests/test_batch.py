@@ -1871,6 +1871,39 @@ def test_an_input_folder_that_cannot_be_listed_is_an_error(
     assert not (tmp_path / "out").exists()
 
 
+def test_images_of_a_camera_folder_whose_sibling_cannot_be_listed_are_no_half_pairs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """seq/right/sub/ that cannot be listed (no permission) is warned of as left out, but
+    seq/left/sub/0002.png was also a failed pair, 'unpaired image: no seq/right/sub/0002.png
+    for ...', a file that may well be there. Its pair is left out as the warning says; a
+    right/ short of an image it can list is reported as before."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "in"
+    img = np.zeros((4, 6), np.uint8)
+    for f in ("0001.png", "0003.png", "sub/0002.png"):
+        for side in ("left", "right"):
+            if not (side == "right" and f == "0003.png"):
+                (root / "seq" / side / f).parent.mkdir(parents=True, exist_ok=True)
+                cv2.imwrite(str(root / "seq" / side / f), img)
+    listing = os.scandir
+    locked = str(root / "seq/right/sub")
+
+    def scandir(path: Any = ".") -> Any:
+        if not isinstance(path, int) and os.fspath(path) == locked:
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    with pytest.warns(UserWarning, match="cannot search folder .*right/sub: Permission denied"):
+        jobs, unpaired, _ = _scan(root)
+    assert [j.name for j in jobs] == ["seq/0001"]
+    assert [(u.name, u.error) for u in unpaired] == [
+        ("seq/0003", f"unpaired image: no {root}/seq/right/0003.png for {root}/seq/left/0003.png")
+    ]
+
+
 def test_outputs_written_into_the_input_are_not_reported_as_half_pairs(tmp_path: Path) -> None:
     """``batch 00 -o 00`` (-o given as the input) over a KITTI sequence of two rigs: each
     pair's folder lies in its left camera folder (00/image_0/000000/), and the next run

@@ -705,11 +705,27 @@ def _sibling_pairs(
             left_name = f if side == "left" else partner.as_posix()
             alone.append(_Unpaired(name(_without_side(left_name)), own / f, other / partner, side))
             told.add(own / f)
+    # an image whose other's folder cannot be listed (no permission) was "no right/sub/0002.png
+    # for ...", a file that may be there: its pair is left out, as _walk's warning says
+    unlisted = {d for d in {u.missing.parent for u in alone} if not _listable(d)}
+    alone = [u for u in alone if u.missing.parent not in unlisted]
     return (
         pairs,
         alone,
         {left_dir / a for a, _ in by_number} | {right_dir / b for _, b in by_number} | told,
     )
+
+
+def _listable(folder: Path) -> bool:
+    """False for a folder that is there but cannot be listed (no permission, an I/O error);
+    True for one that can, or that is not there at all."""
+    try:
+        with os.scandir(folder):
+            return True
+    except (FileNotFoundError, NotADirectoryError):
+        return True
+    except OSError:
+        return False
 
 
 def _lone_named_images(folder: Path, skip: frozenset[str] = frozenset()) -> set[str]:
