@@ -1809,6 +1809,22 @@ def test_a_left_camera_folder_without_its_right_one_is_reported(tmp_path: Path) 
     ]  # fmt: skip
 
 
+def test_an_image_of_a_lone_left_camera_folder_is_reported_once(tmp_path: Path) -> None:
+    """seq/left/im0.png, its folder without seq/right/ (8d17cab1), was two failed pairs for one
+    file: 'seq/left' (no im1.png beside it) and 'seq/im0' (no seq/right/im0.png for it). Once
+    now, as the camera folder's half pair, as in a rig whose right/ holds no im0.png."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "in"
+    for f in ("seq/left/im0.png", "seq/left/0001.png"):
+        (root / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(root / f), np.zeros((4, 6), np.uint8))
+    assert [(u.name, u.error) for u in _scan(root)[1]] == [
+        ("seq/0001", f"unpaired image: no {root}/seq/right/0001.png for {root}/seq/left/0001.png"),
+        ("seq/im0", f"unpaired image: no {root}/seq/right/im0.png for {root}/seq/left/im0.png"),
+    ]
+
+
 def test_a_folder_that_cannot_be_listed_is_warned_of(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

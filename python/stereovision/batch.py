@@ -429,6 +429,8 @@ def _scan(
                 short = f.rsplit(".", 1)[0]
                 name = "/".join(x for x in (rel, short) if x not in ("", "."))
                 lone_unpaired.append(_Unpaired(name, here / cam / f, here / other / f, side))
+                # as a rig's: its im0.png alone was also "no im1.png beside" it, two for one
+                cam_images.add(here / cam / f)
     # after the other layouts' pairs, so that those keep their names in a clash (the sort is
     # stable): camera folders' images were not pairs before
     found += cam_found
