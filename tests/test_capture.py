@@ -1583,6 +1583,44 @@ def test_a_board_capture_resumed_into_its_folder_judges_against_the_pairs_there(
     ]
 
 
+def test_a_board_capture_resumed_into_a_full_folder_reads_its_last_pairs_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A board capture resumed into its folder read and searched every pair there before its
+    first pair (200 board-less VGA pairs: 12 s of CPU in silence); it reads the last
+    RESUME_POSES_MAX, and says how many earlier ones it did not read."""
+    out = tmp_path / "pairs"
+    out.mkdir()
+    blank = np.full((240, 320, 3), 128, np.uint8)
+    for i, image in enumerate([blank, _half_board(), blank], start=1):
+        for side in ("left", "right"):
+            cv2.imwrite(str(out / f"{side}_{i:04d}.png"), image)
+    monkeypatch.setattr(capmod, "RESUME_POSES_MAX", 2, raising=False)
+    import stereovision.io as svio
+
+    read: list[str] = []
+    real_read = svio.read_image
+
+    def read_image(path: Path) -> np.ndarray:
+        read.append(Path(path).name)
+        return real_read(path)
+
+    monkeypatch.setattr(svio, "read_image", read_image)
+    left = _write_sequence(tmp_path / "seq", "left", [_half_board()])
+    right = _write_sequence(tmp_path / "seq", "right", [_half_board()])
+    lines: list[str] = []
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, out, chessboard="9x6", log=lines.append)
+    assert read == ["left_0002.png", "right_0002.png", "left_0003.png", "right_0003.png"]
+    assert result.saved == []  # the pose of pair 2, read
+    bars = "  ".join(f"{k} [----------]   0%" for k in ("x", "y", "size", "skew"))
+    assert lines == [
+        f"1 of the last 2 pairs in {out} shows the board (1 before them not read, for a quick "
+        f"start): new poses must differ from it too  {bars}",
+        "no pair saved of the 1 pair judged: pose too close to a saved one (1 pair)",
+    ]
+
+
 def _still_noisy_sequence(
     data_dir: Path, directory: Path, n: int, shift_per_frame: int = 0
 ) -> tuple[str, str]:

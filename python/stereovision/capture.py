@@ -125,6 +125,10 @@ LIVE_DETECT_FLAGS = (
 _TEMPORAL_FULL = 0.95
 #: Width of each coverage bar in the progress line (characters).
 PROGRESS_BAR_WIDTH = 10
+#: A board capture resumed into its folder reads the board poses of at most this many pairs
+#: there, the last ones: each is two image reads and a board search (~60 ms of CPU at VGA, ~100
+#: ms at 1280x720), and 200 pairs there held the first pair back 12-22 s in silence.
+RESUME_POSES_MAX = 20
 #: File name pattern of saved pairs (index from 1; 4 digits sort well up to 9999 pairs).
 PAIR_NAME = "{side}_{index:04d}{ext}"
 _PAIR_RE = re.compile(r"^(left|right)_(\d+)\.[A-Za-z0-9]+$")
@@ -3151,9 +3155,10 @@ def capture(
     camera : StereoCamera
     directory : str or os.PathLike
         Created if missing; numbering continues after pairs already there (none is overwritten).
-        With a board, their poses count as saved ones (a capture resumed into its folder saves
-        only poses new to it; said to ``log``). Temporary files a killed capture left there
-        are removed first (said to ``log``).
+        With a board, the poses of the last :data:`RESUME_POSES_MAX` of them count as saved
+        ones (a capture resumed into its folder saves only poses new to them; said to ``log``,
+        with the number of earlier pairs not read). Temporary files a killed capture left
+        there are removed first (said to ``log``).
     count : int, optional
         Pairs to save. Without it, capture runs until a source ends (normal for files); when
         one ends before the other, or a video file before the frames its header announces
@@ -3272,13 +3277,23 @@ def capture(
     if collector is not None and index > 1:
         # a capture resumed into its folder ("run again to add more") judged new poses
         # against none: the poses saved before were saved again, the coverage from 0 %
-        seen = _remember_saved_poses(collector, out)
+        seen, older = _remember_saved_poses(collector, out)
+        where = escaped(str(out))
+        # the pairs not read may hold poses the new ones repeat: said, not hidden
+        unread = f" ({older} before them not read, for a quick start)" if older else ""
         if seen and log is not None:
+            had = (
+                f"{seen} of the last {RESUME_POSES_MAX} pairs in {where} "
+                f"{'shows' if seen == 1 else 'show'} the board{unread}"
+                if older
+                else f"{_pairs(seen)} already in {where} with the board"
+            )
             log(
-                f"{_pairs(seen)} already in {escaped(str(out))} with the board: new poses "
-                f"must differ from {'it' if seen == 1 else 'them'} too  "
+                f"{had}: new poses must differ from {'it' if seen == 1 else 'them'} too  "
                 + collector.format_progress()
             )
+        elif older and log is not None:
+            log(f"none of the last {RESUME_POSES_MAX} pairs in {where} shows the board{unread}")
     saved: list[tuple[Path, Path]] = []
     ended = "count reached"
     last_index = -1  # the frame index of the pair saved last
@@ -3430,25 +3445,29 @@ def capture(
     )
 
 
-def _remember_saved_poses(collector: ChessboardCollector, out: Path) -> int:
-    """Give ``collector`` the board poses of the pairs already in ``out`` (saved by an earlier
-    capture: ``left_0001.png`` with ``right_0001.png``); the number of pairs whose board it
-    found. An image that does not read is passed over."""
+def _remember_saved_poses(collector: ChessboardCollector, out: Path) -> tuple[int, int]:
+    """Give ``collector`` the board poses of the last :data:`RESUME_POSES_MAX` pairs already in
+    ``out`` (saved by an earlier capture: ``left_0001.png`` with ``right_0001.png``); the
+    number of pairs whose board it found, and the number of earlier pairs not read. An image
+    that does not read is passed over."""
     from stereovision.io import read_image
 
     names = {p.name for p in out.iterdir()}
-    found = 0
-    for name in sorted(names):
+    pairs: list[tuple[int, str, str]] = []
+    for name in names:
         m = _PAIR_RE.match(name)
         other = "right" + name[len("left") :]
-        if m is None or m.group(1) != "left" or other not in names:
-            continue
+        if m is not None and m.group(1) == "left" and other in names:
+            pairs.append((int(m.group(2)), name, other))
+    pairs.sort()  # by index: left_10000 after left_9999
+    found = 0
+    for _, name, other in pairs[-RESUME_POSES_MAX:]:
         try:
             left, right = read_image(out / name), read_image(out / other)
         except (OSError, ValueError):  # damaged, or not an image: no pose to count
             continue
         found += collector.remember(StereoFrame(left, right, 0.0, 0.0, 0))
-    return found
+    return found, max(0, len(pairs) - RESUME_POSES_MAX)
 
 
 def _no_board_note(
