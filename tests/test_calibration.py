@@ -6,6 +6,7 @@ import dataclasses
 import json
 import os
 import re
+import sys
 from pathlib import Path
 
 import cv2
@@ -508,6 +509,22 @@ def test_from_kitti_shared_file(data_dir: Path) -> None:
     assert c.baseline_m == pytest.approx(mb.baseline_m, abs=1e-6)
     assert Calibration.from_file(path) == c
     assert parse_kitti_calib(path)["T_03"][0] == -4.731050e-01
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX file names are bytes")
+def test_from_kitti_sized_by_an_image_in_a_folder_whose_name_is_not_utf8(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A KITTI file without S_rect_02 is sized by the left.png beside it, which cv2.imread
+    read by its name: a folder named with a byte that is not UTF-8 (a Latin-1 0xFF, the lone
+    surrogate of os.fsdecode) crashed the process there (SIGSEGV, as capture's sources did)."""
+    folder = tmp_path / os.fsdecode(b"k\xff")
+    folder.mkdir()
+    kitti = data_dir / "kitti2015" / "000005_10" / "calib_kitti.txt"
+    (folder / "calib.txt").write_bytes(kitti.read_bytes())
+    cv2.imwrite(str(tmp_path / "left.png"), np.zeros((5, 8, 3), np.uint8))
+    (tmp_path / "left.png").rename(folder / "left.png")
+    assert Calibration.from_kitti(folder / "calib.txt").image_size == (8, 5)
 
 
 def test_from_kitti_says_cameras_given_right_first(data_dir: Path) -> None:

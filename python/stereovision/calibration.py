@@ -2253,7 +2253,11 @@ class Calibration:
             for name in ("left.png", "left.jpg", f"image_{a}.png"):
                 img = p.parent / name
                 if img.is_file():
-                    hdr = cv2.imread(str(img), cv2.IMREAD_UNCHANGED)
+                    from stereovision.io import _imdecode
+
+                    # from its bytes: cv2.imread of a folder named with a byte that is not
+                    # UTF-8 (os.fsdecode's lone surrogate) crashed the process (SIGSEGV)
+                    hdr = _imdecode(np.fromfile(img, np.uint8), cv2.IMREAD_UNCHANGED)
                     if hdr is not None:
                         size = (int(hdr.shape[1]), int(hdr.shape[0]))
                         break
