@@ -574,6 +574,41 @@ def test_cli_check_and_rectify_of_homographies_as_calib_name_what_they_take(
     assert "give it as --rectification (in Python" in capsys.readouterr().err
 
 
+def test_cli_info_and_batch_of_homographies_as_calib_name_what_they_take(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """info and batch, which have no --rectification either, told rectify's rectification.json
+    given as their calibration to "give it as --rectification" (argparse then: 'unrecognized
+    arguments'), as check and rectify did before (test above)."""
+    from stereovision.cli import main
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (40, 30), (40, 30), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    js = str(rect.save(tmp_path / "rectification.json"))
+    img = np.random.default_rng(0).integers(0, 256, (30, 40), np.uint8)
+    (tmp_path / "in").mkdir()
+    cv2.imwrite(str(tmp_path / "in" / "left_0001.png"), img)
+    cv2.imwrite(str(tmp_path / "in" / "right_0001.png"), np.roll(img, -2, axis=1))
+    head = f"stereovision: error: {js} holds the homographies `stereovision rectify` found for "
+    head += "a rig without a calibration (disparity only): "
+    use = "`stereovision depth LEFT RIGHT --rectification FILE` rectifies a raw pair with them"
+    assert main(["info", js]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == (
+        f"{head}info takes no homographies (they measure no depth); {use} (in Python: "
+        "stereovision.uncalibrated.UncalibratedRectification.load(path).describe() says what "
+        "they hold)\n"
+    )
+    out_dir = tmp_path / "out"
+    assert main(["batch", str(tmp_path / "in"), "-o", str(out_dir), "--calib", js]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == f"{head}batch takes no homographies; {use}\n"
+    assert not out_dir.exists()
+
+
 # ------------------------------------------------------------- mutation audit: the rule on
 # matched points (_judge_rows, shared with stereovision.uncalibrated) against closed forms
 

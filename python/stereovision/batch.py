@@ -2674,7 +2674,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from stereovision.io import check_output_folder
 
     if args.calib_unit is not None or (args.calib is not None and Path(args.calib).exists()):
-        from stereovision.cli import load_calibration
+        from stereovision.cli import _HOMOGRAPHIES_USE, load_calibration
 
         # refused in the CLI's words (--calib-unit), before a cluster starts; one that holds
         # no image size (OpenCV stereo_calib output) read at run_batch's: the first pair's
@@ -2684,7 +2684,13 @@ def cmd_batch(args: argparse.Namespace) -> int:
             with contextlib.suppress(OSError):  # no input folder: run_batch says so
                 size = _calib_size(Path(args.calib), _scan(args.input, output=args.output)[0])
         if size is not None or not sizeless:
-            load_calibration(args.calib, args.calib_unit, size=size)
+            # batch has no --rectification, which the refusal of rectify's homographies named
+            load_calibration(
+                args.calib,
+                args.calib_unit,
+                size=size,
+                homographies=f"batch takes no homographies; {_HOMOGRAPHIES_USE}",
+            )
     if args.scheduler is not None:
         _check_scheduler_address(args.scheduler)
     check_output_folder(args.output, "-o")

@@ -205,6 +205,13 @@ def add_calib_unit(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--calib-unit", choices=list(UNIT_TO_METRES), help=CALIB_UNIT_HELP)
 
 
+#: Where rectify's homographies go, for the commands without --rectification that refuse them
+#: as --calib (info, rectify, batch).
+_HOMOGRAPHIES_USE = (
+    "`stereovision depth LEFT RIGHT --rectification FILE` rectifies a raw pair with them"
+)
+
+
 def load_calibration(
     path: str | os.PathLike[str] | None,
     unit: str | None = None,
@@ -1323,7 +1330,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         args.calib_unit,
         left,
         homographies="rectify takes no homographies (without --calib it finds them anew); "
-        "`stereovision depth LEFT RIGHT --rectification FILE` rectifies a raw pair with them",
+        + _HOMOGRAPHIES_USE,
     )
     out = Path(args.output)
     if out.exists() and not out.is_dir():
@@ -1631,7 +1638,16 @@ def cmd_info(args: argparse.Namespace) -> int:
         # --size with a calibration: the image size of one that holds none (stereo_calib
         # output, a Q.dat alone), a check of the size of one that does
         size = parse_size(args.size, "--size")
-        calib = load_calibration(args.calib, args.calib_unit, size=size, size_words="--size WxH")
+        # info has no --rectification, which the refusal of rectify's homographies named
+        calib = load_calibration(
+            args.calib,
+            args.calib_unit,
+            size=size,
+            size_words="--size WxH",
+            homographies=f"info takes no homographies (they measure no depth); {_HOMOGRAPHIES_USE}"
+            " (in Python: stereovision.uncalibrated.UncalibratedRectification.load(path)"
+            ".describe() says what they hold)",
+        )
         print(calib.describe())
         if size is not None and _sizeless(args.calib):
             # the field of view is --size's alone: a Q.dat of a 640x480 rig given 100x100 said
