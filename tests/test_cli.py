@@ -3159,6 +3159,12 @@ def test_calib_help_lists_the_same_formats_for_every_command() -> None:
     assert option_help("depth", "--max-disparity").endswith(
         "(default: estimated from the images; with --rectification, the search range it holds)"
     )
+    # so did stream's, its default estimated once "from the first pair" (run_stream: the
+    # homographies' max_disparity)
+    assert option_help("stream", "--max-disparity").endswith(
+        "(default: estimated once, from the first pair; with --rectification, the search "
+        "range it holds)"
+    )
 
 
 @pytest.mark.parametrize(

@@ -1954,7 +1954,9 @@ def add_cli(subparsers: Any) -> None:
         "--max-disparity",
         type=positive_pixels,
         metavar="N",
-        help="disparity range to search, in pixels (default: estimated once, from the first pair)",
+        # with --rectification the default is its own range (run_stream), not an estimate
+        help="disparity range to search, in pixels (default: estimated once, from the first "
+        "pair; with --rectification, the search range it holds)",
     )
     p.add_argument(
         "--method",
