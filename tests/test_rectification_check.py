@@ -541,7 +541,9 @@ def test_cli_check_and_rectify_of_homographies_as_calib_name_what_they_take(
 ) -> None:
     """rectify's rectification.json given as ``check --calib`` or ``rectify --calib`` was told
     "give it as --rectification", an option neither command has (argparse then refused it).
-    Each now says what it takes; depth, which has the option, still names it."""
+    Each now says what it takes; depth, which has the option, still names it. check's words
+    sent the user to check rectify's left_rect.png and right_rect.png, where check finds few
+    features (OpenCV's books: 18, "cannot tell", exit 3): they name the check through them."""
     from stereovision.cli import main
     from stereovision.uncalibrated import UncalibratedRectification
 
@@ -559,9 +561,10 @@ def test_cli_check_and_rectify_of_homographies_as_calib_name_what_they_take(
     assert main(["check", *pair, "--calib", js]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err == (
-        f"{head}check takes no homographies: give the pair they rectified (rectify's "
-        "left_rect.png and right_rect.png) without --calib (in Python: stereovision."
-        "uncalibrated.UncalibratedRectification.load(path).check(left, right))\n"
+        f"{head}check takes no homographies: in Python, stereovision.uncalibrated."
+        "UncalibratedRectification.load(path).check(left, right) checks the raw pair through "
+        "them (rectify says that check of the ones it finds; check of its left_rect.png and "
+        "right_rect.png finds features anew, few on a warped pair)\n"
     )
     assert main(["rectify", *pair, "--calib", js, "-o", str(tmp_path / "out")]) == 2
     out, err = capsys.readouterr()
