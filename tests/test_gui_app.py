@@ -5066,6 +5066,30 @@ def test_calib_unit_without_calib_is_refused():
     assert str(err.value) == "--calib-unit is the unit of --calib's file: give --calib too"
 
 
+def test_homographies_as_calib_are_not_sent_to_an_option_gui_has_not(tmp_path):
+    """`gui --calib rectification.json` (rectify's homographies) was told "give it as
+    --rectification", an option gui has not (argparse then: 'unrecognized arguments')."""
+    pytest.importorskip("trame")
+    from stereovision.gui import add_arguments, build_app
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (40, 30), (40, 30), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    js = str(rect.save(tmp_path / "rectification.json"))
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    with pytest.raises(ValueError) as err:
+        build_app(parser.parse_args(["--calib", js]))
+    assert str(err.value) == (
+        f"{js} holds the homographies `stereovision rectify` found for a rig without a "
+        "calibration (disparity only): gui takes no homographies (its Rectify button finds them "
+        "anew from the pair on show); `stereovision depth LEFT RIGHT --rectification FILE` "
+        "rectifies a raw pair with them"
+    )
+
+
 def test_a_one_point_cloud_is_captioned_1_point(tmp_path):
     """A cloud file of one point was captioned "1 points"."""
     from stereovision.gui import bundled_data_dir

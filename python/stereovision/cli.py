@@ -206,7 +206,7 @@ def add_calib_unit(parser: argparse.ArgumentParser) -> None:
 
 
 #: Where rectify's homographies go, for the commands without --rectification that refuse them
-#: as --calib (info, rectify, batch).
+#: as --calib (info, rectify, batch, gui).
 _HOMOGRAPHIES_USE = (
     "`stereovision depth LEFT RIGHT --rectification FILE` rectifies a raw pair with them"
 )

@@ -125,7 +125,15 @@ def build_app(args: argparse.Namespace) -> Any:
             load_calibration(args.calib, args.calib_unit, size=(640, 480))
             sizeless = (str(args.calib), args.calib_unit)
         else:
-            calib = load_calibration(args.calib, args.calib_unit)
+            # gui has no --rectification, which the refusal of rectify's homographies named
+            from stereovision.cli import _HOMOGRAPHIES_USE
+
+            calib = load_calibration(
+                args.calib,
+                args.calib_unit,
+                homographies="gui takes no homographies (its Rectify button finds them anew "
+                f"from the pair on show); {_HOMOGRAPHIES_USE}",
+            )
     elif args.calib_unit is not None:  # refused as the other commands refuse it (it was ignored)
         from stereovision.cli import load_calibration
 
