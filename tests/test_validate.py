@@ -1442,6 +1442,23 @@ def test_xy_points_takes_a_float64_array_as_given_not_a_copy() -> None:
     assert xy_points(small).tolist() == pts.tolist()
 
 
+def test_xy_points_says_how_to_pass_one_point() -> None:
+    """One pixel given as its (x, y), rectify_points((320, 240)), was "points: expected shape
+    (N, 2) of (x, y), got (2,)", not what to pass; triangulate's points say it (4e0c5628), and
+    Calibration.rectify_points and UncalibratedRectification.rectify_points read them here."""
+    from stereovision._validate import xy_points
+
+    with pytest.raises(ValueError) as err:
+        xy_points((320, 240))
+    assert str(err.value) == (
+        "points: expected shape (N, 2) of (x, y), got (2,) (one point: [[x, y]])"
+    )
+    with pytest.raises(ValueError) as err:
+        xy_points(np.zeros(3), "pixels")  # neither one point nor (N, 2): the shape alone
+    assert str(err.value) == "pixels: expected shape (N, 2) of (x, y), got (3,)"
+    assert xy_points([[320, 240]]).tolist() == [[320.0, 240.0]]
+
+
 @pytest.mark.parametrize(
     "exc", [KeyError(10**5000), ValueError(10**5000), RuntimeError(-(10**4400))]
 )

@@ -1618,6 +1618,10 @@ def xy_points(points: object, name: str = "points") -> npt.NDArray[np.float64]:
         hint = (
             " (transpose a (2, N) array)"
             if pts.ndim == 2 and pts.shape[0] == 2 and pts.shape[1] != 2
+            # one pixel as its (x, y), as triangulate's points say it: the shape alone did not
+            # say what to pass
+            else " (one point: [[x, y]])"
+            if pts.shape == (2,)
             else ""
         )
         raise ValueError(f"{name}: expected shape (N, 2) of (x, y), got {pts.shape}{hint}")
