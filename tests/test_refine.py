@@ -375,6 +375,23 @@ def test_a_colour_pair_is_refined_as_its_grey_one() -> None:
         refine_disparity(left.astype(np.uint16) * 16, right * np.uint16(257), disp, max_disparity=8)
 
 
+def test_an_image_of_no_shape_taken_names_the_colour_ones_too() -> None:
+    """Since colour pairs are refined (9be8aed9), "left must be a non-empty 2-D (H, W) array"
+    told the caller of a two-channel or a (3, H, W) image that only grey ones are taken. The
+    images' message names the colour shapes too; the maps' stays."""
+    grey = np.zeros((30, 48), np.float32)
+    for bad in (np.zeros((30, 48, 2), np.uint8), np.zeros((3, 30, 48), np.uint8)):
+        with pytest.raises(ValueError) as err:
+            refine_disparity(bad, bad, grey, max_disparity=8)
+        assert str(err.value) == (
+            "left must be a non-empty 2-D (H, W) array or an (H, W, 3) BGR / (H, W, 4) BGRA "
+            f"colour image, got shape {bad.shape}"
+        )
+    with pytest.raises(ValueError) as err:
+        refine_disparity(grey, grey, grey[None], max_disparity=8)
+    assert str(err.value) == "disparity must be a non-empty 2-D (H, W) array, got shape (1, 30, 48)"
+
+
 def test_a_map_mostly_outside_the_range_is_warned_of_as_fixed_point() -> None:
     """OpenCV StereoSGBM's int16 map (d * 16, -16 = no match) was refined as pixels: every
     value past max_disparity dropped, tsukuba's refined map kept 1 % of its pixels, without a

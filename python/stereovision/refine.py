@@ -129,7 +129,12 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
             _warn_low_uint16(arr, name, _LOW_UINT16_EFFECT)
         return as_gray_float(arr, name, warn=False)
     if arr.ndim != 2 or arr.size == 0:
-        raise ValueError(f"{name} must be a non-empty 2-D (H, W) array, got shape {arr.shape}")
+        # an image may be a colour one too (above): "2-D (H, W)" alone told the caller of a
+        # two-channel or (3, H, W) image that only grey ones are taken
+        colour = " or an (H, W, 3) BGR / (H, W, 4) BGRA colour image" if image else ""
+        raise ValueError(
+            f"{name} must be a non-empty 2-D (H, W) array{colour}, got shape {arr.shape}"
+        )
     # before the float32 copy: a broadcast image past the kernel's limit may not fit in memory
     check_index_range(arr.shape, name, "image" if image else "map")
     if image and arr.dtype in (np.uint8, np.uint16):
