@@ -419,6 +419,31 @@ def test_a_map_mostly_outside_the_range_is_warned_of_as_fixed_point() -> None:
         refine_disparity(left, right, np.full(left.shape, -3.0), max_disparity=8)
 
 
+def test_a_fixed_point_map_mostly_without_a_match_is_warned_of_too() -> None:
+    """StereoBM's int16 map of KITTI 000005 is 52 % -16 (no match): 45 % of its values lay
+    above max_disparity, under the half the warning asked for, and its refined map kept 8.9 %
+    of the pixels (its values / 16: 60.2 %) without a word. Values below the range are not
+    counted against it; a map mostly in the range is still not warned of."""
+    rng = np.random.default_rng(3)
+    left = (rng.random((30, 48)) * 255).astype(np.uint8)
+    right = np.roll(left, -2, axis=1)
+    fixed = np.full(left.shape, -16, np.int16)  # no match on 30 of 48 columns
+    fixed[:, 30:] = 32
+    with pytest.warns(UserWarning) as caught:
+        refine_disparity(left, right, fixed, max_disparity=8)
+    assert [str(w.message) for w in caught] == [
+        "disparity: 540 of its 1440 values (37.5 %) lie above max_disparity 8 px and are "
+        "dropped (the largest 32 px); fixed-point values? OpenCV StereoBM / StereoSGBM's int16 "
+        "map is d * 16 (divide by 16; its -16 is no match), a 16-bit disparity PNG d * 256 "
+        "(stereovision.export.read_disparity_png)"
+    ]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fixed[:, 20:30] = 2  # 10 columns in the range, 18 above: fewer than half of them
+        fixed[:, 39:] = 2
+        refine_disparity(left, right, fixed, max_disparity=8)
+
+
 def test_a_12_bit_pair_in_uint16_is_warned_of_as_the_matchers_do() -> None:
     """A uint16 pair of 12-bit values was taken at /65535 without a word, where the matchers
     (as_gray_float) warn of it: 16 times darker, its contrast under var_floor (teddy as 12-bit

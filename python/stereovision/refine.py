@@ -148,13 +148,15 @@ def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
     return np.ascontiguousarray(arr, dtype=np.float32)
 
 
-def _warn_if_mostly_above_range(d: npt.NDArray[np.float32], hi: float) -> None:
-    """Warn when most of the map's values lie above ``max_disparity``, which the refinement
-    drops: OpenCV StereoSGBM's int16 map (``d * 16``, -16 = none) gave tsukuba's refined map
-    1 % of its pixels (its values / 16: 89 %), without a word."""
+def _warn_if_mostly_above_range(d: npt.NDArray[np.float32], lo: float, hi: float) -> None:
+    """Warn when most of the map's values not below ``min_disparity`` lie above
+    ``max_disparity``, which the refinement drops: OpenCV StereoSGBM's int16 map (``d * 16``,
+    -16 = none) gave tsukuba's refined map 1 % of its pixels (its values / 16: 89 %), without
+    a word. Values below the range (the -16 of no match) are not counted against it: KITTI's
+    StereoBM map, 52 % of it -16, was not warned of with 45 % of its values above."""
     values = d[np.isfinite(d)]
     above = int(np.count_nonzero(values > hi))
-    if above * 2 <= values.size:
+    if above * 2 <= values.size - int(np.count_nonzero(values < lo)):
         return
     import warnings
 
@@ -210,8 +212,9 @@ def refine_disparity(
     Warns
     -----
     UserWarning
-        When most of the map's values lie above ``max_disparity`` (fixed-point values: OpenCV's
-        int16 ``d * 16``, a 16-bit disparity PNG's ``d * 256``), all of which are dropped.
+        When most of the map's values not below ``min_disparity`` lie above ``max_disparity``
+        (fixed-point values: OpenCV's int16 ``d * 16``, whose -16 is no match, a 16-bit
+        disparity PNG's ``d * 256``), all of which are dropped.
 
     Raises
     ------
@@ -264,7 +267,7 @@ def refine_disparity(
                 f"{name}: expected a finite number in float32, the kernel's precision, got "
                 f"{number_shown(v)}"
             )
-    _warn_if_mostly_above_range(dsp, hi)
+    _warn_if_mostly_above_range(dsp, lo, hi)
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:
