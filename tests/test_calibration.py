@@ -736,6 +736,20 @@ def test_stereopi_reference_calibration(data_dir: Path) -> None:
     )
 
 
+def test_rectify_points_reaches_the_corners_of_a_wide_lens(data_dir: Path) -> None:
+    """OpenCV's undistortion capped at 40 rounds left 524 of the StereoPi left camera's pixels
+    (k1 0.53, k2 -3.09, k3 4.93; within 44 px of its corners) up to 2.8 px from where rectify
+    puts them, as triangulate's 100 did (c2808b73). They are mapped onto their pixels now:
+    the rectified point's ray projects back onto the raw pixel."""
+    c = stereopi_calib(data_dir)
+    px = np.array([[32.0, 0.0], [16.0, 16.0], [312.0, 24.0], [160.0, 120.0]])
+    got = c.rectify_points(px, "left")
+    r1, _, p1, _, _ = c._stereo_rectify(0.0)
+    ray = np.column_stack([(got - p1[:2, 2]) / np.diag(p1)[:2], np.ones(len(got))]) @ r1
+    back = cv2.projectPoints(ray, np.zeros(3), np.zeros(3), c.K1, c.D1)[0].reshape(-1, 2)
+    np.testing.assert_allclose(back, px, rtol=0, atol=1e-9)
+
+
 def test_valid_roi_depends_on_alpha() -> None:
     c = raw_calib()
     (_, _, w0, h0), roi_r0 = c.valid_roi(0.0)
