@@ -329,6 +329,31 @@ def test_a_new_size_starts_again_and_bad_input_is_named() -> None:
     assert tf.mean_frames() == 0.0
 
 
+def test_only_max_frames_and_k_are_parameters() -> None:
+    """The counters and the noise estimate are state, not parameters (the docstring's
+    Parameters are max_frames and k): TemporalFilter(8, 3.0, 5) started at frames=5, and
+    sigma=2.0 (read as a noise level) was taken silently and replaced by the first pair's."""
+    import inspect
+
+    assert list(inspect.signature(TemporalFilter).parameters) == ["max_frames", "k"]
+    with pytest.raises(TypeError, match="positional argument"):
+        TemporalFilter(8, 3.0, 5)  # type: ignore[call-arg]
+    with pytest.raises(TypeError, match="unexpected keyword argument 'sigma'"):
+        TemporalFilter(sigma=2.0)  # type: ignore[call-arg]
+    tf = TemporalFilter(4, 2.0)
+    assert (tf.max_frames, tf.k, tf.frames, tf.restarts, tf.sigma, tf.relit) == (
+        4,
+        2.0,
+        0,
+        0,
+        0.0,
+        0,
+    )
+    assert (
+        repr(tf) == "TemporalFilter(max_frames=4, k=2.0, frames=0, restarts=0, sigma=0.0, relit=0)"
+    )
+
+
 def test_max_frames_caps_the_mean_and_a_new_light_is_followed() -> None:
     """Beyond ``max_frames`` the mean follows a still pixel's new value by 1/max_frames each;
     a change of the whole image's brightness (a flickering light, an auto-exposure step) is

@@ -285,14 +285,16 @@ class TemporalFilter:
 
     max_frames: int = 8
     k: float = 3.0
-    frames: int = 0
-    restarts: int = 0
-    sigma: float = 0.0
-    relit: int = 0
-    _means: list[_Mean] = field(default_factory=list, repr=False)
-    _sigmas: deque[float] = field(default_factory=lambda: deque(maxlen=8), repr=False)
+    # The state is no parameter (init=False): TemporalFilter(8, 3.0, 5) started at frames=5 and
+    # TemporalFilter(sigma=2.0), read as a noise level, was overwritten by the first pair.
+    frames: int = field(default=0, init=False)
+    restarts: int = field(default=0, init=False)
+    sigma: float = field(default=0.0, init=False)
+    relit: int = field(default=0, init=False)
+    _means: list[_Mean] = field(default_factory=list, init=False, repr=False)
+    _sigmas: deque[float] = field(default_factory=lambda: deque(maxlen=8), init=False, repr=False)
     # the last frame's shape, kept when the means are forgotten (capture, after a saved pair)
-    _shape: tuple[int, ...] | None = field(default=None, repr=False)
+    _shape: tuple[int, ...] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.max_frames, (int, np.integer)) or isinstance(
