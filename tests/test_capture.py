@@ -1853,6 +1853,24 @@ def test_collector_checks_its_arguments_when_made() -> None:
     assert ChessboardCollector((9, 6), min_distance=np.float32(0.5)).min_distance == 0.5
 
 
+def test_collector_takes_its_parameters_in_the_documented_order() -> None:
+    """The docstring's Parameters are pattern, min_distance, board; the constructor took the
+    list of kept poses third, so ChessboardCollector(pattern, 0.2, board) put the board there
+    and collected chessboards (board None); kept is state now, never a parameter."""
+    import inspect
+
+    board = CharucoBoard("10x7", 0.03, 0.022)
+    col = ChessboardCollector(board.inner, 0.2, board)
+    assert col.board is board and col.kept == [] and col.min_distance == 0.2
+    assert list(inspect.signature(ChessboardCollector).parameters) == [
+        "pattern",
+        "min_distance",
+        "board",
+    ]
+    with pytest.raises(TypeError, match="unexpected keyword argument 'kept'"):
+        ChessboardCollector((9, 6), kept=[])  # type: ignore[call-arg]
+
+
 def test_capture_names_a_charuco_that_is_no_board(tmp_path: Path) -> None:
     """capture(charuco="10x7"), a pattern's words given for the board, was AttributeError
     "'str' object has no attribute 'inner'" (ChessboardCollector's own check came after):

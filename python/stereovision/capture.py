@@ -2951,7 +2951,9 @@ class ChessboardCollector:
 
     pattern: tuple[int, int]
     min_distance: float = MIN_POSE_DISTANCE
-    kept: list[tuple[float, float, float, float]] = field(default_factory=list)
+    # state, not a parameter: ChessboardCollector(pattern, min_distance, board), the documented
+    # order, put the board into kept and collected chessboards
+    kept: list[tuple[float, float, float, float]] = field(default_factory=list, init=False)
     board: CharucoBoard | None = None
 
     def __post_init__(self) -> None:
