@@ -487,13 +487,8 @@ def test_public_functions_document_their_parameters_and_returns() -> None:
     assert not problems, "\n".join(problems)
 
 
-def test_public_dataclasses_document_their_fields() -> None:
-    """Every public field of a dataclass ``stereovision`` or one of its modules exports is
-    named in its docstring's Parameters or Attributes: ``DepthResult.min_disparity`` and
-    ``left_rectified`` (the image the cloud takes its colours from) were in none, nor 14 fields
-    of 5 classes the modules export (``CaptureResult.saved``, ``StreamReport.density``, ...)."""
-    import dataclasses
-
+def _exported() -> dict[int, tuple[str, object]]:
+    """What ``stereovision`` and each of its modules' ``__all__`` export, by identity."""
     import stereovision as sv
 
     exported = {id(getattr(sv, name)): (name, getattr(sv, name)) for name in sv.__all__}
@@ -507,8 +502,18 @@ def test_public_dataclasses_document_their_fields() -> None:
         for name in getattr(module, "__all__", ()):
             obj = getattr(module, name, None)
             exported.setdefault(id(obj), (name, obj))
+    return exported
+
+
+def test_public_dataclasses_document_their_fields() -> None:
+    """Every public field of a dataclass ``stereovision`` or one of its modules exports is
+    named in its docstring's Parameters or Attributes: ``DepthResult.min_disparity`` and
+    ``left_rectified`` (the image the cloud takes its colours from) were in none, nor 14 fields
+    of 5 classes the modules export (``CaptureResult.saved``, ``StreamReport.density``, ...)."""
+    import dataclasses
+
     undocumented, checked = [], 0
-    for name, cls in exported.values():
+    for name, cls in _exported().values():
         if not (inspect.isclass(cls) and dataclasses.is_dataclass(cls)):
             continue
         sections = _numpydoc_sections(inspect.getdoc(cls) or "")
@@ -526,6 +531,32 @@ def test_public_dataclasses_document_their_fields() -> None:
                     undocumented.append(f"{name}.{f.name}")
     assert not undocumented, f"fields no docstring names: {undocumented}"
     assert checked >= 240, checked  # 261 on 2026-12-06
+
+
+def test_public_classes_take_the_parameters_their_docstring_lists() -> None:
+    """An exported class whose docstring has a Parameters section is made with exactly those
+    parameters: dataclasses' generated constructors took their state too, so
+    ``TemporalFilter(8, 3.0, 5)`` started at ``frames=5`` and ``ChessboardCollector(pattern,
+    0.2, board)``, the documented order, put the board into ``kept``."""
+    wrong, checked = [], 0
+    for name, cls in _exported().values():
+        if not inspect.isclass(cls):
+            continue
+        sections = _numpydoc_sections(inspect.getdoc(cls) or "")
+        if "Parameters" not in sections:
+            continue
+        documented = {
+            part.strip().lstrip("*")
+            for line in sections["Parameters"].splitlines()
+            if line and not line[0].isspace()
+            for part in line.split(" : ")[0].split(",")
+        }
+        params = set(inspect.signature(cls).parameters)
+        checked += 1
+        if params != documented:
+            wrong.append(f"{name}{sorted(params)}: documents {sorted(documented)}")
+    assert not wrong, "constructors and their Parameters differ:\n" + "\n".join(wrong)
+    assert checked >= 12, checked  # 13 on 2026-12-07
 
 
 #: The modules whose classes and functions a user's script meets beyond ``_public_api``'s:
