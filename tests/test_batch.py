@@ -2778,7 +2778,7 @@ def test_calib_unit_reaches_the_workers(
     assert capsys.readouterr().err == (
         f"stereovision: error: {calib_txt} states its lengths in 'mm', not in --calib-unit m: "
         "leave --calib-unit out (it is for files that do not state theirs: OpenCV stereo_calib "
-        "output, Q.dat)\n"
+        "output, an OpenCV YAML/XML or JSON file without a unit field, Q.dat)\n"
     )
     assert not out.exists()
 

@@ -1797,7 +1797,7 @@ def test_calib_unit_and_size_refuse_what_the_file_states_and_need_a_file(
     assert capsys.readouterr().err == (
         f"stereovision: error: {calib_txt} states its lengths in 'mm', not in --calib-unit m: "
         "leave --calib-unit out (it is for files that do not state theirs: OpenCV stereo_calib "
-        "output, Q.dat)\n"
+        "output, an OpenCV YAML/XML or JSON file without a unit field, Q.dat)\n"
     )
     assert main(["info", str(calib_txt), "--calib-unit", "mm"]) == 0
     assert "baseline 6.0 cm (59.5549 mm)" in capsys.readouterr().out

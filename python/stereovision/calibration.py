@@ -1732,7 +1732,7 @@ class Calibration:
             raise ValueError(
                 f"{path} states its lengths in {calib.unit!r}, not in the unit {unit!r} given: "
                 "leave unit out (it is for files that do not state theirs: OpenCV stereo_calib "
-                "output, Q.dat)"
+                "output, an OpenCV YAML/XML or JSON file without a unit field, Q.dat)"
             )
         # the checked size in the message: an array's tuple() read "(np.int64(1280), ...)"
         given = None if image_size is None else cls._check_size(image_size)
