@@ -1087,6 +1087,28 @@ def test_opencv_stereo_calib_output_needs_image_size_and_unit(tmp_path: Path) ->
         Calibration.from_file(tmp_path, image_size=(640, 480))
 
 
+def test_opencv_stereo_calib_output_missing_one_file_names_it(tmp_path: Path) -> None:
+    """One of stereo_calib's two files alone (a copy cut short) was, as a folder, "a folder
+    without left.yaml and right.yaml (ROS camera_info), calib.txt or Q.dat" (not naming the
+    format at all) and, as the file, intrinsics.yml "lacks field 'image_width'": what is
+    missing is its partner."""
+    _opencv_stereo_calib(tmp_path)
+    (tmp_path / "extrinsics.yml").unlink()
+    said = (
+        "OpenCV stereo_calib's intrinsics.yml without its extrinsics.yml beside it: the rig's "
+        "calibration is the two files together (intrinsics M1 D1 M2 D2, extrinsics R T)"
+    )
+    with pytest.raises(ValueError) as folder:
+        Calibration.from_file(tmp_path, image_size=(640, 480), unit="mm")
+    assert str(folder.value) == f"calibration path {tmp_path} holds {said}"
+    with pytest.raises(ValueError) as file:
+        Calibration.from_file(tmp_path / "intrinsics.yml", image_size=(640, 480), unit="mm")
+    assert str(file.value) == f"{tmp_path / 'intrinsics.yml'} is {said}"
+    (tmp_path / "intrinsics.yml").unlink()
+    with pytest.raises(ValueError, match=r"intrinsics\.yml and extrinsics\.yml \(OpenCV stereo"):
+        Calibration.from_file(tmp_path)  # the formats a folder may hold, stereo_calib's too
+
+
 def test_from_file_refuses_a_unit_the_file_contradicts(data_dir: Path) -> None:
     """unit was read for stereo_calib output only and dropped silently for every other
     format: a Middlebury calib.txt (mm) with unit="m" came back in mm as if agreed."""

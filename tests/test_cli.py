@@ -1542,8 +1542,8 @@ def test_info_on_a_scene_folder_reads_its_calibration(
     assert main(["info", str(data_dir / "chessboard")]) == 2
     assert capsys.readouterr().err == (
         f"stereovision: error: calibration path {data_dir / 'chessboard'} is a folder without "
-        "left.yaml and right.yaml (ROS camera_info), calib.txt or Q.dat; pass a calibration "
-        "file\n"
+        "left.yaml and right.yaml (ROS camera_info), intrinsics.yml and extrinsics.yml (OpenCV "
+        "stereo_calib output), calib.txt or Q.dat; pass a calibration file\n"
     )
 
 

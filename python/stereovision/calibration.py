@@ -1782,9 +1782,17 @@ class Calibration:
             for name in ("left.yaml", "right.yaml", "left.yml", "right.yml", "calib.txt", "Q.dat"):
                 if ((p / name).exists() or (p / name).is_symlink()) and not (p / name).is_file():
                     cls._read_text(p / name)
+            # stereo_calib's output is read from a folder too (README, --calib): one of its two
+            # files alone (a copy cut short) was told only of the other formats
+            for ext in _OPENCV_EXTS:
+                for name in ("intrinsics", "extrinsics"):
+                    half = _stereo_calib_half(p / f"{name}{ext}")
+                    if half is not None:
+                        raise ValueError(f"calibration path {p} holds {half}")
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
-                "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
+                "(ROS camera_info), intrinsics.yml and extrinsics.yml (OpenCV stereo_calib "
+                "output), calib.txt or Q.dat; pass a calibration file"
             )
         if p.is_file() and p.name.lower().endswith((".tar.gz", ".tgz", ".tar")):
             ltext, rtext = _read_ros_tar(p)
@@ -1811,7 +1819,15 @@ class Calibration:
             return cls.from_ros(*pair)
         head = text.lstrip()
         if head.startswith(("%YAML", "<?xml", "<opencv", "{")):
-            return cls._load(p, unit)  # unit: for a file without its own (a script's)
+            try:
+                return cls._load(p, unit)  # unit: for a file without its own (a script's)
+            except ValueError as exc:
+                # stereo_calib's intrinsics.yml alone was "lacks field 'image_width'", sending
+                # the user to edit a file whose partner (R, T) is what is missing
+                half = _stereo_calib_half(p)
+                if half is None or "lacks field" not in str(exc):
+                    raise
+                raise ValueError(f"{p} is {half}") from None
         if re.search(r"^\s*cam0\s*=", text, re.MULTILINE):
             return cls.from_middlebury(p)
         if re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE):
@@ -3183,6 +3199,21 @@ def _opencv_stereo_calib_pair(path: Path) -> tuple[Path, Path] | None:
     if not other.is_file():
         return None
     return (path, other) if stem == "intrinsics" else (other, path)
+
+
+def _stereo_calib_half(path: Path) -> str | None:
+    """What to say of ``path`` when it is one of OpenCV ``stereo_calib``'s two files (by name)
+    and its partner is not beside it; None otherwise."""
+    stem, ext = path.stem.lower(), path.suffix.lower()
+    if not path.is_file() or ext not in _OPENCV_EXTS or stem not in ("intrinsics", "extrinsics"):
+        return None
+    lack = ("extrinsics" if stem == "intrinsics" else "intrinsics") + path.suffix
+    if path.with_name(lack).is_file():
+        return None
+    return (
+        f"OpenCV stereo_calib's {path.name} without its {lack} beside it: the rig's "
+        "calibration is the two files together (intrinsics M1 D1 M2 D2, extrinsics R T)"
+    )
 
 
 def _stereo_calib_files(path: Path) -> tuple[Path, Path] | None:
