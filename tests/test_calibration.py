@@ -1109,6 +1109,19 @@ def test_opencv_stereo_calib_output_missing_one_file_names_it(tmp_path: Path) ->
         Calibration.from_file(tmp_path)  # the formats a folder may hold, stereo_calib's too
 
 
+def test_a_ros_folder_missing_one_camera_names_it(tmp_path: Path) -> None:
+    """A ROS camera_info folder holding left.yaml alone (the right camera's file not copied)
+    was "a folder without left.yaml and right.yaml ...", as if neither were there."""
+    rect_calib().save_ros(tmp_path)
+    (tmp_path / "right.yaml").unlink()
+    with pytest.raises(ValueError) as exc:
+        Calibration.from_file(tmp_path)
+    assert str(exc.value) == (
+        f"calibration path {tmp_path} holds left.yaml but not right.yaml (ROS camera_info: a "
+        "rig needs both cameras' files)"
+    )
+
+
 def test_from_file_refuses_a_unit_the_file_contradicts(data_dir: Path) -> None:
     """unit was read for stereo_calib output only and dropped silently for every other
     format: a Middlebury calib.txt (mm) with unit="m" came back in mm as if agreed."""

@@ -1789,6 +1789,15 @@ class Calibration:
                     half = _stereo_calib_half(p / f"{name}{ext}")
                     if half is not None:
                         raise ValueError(f"calibration path {p} holds {half}")
+            # a ROS folder's left.yaml alone was "a folder without left.yaml and right.yaml"
+            for ext in (".yaml", ".yml"):
+                has = [(p / f"{side}{ext}").is_file() for side in ("left", "right")]
+                if has[0] != has[1]:
+                    there, absent = ("left", "right")[:: 1 if has[0] else -1]
+                    raise ValueError(
+                        f"calibration path {p} holds {there}{ext} but not {absent}{ext} (ROS "
+                        "camera_info: a rig needs both cameras' files)"
+                    )
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
                 "(ROS camera_info), intrinsics.yml and extrinsics.yml (OpenCV stereo_calib "
