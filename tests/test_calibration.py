@@ -8,6 +8,7 @@ import os
 import re
 import sys
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -525,6 +526,27 @@ def test_from_kitti_sized_by_an_image_in_a_folder_whose_name_is_not_utf8(
     cv2.imwrite(str(tmp_path / "left.png"), np.zeros((5, 8, 3), np.uint8))
     (tmp_path / "left.png").rename(folder / "left.png")
     assert Calibration.from_kitti(folder / "calib.txt").image_size == (8, 5)
+
+
+def test_from_kitti_passes_over_an_image_beside_it_that_cannot_be_read(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A left.png beside a KITTI file without S_rect_02 that cannot be read (no permission)
+    was passed over by cv2.imread's None for the next image; read from its bytes (b418a20e) it
+    was np.fromfile's bare PermissionError out of from_kitti, the left.jpg beside it unread."""
+    kitti = data_dir / "kitti2015" / "000005_10" / "calib_kitti.txt"
+    (tmp_path / "calib.txt").write_bytes(kitti.read_bytes())
+    cv2.imwrite(str(tmp_path / "left.png"), np.zeros((5, 8, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "left.jpg"), np.zeros((6, 9, 3), np.uint8))
+    fromfile = np.fromfile
+
+    def refused(file: Any, *args: Any, **kwargs: Any) -> Any:
+        if Path(file).name == "left.png":
+            raise PermissionError(13, "Permission denied", str(file))
+        return fromfile(file, *args, **kwargs)
+
+    monkeypatch.setattr(np, "fromfile", refused)
+    assert Calibration.from_kitti(tmp_path / "calib.txt").image_size == (9, 6)
 
 
 def test_from_kitti_says_cameras_given_right_first(data_dir: Path) -> None:

@@ -2285,7 +2285,11 @@ class Calibration:
 
                     # from its bytes: cv2.imread of a folder named with a byte that is not
                     # UTF-8 (os.fsdecode's lone surrogate) crashed the process (SIGSEGV)
-                    hdr = _imdecode(np.fromfile(img, np.uint8), cv2.IMREAD_UNCHANGED)
+                    try:
+                        buf = np.fromfile(img, np.uint8)
+                    except OSError:  # no permission: passed over, as cv2.imread's None was
+                        continue
+                    hdr = _imdecode(buf, cv2.IMREAD_UNCHANGED)
                     if hdr is not None:
                         size = (int(hdr.shape[1]), int(hdr.shape[0]))
                         break
