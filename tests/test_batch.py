@@ -1920,6 +1920,34 @@ def test_images_of_a_camera_folder_whose_sibling_cannot_be_listed_are_no_half_pa
     ]
 
 
+def test_images_under_an_execute_only_sibling_camera_folder_are_no_half_pairs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """seq/right/ that cannot be listed but can be entered (execute-only, d--x--x--x): the walk
+    never reached seq/right/sub/, which can be listed, so d2c43757's check of the missing
+    file's own folder still reported seq/left/sub/0002.png as 'no seq/right/sub/0002.png', a
+    file that is there. Left out as the warning says, as the images of right/ itself are."""
+    from stereovision.batch import _scan
+
+    root = tmp_path / "in"
+    for f in ("0001.png", "sub/0002.png"):
+        for side in ("left", "right"):
+            (root / "seq" / side / f).parent.mkdir(parents=True, exist_ok=True)
+            cv2.imwrite(str(root / "seq" / side / f), np.zeros((4, 6), np.uint8))
+    listing = os.scandir
+    locked = str(root / "seq/right")
+
+    def scandir(path: Any = ".") -> Any:
+        if not isinstance(path, int) and os.fspath(path) == locked:
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    with pytest.warns(UserWarning, match="cannot search folder .*seq/right: Permission denied"):
+        jobs, unpaired, _ = _scan(root)
+    assert (jobs, [(u.name, u.error) for u in unpaired]) == ([], [])
+
+
 def test_outputs_written_into_the_input_are_not_reported_as_half_pairs(tmp_path: Path) -> None:
     """``batch 00 -o 00`` (-o given as the input) over a KITTI sequence of two rigs: each
     pair's folder lies in its left camera folder (00/image_0/000000/), and the next run

@@ -708,9 +708,23 @@ def _sibling_pairs(
             alone.append(_Unpaired(name(_without_side(left_name)), own / f, other / partner, side))
             told.add(own / f)
     # an image whose other's folder cannot be listed (no permission) was "no right/sub/0002.png
-    # for ...", a file that may be there: its pair is left out, as _walk's warning says
-    unlisted = {d for d in {u.missing.parent for u in alone} if not _listable(d)}
-    alone = [u for u in alone if u.missing.parent not in unlisted]
+    # for ...", a file that may be there: its pair is left out, as _walk's warning says. A
+    # folder above it counts too: an execute-only right/ lets right/sub/ be listed, but the
+    # walk never reached it
+    listable: dict[Path, bool] = {}
+
+    def unreached(u: _Unpaired) -> bool:
+        top = right_dir if u.side == "left" else left_dir
+        for d in (u.missing.parent, *u.missing.parent.parents):
+            if d not in listable:
+                listable[d] = _listable(d)
+            if not listable[d]:
+                return True
+            if d == top:
+                break
+        return False
+
+    alone = [u for u in alone if not unreached(u)]
     return (
         pairs,
         alone,
