@@ -2028,6 +2028,17 @@ def test_names_of_another_count_are_refused_before_the_boards_are_looked_for(
         with pytest.raises(TypeError) as nerr:
             calibrate(square_size=1.0, **given)
         assert str(nerr.value) == words
+    # one image array, not a list of them: list() gave its rows as 120 "images"
+    for one in (blank, np.dstack([blank] * 3)):
+        with pytest.raises(TypeError) as ierr:
+            calibrate(one, [one] * 3, square_size=1.0)
+        assert str(ierr.value) == (
+            f"left_images: expected a sequence of images or paths, got one image of shape "
+            f"{one.shape} (a list of the pair's images: [image, ...])"
+        )
+    # a stack of grey images (N, H, W) is a sequence of them, as before
+    with pytest.raises(ValueError, match="names: expected 3 names"):
+        calibrate(np.stack([blank] * 3), [blank] * 3, square_size=1.0, names=["a"])
 
 
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:

@@ -1545,7 +1545,7 @@ def calibrate(
     TypeError
         If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard` (a
         chessboard's ``"9x6"`` goes in ``pattern``), or ``left_images``, ``right_images`` or
-        ``names`` is no sequence (one path, one string, None, a number).
+        ``names`` is no sequence (one path, one string, one image array, None, a number).
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
@@ -1583,6 +1583,14 @@ def calibrate(
             raise TypeError(
                 f"{name}: expected a sequence of images or paths, got one path {given!r} "
                 "(a list of one, or a glob through stereovision calibrate --left 'left*.png')"
+            )
+        shape = np.shape(given) if isinstance(given, np.ndarray) else ()
+        if len(shape) == 2 or (len(shape) == 3 and shape[2] in (1, 3, 4)):
+            # one image, not a stack of them: list() gave its rows as images, a colour one
+            # "found in both images of only 0 of 48 pairs" after 48 board searches
+            raise TypeError(
+                f"{name}: expected a sequence of images or paths, got one image of shape "
+                f"{shape} (a list of the pair's images: [image, ...])"
             )
     lefts = _listed(left_images, "left_images", "images or paths")
     rights = _listed(right_images, "right_images", "images or paths")
