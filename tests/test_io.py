@@ -7,7 +7,9 @@ import os
 import re
 import shutil
 import struct
+import warnings
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -1755,6 +1757,33 @@ def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:
     (tmp_path / "left.png").write_bytes(b"")
     with pytest.raises(FileNotFoundError, match=r"^scene root not found: .*left\.png$"):
         find_scenes(tmp_path / "left.png")
+
+
+def test_scan_scenes_of_a_root_that_cannot_be_listed_is_an_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scene root that cannot be listed (no permission) was the walk's warning 'cannot
+    search folder in: ...; the pairs in it, if any, are left out' and then eval's 'no scene
+    (left.png + right.png) under in', as if it held none: an error naming it now, as batch's
+    input folder (564d04ae); eval and bench say it in one line, exit 2."""
+    from stereovision.io import scan_scenes
+
+    root = tmp_path / "in"
+    (root / "a").mkdir(parents=True)
+    listing = os.scandir
+
+    def scandir(path: Any = ".") -> Any:
+        if not isinstance(path, int) and os.fspath(path) == str(root):
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    said = f"cannot search scene root {root}: Permission denied"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the error alone, no warning before it
+        with pytest.raises(PermissionError) as err:
+            scan_scenes(root)
+    assert str(err.value) == said
 
 
 def test_path_helpers_of_the_cli(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -2252,6 +2252,8 @@ def find_scenes(root: PathLike) -> list[Path]:
     ------
     FileNotFoundError
         If ``root`` is not a directory.
+    PermissionError
+        If ``root`` cannot be listed (an :class:`OSError` of its kind for another reason).
     """
     return scan_scenes(root)[0]
 
@@ -2294,12 +2296,21 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     ------
     FileNotFoundError
         If ``root`` is not a directory.
+    PermissionError
+        If ``root`` cannot be listed (an :class:`OSError` of its kind for another reason).
     """
     r = as_path(root, "root")
     if not r.is_dir():
         # a link whose target moved: its target named, as load_scene's words name it
         gone = f" ({_broken_link(r)})" if r.is_symlink() and not r.exists() else ""
         raise FileNotFoundError(f"scene root not found: {r}{gone}")
+    try:
+        # one that cannot be listed (no permission) was the walk's warning that its pairs are
+        # left out, then eval's "no scene under" it, as if it held none (as batch's input was)
+        with os.scandir(r):
+            pass
+    except OSError as e:
+        raise type(e)(f"cannot search scene root {r}: {e.strerror or e}") from None
     # Links followed: Path.rglob does not enter a link to a folder, so scenes linked into a
     # folder were not found. As batch's walk, a link to a folder inside the root (or holding
     # it: a loop), or to one entered already, is an alias, not entered: `latest -> run3` listed
