@@ -125,7 +125,7 @@ def draw_refine(out_dir: Path) -> None:
 
     from stereovision.baselines import opencv_sgbm
     from stereovision.depth import depth_map
-    from stereovision.evaluate import depth_metrics, gt_depth
+    from stereovision.evaluate import depth_metrics, gt_depth, saturated_gt_depth
     from stereovision.io import load_scene
     from stereovision.triangulation import depth_from_disparity
 
@@ -135,6 +135,9 @@ def draw_refine(out_dir: Path) -> None:
         assert sc.gt is not None and sc.calib is not None, name
         md = sc.max_disparity
         gt = gt_depth(sc.gt, sc.calib)
+        # float16's largest depth (TartanAir's sky, 65504 m) is a clamp, not a distance: no GT,
+        # as `stereovision eval` has it (its error panel and figures left out alike)
+        gt[saturated_gt_depth(gt)] = np.nan
         maps = {
             "gabor, refine=False": depth_map(
                 sc.left, sc.right, sc.calib, max_disparity=md, method="gabor", refine=False

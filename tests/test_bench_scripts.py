@@ -242,6 +242,61 @@ def test_eval_gabor_scenes_times_ours_beside_sgbm(data_dir: Path) -> None:
     assert ratio == pytest.approx(ms / sgbm_ms, abs=0.006 + 0.05 * (1 + ratio) / sgbm_ms)
 
 
+def _sky_scene() -> tuple[Any, np.ndarray]:
+    """A two-pixel TartanAir-like scene (f B = 80 m px): GT disparity 80 / 65504 px (the sky,
+    GT depth float16's largest value) then 8 px (10 m); and a disparity map measuring 8 px (10 m)
+    at both."""
+    import types
+
+    from stereovision.calibration import Calibration
+
+    K = np.array([[320.0, 0, 1], [0, 320.0, 0], [0, 0, 1]])
+    calib = Calibration(
+        K1=K,
+        D1=np.zeros(5),
+        K2=K.copy(),
+        D2=np.zeros(5),
+        R=np.eye(3),
+        T=np.array([-250.0, 0, 0]),
+        image_size=(64, 48),
+        unit="mm",
+        rectified=True,
+    )
+    gt = np.array([[80.0 / 65504.0, 8.0]], np.float32)
+    scene = types.SimpleNamespace(
+        name="tartanair/sky", left=np.zeros((1, 2, 3), np.uint8), gt=gt, calib=calib
+    )
+    scene.right, scene.max_disparity = scene.left, 16
+    return scene, np.full((1, 2), 8.0, np.float32)
+
+
+def test_eval_gabor_scenes_leaves_the_gt_depth_at_float16s_largest_value_out(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The depth lines scored TartanAir's sky (GT depth 65504 m, float16's clamp) as a distance,
+    as eval did before 621b5d1b (its SGBM median 2.73 % where eval says 2.68 %). A stubbed
+    two-pixel scene, f B = 80 m px: a sky pixel and one at 10 m, both measured at 10 m: the
+    median was 49.99 % over both pixels, it is 0 % over the one with a GT depth (_sky_scene)."""
+    import types
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import eval_gabor_scenes as egs
+
+    scene, d = _sky_scene()
+    monkeypatch.setattr(egs, "find_scenes", lambda root: ["tartanair/sky"])
+    monkeypatch.setattr(egs, "load_scene", lambda path: scene)
+    monkeypatch.setattr(egs, "gabor_disparity", lambda *a, **k: types.SimpleNamespace(disparity=d))
+    monkeypatch.setattr(egs.baselines, "opencv_sgbm", lambda *a, **k: d)
+    monkeypatch.setattr(egs.baselines, "opencv_bm", lambda *a, **k: d)
+    monkeypatch.setattr(sys, "argv", ["eval_gabor_scenes.py", "--runs", "5"])
+    egs.main()
+    last = capsys.readouterr().out.splitlines()[-1]
+    assert last.split() == [
+        "depth", "tartanair/sky", "ours", "med", "0.00%", ">5%", "0.0%",
+        "SGBM", "med", "0.00%", ">5%", "0.0%", "coverage", "ours/SGBM", "1.000",
+    ]  # fmt: skip
+
+
 def test_docs_pictures_script_redraws_the_demo_pictures(tmp_path: Path) -> None:
     """docs/images' demo pictures had no script that redrew them (they were copied by hand from
     ``make demo``'s output). ``plot_docs_pictures.py --only demo`` writes them, the overview
@@ -258,6 +313,50 @@ def test_docs_pictures_script_redraws_the_demo_pictures(tmp_path: Path) -> None:
         img = cv2.imread(str(tmp_path / name))
         assert img is not None and img.shape == shapes.get(name, (375, 450, 3)), name
         assert (tmp_path / name).stat().st_size < 300_000, name
+
+
+def test_docs_pictures_refine_leaves_the_gt_depth_at_float16s_largest_value_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The refine picture's titles and error panels scored a GT depth of 65504 m (TartanAir's
+    sky, float16's clamp) as a distance, where eval leaves it out (621b5d1b): on _sky_scene a
+    49.99 % median over 2 px; 0.00 % over the 1 px with a GT depth now. Scene, matchers and
+    the PNG stubbed (the picture not looked at)."""
+    import types
+
+    import matplotlib.figure
+    import matplotlib.pyplot as plt
+
+    import stereovision.baselines
+    import stereovision.depth
+    import stereovision.io
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import plot_docs_pictures as pdp
+
+    scene, d = _sky_scene()
+    depth = types.SimpleNamespace(depth=np.full((1, 2), 10.0, np.float32))
+    monkeypatch.setattr(pdp, "REFINE_SCENES", ("tartanair/sky",))
+    monkeypatch.setattr(stereovision.io, "load_scene", lambda path: scene)
+    monkeypatch.setattr(stereovision.depth, "depth_map", lambda *a, **k: depth)
+    monkeypatch.setattr(stereovision.baselines, "opencv_sgbm", lambda *a, **k: d)
+    monkeypatch.setattr(pdp, "save_png", lambda image, out: out)
+    monkeypatch.setattr(pdp.io, "BytesIO", lambda: None)
+    titles: list[str] = []
+    close = plt.close
+
+    def keep_titles(fig: Any) -> None:
+        titles.extend(ax.get_title(loc="left") for ax in fig.axes)
+        close(fig)
+
+    monkeypatch.setattr(plt, "close", keep_titles)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda self, *a, **k: None)
+    monkeypatch.setattr("PIL.Image.open", lambda buf: None)
+    pdp.draw_refine(tmp_path)
+    assert titles[:3] == [
+        f"tartanair {label}: median 0.00 %, >5 %: 0.0 %, 1 px"
+        for label in ("gabor, refine=False", "gabor (refined, its default)", "OpenCV SGBM-3WAY")
+    ], titles
 
 
 def test_docs_pictures_gui_offers_a_save_folder(
