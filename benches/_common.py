@@ -5,6 +5,8 @@ The benches run as scripts (``python benches/bench_x.py``), so this folder is on
 
 from __future__ import annotations
 
+import argparse
+import json
 import math
 import statistics
 import time
@@ -25,6 +27,37 @@ DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 timed_runs = _run_count
 
 T = TypeVar("T")
+
+
+def gabor_param(text: str) -> tuple[str, object]:
+    """argparse ``type`` of a bench's ``--param key=JSON``: the pair, or argparse's one-line
+    error (a missing ``=`` or a value that is not JSON was a traceback of the unpacking or of
+    json.loads). Unknown keys: :func:`gabor_params`."""
+    key, eq, value = text.partition("=")
+    if not eq or not key:
+        raise argparse.ArgumentTypeError(f"expected key=value (value in JSON), got {text!r}")
+    try:
+        return key, json.loads(value)
+    except json.JSONDecodeError:
+        # a bare word is most likely a string meant: say how the shell passes its quotes
+        hint = f" (a string is quoted: {key}='\"{value}\"')" if value.isidentifier() else ""
+        raise argparse.ArgumentTypeError(f"{key}: {value!r} is not a JSON value{hint}") from None
+
+
+def gabor_params(
+    ap: argparse.ArgumentParser, pairs: Sequence[tuple[str, object]]
+) -> dict[str, object]:
+    """The ``--param`` pairs as gabor_disparity's overrides; an unknown key is ``ap``'s one-line
+    error before any scene is loaded (it was gabor_disparity's traceback on the first scene)."""
+    from stereovision._validate import refuse_unknown
+    from stereovision.matching.gabor import DEFAULTS
+
+    params = dict(pairs)
+    try:
+        refuse_unknown("Gabor parameter", params, DEFAULTS, "stereovision.matching.gabor.DEFAULTS")
+    except ValueError as e:
+        ap.error(f"argument --param: {e}")
+    return params
 
 
 def gt_scenes() -> list[str]:

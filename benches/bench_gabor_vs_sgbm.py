@@ -19,7 +19,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import timed_runs
+from _common import gabor_param, gabor_params, timed_runs
 
 from stereovision.matching.gabor import gabor_disparity
 
@@ -47,9 +47,11 @@ def sgbm_matcher(max_disparity: int) -> cv2.StereoSGBM:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", type=timed_runs, default=9)
-    ap.add_argument("--param", action="append", default=[])
+    ap.add_argument(
+        "--param", action="append", default=[], type=gabor_param, help="key=JSON (repeatable)"
+    )
     args = ap.parse_args()
-    params = {k: json.loads(v) for k, v in (kv.split("=", 1) for kv in args.param)}
+    params = gabor_params(ap, args.param)
     cv2.setNumThreads(2)
     print(f"{'scene':24s} {'size':>9s} {'D':>4s} {'gabor ms':>9s} {'SGBM ms':>8s} {'ratio':>6s}")
     for scene, dmax in CASES:

@@ -15,12 +15,11 @@ Usage: ``python benches/eval_gabor_scenes.py [--scenes a,b] [--param key=value .
 from __future__ import annotations
 
 import argparse
-import json
 from functools import partial
 
 import cv2
 import numpy as np
-from _common import DATA, interleaved_runs, timed_runs
+from _common import DATA, gabor_param, gabor_params, interleaved_runs, timed_runs
 
 from stereovision import baselines
 from stereovision._validate import as_gray_float
@@ -32,14 +31,13 @@ from stereovision.matching.gabor import gabor_disparity
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default="", help="comma-separated substrings of scene names")
-    ap.add_argument("--param", action="append", default=[], help="key=JSON value (repeatable)")
+    ap.add_argument(
+        "--param", action="append", default=[], type=gabor_param, help="key=JSON (repeatable)"
+    )
     ap.add_argument("--no-cv", action="store_true", help="skip the OpenCV references")
     ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     args = ap.parse_args()
-    params: dict[str, object] = {}
-    for kv in args.param:
-        k, v = kv.split("=", 1)
-        params[k] = json.loads(v)
+    params = gabor_params(ap, args.param)
     cv2.setNumThreads(2)
     rows = []
     hdr = f"{'scene':38s} {'fill':>6s} {'unf':>6s} {'dens':>5s} {'BM':>6s} {'SGBM':>6s} {'ms':>6s}"

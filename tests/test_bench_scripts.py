@@ -297,6 +297,41 @@ def test_eval_gabor_scenes_leaves_the_gt_depth_at_float16s_largest_value_out(
     ]  # fmt: skip
 
 
+@pytest.mark.parametrize(
+    ("script", "param", "message"),
+    [
+        ("eval_gabor_scenes.py", "freq", "expected key=value (value in JSON), got 'freq'"),
+        ("eval_gabor_scenes.py", "freq=[1", "freq: '[1' is not a JSON value"),
+        (
+            "eval_gabor_scenes.py",
+            "speckle_size=big",
+            "speckle_size: 'big' is not a JSON value (a string is quoted: speckle_size='\"big\"')",
+        ),
+        ("bench_gabor_vs_sgbm.py", "frq=0.2", "unknown Gabor parameter(s) ['frq'] (did you mean"),
+    ],
+)
+def test_gabor_benches_refuse_a_bad_param_in_one_line(
+    script: str,
+    param: str,
+    message: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """--param without '=', with a value that is not JSON, or with a key gabor_disparity does not
+    take was a traceback (of the unpacking, json.loads, or gabor_disparity on the first scene);
+    now argparse's one-line error, exit status 2, before any scene is loaded."""
+    import importlib
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    bench = importlib.import_module(script.removesuffix(".py"))
+    monkeypatch.setattr(sys, "argv", [script, "--param", param, "--runs", "5"])
+    with pytest.raises(SystemExit) as exc:
+        bench.main()
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[-1].startswith(f"{script}: error: argument --param: {message}"), err
+
+
 def test_docs_pictures_script_redraws_the_demo_pictures(tmp_path: Path) -> None:
     """docs/images' demo pictures had no script that redrew them (they were copied by hand from
     ``make demo``'s output). ``plot_docs_pictures.py --only demo`` writes them, the overview
