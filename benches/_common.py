@@ -65,6 +65,27 @@ def gt_scenes() -> list[str]:
     return sorted(str(p.parent.relative_to(DATA)) for p in DATA.glob("*/*/gt_disp.pfm"))
 
 
+def gt_scene(name: str) -> str:
+    """argparse ``type`` of a bench's ``--scenes`` name: a ``family/scene`` of ``shared/data``
+    or a scene folder (as the benches load ``DATA / name``), either holding a ``gt_disp.pfm``;
+    else argparse's one-line error listing :func:`gt_scenes` (a typo or a scene without GT was
+    load_scene's FileNotFoundError traceback once the bench had started)."""
+    if (DATA / name / "gt_disp.pfm").is_file():  # an absolute folder too: DATA / it is it
+        return name
+    if (Path(name) / "gt_disp.pfm").is_file():  # relative to the working directory
+        return str(Path(name).resolve())
+    raise argparse.ArgumentTypeError(
+        f"{name!r} is no scene with a gt_disp.pfm: expected a scene folder or a family/scene "
+        f"of {DATA}, one of {', '.join(gt_scenes())}"
+    )
+
+
+def gt_scene_list(text: str) -> list[str]:
+    """argparse ``type`` of a comma-separated ``--scenes``: each name checked by
+    :func:`gt_scene`; ``""`` (the default: every GT scene) is ``[]``."""
+    return [gt_scene(name) for name in text.split(",")] if text else []
+
+
 def sparse_row(m: Matches, gt: np.ndarray) -> dict[str, float | int]:
     """evaluation.md's sparse figures of ``m`` as a JSON-ready dict."""
     sm = sparse_metrics(m.xl, m.yl, m.xr, gt)

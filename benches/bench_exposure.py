@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _common import DATA, gt_scenes
+from _common import DATA, gt_scene, gt_scenes
 
 import stereovision as sv
 from stereovision.baselines import opencv_sgbm, row_fill
@@ -43,7 +43,9 @@ NOISE = 8.0
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
+    ap.add_argument(
+        "--scenes", nargs="*", type=gt_scene, help="family/scene names (default: every GT scene)"
+    )
     args = ap.parse_args()
     print("| scene | " + " | ".join(f"{c}: ours / SGBM-3WAY + fill" for c in CASES) + " |")
     print("|---" * (len(CASES) + 1) + "|")

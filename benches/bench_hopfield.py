@@ -22,6 +22,7 @@ from functools import partial
 from _common import (
     DATA,
     count_at,
+    gt_scene_list,
     gt_scenes,
     interleaved_ms,
     interleaved_runs,
@@ -100,12 +101,17 @@ def speed(repeats: int) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", default="", help="comma-separated family/scene (default: all)")
+    ap.add_argument(
+        "--scenes",
+        default="",
+        type=gt_scene_list,
+        help="comma-separated family/scene (default: all)",
+    )
     ap.add_argument("--repeats", type=timed_runs, default=7)
     ap.add_argument("--no-speed", action="store_true")
     ap.add_argument("--no-accuracy", action="store_true")
     args = ap.parse_args()
-    scenes = args.scenes.split(",") if args.scenes else gt_scenes()
+    scenes = args.scenes or gt_scenes()
     if not args.no_accuracy:
         accuracy(scenes, args.repeats)
     if not args.no_speed:

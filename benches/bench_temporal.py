@@ -25,7 +25,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA, gt_scenes
+from _common import DATA, gt_scene, gt_scenes
 
 import stereovision as sv
 from stereovision.evaluate import dense_metrics
@@ -152,7 +152,9 @@ def timing() -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
+    ap.add_argument(
+        "--scenes", nargs="*", type=gt_scene, help="family/scene names (default: every GT scene)"
+    )
     ap.add_argument("--skip-moving", action="store_true", help="only the still scenes and time")
     args = ap.parse_args()
     still(args.scenes or gt_scenes())

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA, gt_scenes, interleaved_runs, timed_runs
+from _common import DATA, gt_scene, gt_scenes, interleaved_runs, timed_runs
 
 import stereovision as sv
 from stereovision.baselines import opencv_sgbm
@@ -61,7 +61,9 @@ def _opencv_shape(left: np.ndarray, right: np.ndarray, fm: np.ndarray) -> tuple:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
+    ap.add_argument(
+        "--scenes", nargs="*", type=gt_scene, help="family/scene names (default: every GT scene)"
+    )
     ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     ap.add_argument(
         "--picture", type=Path, default=ROOT / "docs/images/uncalibrated_rectification.jpg"

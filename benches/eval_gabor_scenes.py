@@ -19,7 +19,7 @@ from functools import partial
 
 import cv2
 import numpy as np
-from _common import DATA, gabor_param, gabor_params, interleaved_runs, timed_runs
+from _common import DATA, gabor_param, gabor_params, gt_scenes, interleaved_runs, timed_runs
 
 from stereovision import baselines
 from stereovision._validate import as_gray_float
@@ -38,6 +38,10 @@ def main() -> None:
     ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     args = ap.parse_args()
     params = gabor_params(ap, args.param)
+    wanted = [p for p in args.scenes.split(",") if p]
+    if wanted and not any(p in name for name in gt_scenes() for p in wanted):
+        # none matched: the means were NaN (NumPy's "Mean of empty slice") and the exit status 0
+        ap.error(f"argument --scenes: no scene with GT matches {args.scenes!r}")
     cv2.setNumThreads(2)
     rows = []
     hdr = f"{'scene':38s} {'fill':>6s} {'unf':>6s} {'dens':>5s} {'BM':>6s} {'SGBM':>6s} {'ms':>6s}"
@@ -46,7 +50,7 @@ def main() -> None:
     for d in find_scenes(DATA):
         scene = load_scene(d)
         name = scene.name
-        if scene.gt is None or (args.scenes and not any(p in name for p in args.scenes.split(","))):
+        if scene.gt is None or (wanted and not any(p in name for p in wanted)):
             continue
         gt, dmax = scene.gt, scene.max_disparity
         lf, rf = as_gray_float(scene.left, "left"), as_gray_float(scene.right, "right")

@@ -332,6 +332,70 @@ def test_gabor_benches_refuse_a_bad_param_in_one_line(
     assert err[-1].startswith(f"{script}: error: argument --param: {message}"), err
 
 
+@pytest.mark.parametrize(
+    ("script", "scenes", "message"),
+    [
+        (
+            "bench_hopfield.py",
+            "middlebury2001/tsukuba,middlebury2001/tsukba",
+            "'middlebury2001/tsukba'",
+        ),
+        ("bench_mcgm.py", "nope", "'nope'"),
+        ("bench_exposure.py", "opencv_uncalibrated/books", "'opencv_uncalibrated/books'"),
+        ("bench_temporal.py", "tsukuba", "'tsukuba'"),
+        ("bench_uncalibrated.py", "chessboard", "'chessboard'"),
+    ],
+)
+def test_benches_refuse_a_scene_without_gt_in_one_line(
+    script: str,
+    scenes: str,
+    message: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """--scenes naming no scene (a typo, a bare scene name) or one without a gt_disp.pfm was
+    load_scene's FileNotFoundError traceback once the bench had started; now argparse's one-line
+    error (exit status 2) naming it and the scenes there are. A folder or family/scene with GT
+    is taken as before."""
+    import importlib
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    bench = importlib.import_module(script.removesuffix(".py"))
+    import _common
+
+    monkeypatch.setattr(sys, "argv", [script, "--scenes", scenes])
+    with pytest.raises(SystemExit) as exc:
+        bench.main()
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    head = f"{script}: error: argument --scenes: {message} is no scene with a gt_disp.pfm: "
+    assert err.startswith(head + "expected a scene folder or a family/scene of "), err
+    assert err.endswith(", tartanair/oldtown_easy_p000_001116"), err
+    # a folder, or a name with a trailing slash, is taken as before
+    assert _common.gt_scene("middlebury2001/tsukuba/") == "middlebury2001/tsukuba/"
+    folder = _common.DATA / "middlebury2001" / "tsukuba"
+    assert _common.gt_scene(str(folder)) == str(folder)
+
+
+def test_eval_gabor_scenes_refuses_scenes_matching_nothing(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--scenes matching no GT scene printed NaN means (NumPy's "Mean of empty slice"
+    warnings) and exited 0; now argparse's one-line error, exit status 2."""
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import eval_gabor_scenes as egs
+
+    monkeypatch.setattr(sys, "argv", ["eval_gabor_scenes.py", "--scenes", "tsukba,vnus"])
+    with pytest.raises(SystemExit) as exc:
+        egs.main()
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert (
+        err
+        == "eval_gabor_scenes.py: error: argument --scenes: no scene with GT matches 'tsukba,vnus'"
+    )
+
+
 def test_docs_pictures_script_redraws_the_demo_pictures(tmp_path: Path) -> None:
     """docs/images' demo pictures had no script that redrew them (they were copied by hand from
     ``make demo``'s output). ``plot_docs_pictures.py --only demo`` writes them, the overview
