@@ -20,7 +20,7 @@ import argparse
 import json
 from pathlib import Path
 
-from _common import DATA, count_at
+from _common import DATA, count_at, gt_scene
 
 from stereovision._validate import as_gray_float
 from stereovision.evaluate import sparse_metrics
@@ -37,7 +37,10 @@ SPARSE = [m for m in METHODS if m in CHANNEL_BITS and m != "gabor"]
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument(
-        "scenes", nargs="*", help="scene folders or family/scene names (default: every GT scene)"
+        "scenes",
+        nargs="*",
+        type=gt_scene,
+        help="scene folders or family/scene names (default: every GT scene)",
     )
     args = ap.parse_args()
     dirs = [Path(s) if Path(s).is_dir() else DATA / s for s in args.scenes] or find_scenes(DATA)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from _common import DATA, plot_bad2_panels
+from _common import DATA, gt_scene, plot_bad2_panels
 
 from stereovision.baselines import opencv_sgbm, row_fill
 from stereovision.depth import depth_map
@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default="middlebury2005/books")
+    ap.add_argument("--scene", default="middlebury2005/books", type=gt_scene)
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "images" / "fused_vs_sgbm.png")
     args = ap.parse_args()
     sc = load_scene(DATA / args.scene)

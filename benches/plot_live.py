@@ -15,7 +15,7 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from _common import DATA
+from _common import DATA, gt_scene
 
 from stereovision.depth import depth_map
 from stereovision.io import load_scene
@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default="middlebury2003/teddy")
+    ap.add_argument("--scene", default="middlebury2003/teddy", type=gt_scene)
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "images" / "live_modes.png")
     args = ap.parse_args()
     import matplotlib

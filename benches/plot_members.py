@@ -18,7 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from _common import DATA
+from _common import DATA, gt_scene
 
 from stereovision._validate import as_gray_float
 from stereovision.io import load_scene
@@ -29,7 +29,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default="middlebury2003/teddy")
+    ap.add_argument("--scene", default="middlebury2003/teddy", type=gt_scene)
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "images" / "members_census.png")
     args = ap.parse_args()
     sc = load_scene(DATA / args.scene)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _common import DATA, plot_bad2_panels
+from _common import DATA, gt_scene, plot_bad2_panels
 
 from stereovision.baselines import opencv_sgbm, row_fill
 from stereovision.depth import depth_map
@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default="eth3d/playground")
+    ap.add_argument("--scene", default="eth3d/playground", type=gt_scene)
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "images" / "modes.png")
     args = ap.parse_args()
     sc = load_scene(DATA / args.scene)

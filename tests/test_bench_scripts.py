@@ -377,6 +377,39 @@ def test_benches_refuse_a_scene_without_gt_in_one_line(
     assert _common.gt_scene(str(folder)) == str(folder)
 
 
+@pytest.mark.parametrize(
+    ("script", "args", "where"),
+    [
+        ("plot_fused.py", ["--scene", "middlebury2005/bookz"], "argument --scene"),
+        ("plot_live.py", ["--scene", "middlebury2005/bookz"], "argument --scene"),
+        ("plot_members.py", ["--scene", "middlebury2005/bookz"], "argument --scene"),
+        ("plot_modes.py", ["--scene", "middlebury2005/bookz"], "argument --scene"),
+        ("bench_fusion.py", ["middlebury2005/bookz"], "argument scenes"),
+    ],
+)
+def test_plots_refuse_a_scene_without_gt_in_one_line(
+    script: str,
+    args: list[str],
+    where: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """As the benches' --scenes (test_benches_refuse_a_scene_without_gt_in_one_line): the
+    plots' --scene and bench_fusion's scenes were load_scene's FileNotFoundError traceback."""
+    import importlib
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    bench = importlib.import_module(script.removesuffix(".py"))
+    monkeypatch.setattr(sys, "argv", [script, *args])
+    with pytest.raises(SystemExit) as exc:
+        bench.main()
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert err.startswith(
+        f"{script}: error: {where}: 'middlebury2005/bookz' is no scene with a gt_disp.pfm: "
+    ), err
+
+
 def test_eval_gabor_scenes_refuses_scenes_matching_nothing(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
