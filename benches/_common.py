@@ -29,6 +29,34 @@ timed_runs = _run_count
 T = TypeVar("T")
 
 
+def picture_path(text: str) -> Path:
+    """argparse ``type`` of a bench's ``--picture`` / ``--out`` written with OpenCV: the path,
+    or argparse's one-line error when OpenCV has no writer for its extension (cv2.imwrite's
+    traceback once the bench had run) or it is a folder."""
+    import cv2
+
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: is a folder; give a file such as {text}/x.jpg")
+    if not cv2.haveImageWriter(text):
+        raise argparse.ArgumentTypeError(
+            f"{text}: OpenCV writes no image of that extension; give a .jpg or .png"
+        )
+    return path
+
+
+def write_picture(path: Path, image: np.ndarray) -> None:
+    """Write a bench's picture as JPEG quality 88 (the docs' pictures), its folder made first.
+
+    cv2.imwrite returns False without a word where it cannot write (a missing folder): the
+    benches printed "wrote PATH" of no file. That is an ``OSError`` naming ``path`` now."""
+    import cv2
+
+    path.parent.mkdir(parents=True, exist_ok=True)  # as plot_charuco and plot_bad2_panels do
+    if not cv2.imwrite(str(path), image, [cv2.IMWRITE_JPEG_QUALITY, 88]):
+        raise OSError(f"{path}: OpenCV could not write the picture")
+
+
 def gabor_param(text: str) -> tuple[str, object]:
     """argparse ``type`` of a bench's ``--param key=JSON``: the pair, or argparse's one-line
     error (a missing ``=`` or a value that is not JSON was a traceback of the unpacking or of

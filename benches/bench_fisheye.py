@@ -22,7 +22,7 @@ from typing import Any
 
 import cv2
 import numpy as np
-from _common import DATA
+from _common import DATA, picture_path, write_picture
 
 import stereovision as sv
 from stereovision.calibrate import calibrate
@@ -42,7 +42,7 @@ def wall(calib: Calibration, z_wall: float) -> tuple[np.ndarray, np.ndarray, Any
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--picture", type=Path, default=ROOT / "docs/images/fisheye_rig.jpg")
+    ap.add_argument("--picture", type=picture_path, default=ROOT / "docs/images/fisheye_rig.jpg")
     args = ap.parse_args()
     views = rig.render_views()
     found = {}
@@ -85,8 +85,7 @@ def main() -> None:
             p, text, (4, 16), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA
         )
     gap = np.full((left.shape[0], 6, 3), 255, np.uint8)
-    cv2.imwrite(str(args.picture), np.hstack([panels[0], gap, panels[1], gap, panels[2]]),
-                [cv2.IMWRITE_JPEG_QUALITY, 88])  # fmt: skip
+    write_picture(args.picture, np.hstack([panels[0], gap, panels[1], gap, panels[2]]))
     print(f"wrote {args.picture}")
 
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA, interleaved_runs, timed_runs
+from _common import DATA, interleaved_runs, picture_path, timed_runs, write_picture
 from scipy.ndimage import binary_dilation
 
 import stereovision as sv
@@ -67,7 +67,7 @@ def _scan_table(
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--picture", type=Path, default=ROOT / "docs/images/ground_kitti.jpg")
+    ap.add_argument("--picture", type=picture_path, default=ROOT / "docs/images/ground_kitti.jpg")
     ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     args = ap.parse_args()
     for name in SCENES:
@@ -134,9 +134,7 @@ def main() -> None:
             cv2.putText(bev, "laser scan", (6, 35), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
                         (200, 120, 0), 1, cv2.LINE_AA)  # fmt: skip
             gap = np.full((img.shape[0], 6, 3), 255, np.uint8)
-            cv2.imwrite(
-                str(args.picture), np.hstack([img, gap, bev]), [cv2.IMWRITE_JPEG_QUALITY, 88]
-            )
+            write_picture(args.picture, np.hstack([img, gap, bev]))
             print(f"wrote {args.picture}")
             for far in (15.0, 30.0):
                 kw = {"resolution": 0.2, "forward": (0.0, far), "lateral": (-far / 2, far / 2)}

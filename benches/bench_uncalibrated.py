@@ -24,7 +24,15 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA, gt_scene, gt_scenes, interleaved_runs, timed_runs
+from _common import (
+    DATA,
+    gt_scene,
+    gt_scenes,
+    interleaved_runs,
+    picture_path,
+    timed_runs,
+    write_picture,
+)
 
 import stereovision as sv
 from stereovision.baselines import opencv_sgbm
@@ -66,7 +74,7 @@ def main() -> None:
     )
     ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     ap.add_argument(
-        "--picture", type=Path, default=ROOT / "docs/images/uncalibrated_rectification.jpg"
+        "--picture", type=picture_path, default=ROOT / "docs/images/uncalibrated_rectification.jpg"
     )
     args = ap.parse_args()
     print(
@@ -119,7 +127,7 @@ def main() -> None:
                 )
                 for i in (before, after)
             ]
-            cv2.imwrite(str(args.picture), np.vstack(pad), [cv2.IMWRITE_JPEG_QUALITY, 88])
+            write_picture(args.picture, np.vstack(pad))
             print(f"wrote {args.picture}")
     for kind, vals in ratios.items():
         if vals:

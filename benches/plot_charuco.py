@@ -16,6 +16,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from _common import picture_path, write_picture
 
 from stereovision.calibrate import (
     SB_FLAG_SETS,
@@ -39,7 +40,7 @@ def label(img: np.ndarray, text: str, y: int = 24) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path, default=ROOT / "docs/images/charuco_cut_board.jpg")
+    ap.add_argument("--out", type=picture_path, default=ROOT / "docs/images/charuco_cut_board.jpg")
     args = ap.parse_args()
     rv, tv = np.array([-0.289, 0.072, 0.195]), np.array([-0.0169, -0.0796, 0.3933])
     board = CharucoBoard("10x7", SQUARE, 0.022, "DICT_5X5_100")
@@ -68,8 +69,7 @@ def main() -> None:
     label(right, "chessboard: OpenCV finds it one square off (red)")
     label(right, "find_corners: " + ("refused, view unused" if refused else "accepted"), 50)
     out = np.hstack([left, np.full((480, 8, 3), 255, np.uint8), right])
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    cv2.imwrite(str(args.out), out, [cv2.IMWRITE_JPEG_QUALITY, 88])
+    write_picture(args.out, out)
     print(f"wrote {args.out}")
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA
+from _common import DATA, picture_path, write_picture
 
 from stereovision.io import imread
 from stereovision.rectification_check import check_rectification, draw_rectification_check
@@ -26,7 +26,9 @@ ROOT = Path(__file__).resolve().parents[1]
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scene", default="middlebury2003/cones")
-    ap.add_argument("--out", type=Path, default=ROOT / "docs/images/rectification_check.jpg")
+    ap.add_argument(
+        "--out", type=picture_path, default=ROOT / "docs/images/rectification_check.jpg"
+    )
     args = ap.parse_args()
     left = imread(DATA / args.scene / "left.png")
     right = imread(DATA / args.scene / "right.png")
@@ -41,7 +43,7 @@ def main() -> None:
         panels.append(draw_rectification_check(left, r, res))
     gap = np.full((12, panels[0].shape[1], 3), 255, np.uint8)
     img = np.concatenate([panels[0], gap, panels[1]], axis=0)
-    cv2.imwrite(str(args.out), img, [cv2.IMWRITE_JPEG_QUALITY, 88])
+    write_picture(args.out, img)
     print(f"wrote {args.out}")
 
 

@@ -522,6 +522,42 @@ def test_docs_pictures_gui_offers_a_save_folder(
     assert app.state.save_hint == SAVE_HINT
 
 
+def test_picture_benches_write_into_a_new_folder_and_refuse_an_unknown_extension(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """cv2.imwrite returns False into a missing folder: plot_rectification_check (and
+    bench_fisheye, bench_ground, bench_uncalibrated) printed "wrote PATH" of no file; an
+    extension OpenCV has no writer for was cv2.error's traceback after the run. Now the folder
+    is made (as plot_charuco did) and the extension refused by argparse in one line. The pair
+    and the check are stubbed (the picture not looked at)."""
+    import types
+
+    import cv2
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import plot_rectification_check as prc
+
+    monkeypatch.setattr(prc, "imread", lambda path: np.zeros((8, 8, 3), np.uint8))
+    check = types.SimpleNamespace(summary=lambda: "rows ok")
+    monkeypatch.setattr(prc, "check_rectification", lambda left, right: check)
+    monkeypatch.setattr(prc, "draw_rectification_check", lambda *a: np.zeros((4, 6, 3), np.uint8))
+    out = tmp_path / "new" / "check.jpg"
+    monkeypatch.setattr(sys, "argv", ["plot_rectification_check.py", "--out", str(out)])
+    prc.main()
+    assert capsys.readouterr().out.splitlines()[-1] == f"wrote {out}"
+    img = cv2.imread(str(out))
+    assert img is not None and img.shape == (20, 6, 3)
+    bad = str(tmp_path / "check.jgp")
+    monkeypatch.setattr(sys, "argv", ["plot_rectification_check.py", "--out", bad])
+    with pytest.raises(SystemExit) as exc:
+        prc.main()
+    assert exc.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        f"plot_rectification_check.py: error: argument --out: {bad}: OpenCV writes no image of "
+        "that extension; give a .jpg or .png"
+    )
+
+
 def test_the_benches_runs_option_is_stereovision_benchs(monkeypatch: pytest.MonkeyPatch) -> None:
     """benches/_common.timed_runs copied bench's --runs rule without its upper bound: a bench's
     ``--runs 1000000000`` was taken (and ran on for days). It is that rule itself now."""
