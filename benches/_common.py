@@ -108,6 +108,18 @@ def gt_scene(name: str) -> str:
     )
 
 
+def scene_folder(name: str) -> str:
+    """argparse ``type`` of a bench's scene that needs no GT (times only): ``name`` when it is a
+    folder or a ``family/scene`` of ``shared/data``, else argparse's one-line error (a typo was
+    load_scene's FileNotFoundError traceback)."""
+    if (DATA / name).is_dir() or Path(name).is_dir():
+        return name
+    raise argparse.ArgumentTypeError(
+        f"{name!r} is no folder: expected a scene folder or a family/scene of {DATA}, e.g. "
+        f"{', '.join(gt_scenes()[:3])}"
+    )
+
+
 def gt_scene_list(text: str) -> list[str]:
     """argparse ``type`` of a comma-separated ``--scenes``: each name checked by
     :func:`gt_scene`; ``""`` (the default: every GT scene) is ``[]``."""

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from _common import DATA, interleaved_ms, timed_runs
+from _common import DATA, interleaved_ms, scene_folder, timed_runs
 
 from stereovision import depth_map
 from stereovision._validate import as_gray_float
@@ -86,7 +86,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=timed_runs, default=7, help="timed runs per case (>= 5)")
     ap.add_argument(
-        "scenes", nargs="*", help="scene folders or family/scene names (default: cloth3 and teddyH)"
+        "scenes",
+        nargs="*",
+        type=scene_folder,
+        help="scene folders or family/scene names (default: cloth3 and teddyH)",
     )
     args = ap.parse_args()
     dirs = [Path(s) if Path(s).is_dir() else DATA / s for s in args.scenes or SCENES]

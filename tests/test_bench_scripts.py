@@ -410,6 +410,26 @@ def test_plots_refuse_a_scene_without_gt_in_one_line(
     ), err
 
 
+def test_bench_stages_refuses_a_missing_scene_in_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """bench_stages' scenes (times only: no GT needed) naming no folder was load_scene's
+    FileNotFoundError traceback; now argparse's one-line error, exit status 2."""
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import bench_stages
+
+    monkeypatch.setattr(sys, "argv", ["bench_stages.py", "middlebury2006/clot3"])
+    with pytest.raises(SystemExit) as exc:
+        bench_stages.main()
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert err.startswith(
+        "bench_stages.py: error: argument scenes: 'middlebury2006/clot3' is no folder: expected "
+        "a scene folder or a family/scene of "
+    ), err
+    assert err.endswith(", e.g. eth3d/playground, eth3d/terrace, kitti2015/000005_10"), err
+
+
 def test_eval_gabor_scenes_refuses_scenes_matching_nothing(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
