@@ -94,6 +94,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-speed", action="store_true")
     ap.add_argument("--json", type=Path, help="also write the figures here")
     args = ap.parse_args(argv)
+    if args.json is not None and args.json.is_dir():  # refused before the run, not after it
+        ap.error(f"argument --json: {args.json}: is a folder; give a file such as figures.json")
     figures: dict[str, object] = {}
     if not args.no_accuracy:
         acc = accuracy()
@@ -134,6 +136,9 @@ def main(argv: list[str] | None = None) -> int:
             cells = [f"{sp[s][name]:.0f} ({sp[s][name] / sp[s][ref]:.2f} x)" for s in SPEED_SCENES]
             print(f"| {name} | " + " | ".join(cells) + " |")
     if args.json:
+        # a new folder made, as the pictures' are: its write_text's FileNotFoundError came after
+        # the whole run, the figures printed but not kept
+        args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(figures, indent=1))
     return 0
 

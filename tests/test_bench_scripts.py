@@ -578,6 +578,28 @@ def test_picture_benches_write_into_a_new_folder_and_refuse_an_unknown_extension
     )
 
 
+def test_bench_tools_json_goes_into_a_new_folder_and_refuses_a_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """bench_tools --json in a missing folder was write_text's FileNotFoundError after the
+    whole run (the figures not kept), and a folder its IsADirectoryError; now the folder is
+    made, and a folder refused by argparse in one line before anything runs."""
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import bench_tools
+
+    monkeypatch.setattr(sys, "argv", ["bench_tools.py"])  # argparse's program name
+    out = tmp_path / "new" / "figures.json"
+    assert bench_tools.main(["--no-accuracy", "--no-speed", "--json", str(out)]) == 0
+    assert json.loads(out.read_text()) == {}
+    with pytest.raises(SystemExit) as exc:
+        bench_tools.main(["--no-accuracy", "--no-speed", "--json", str(tmp_path)])
+    assert exc.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        f"bench_tools.py: error: argument --json: {tmp_path}: is a folder; give a file such as "
+        "figures.json"
+    )
+
+
 def test_the_benches_runs_option_is_stereovision_benchs(monkeypatch: pytest.MonkeyPatch) -> None:
     """benches/_common.timed_runs copied bench's --runs rule without its upper bound: a bench's
     ``--runs 1000000000`` was taken (and ran on for days). It is that rule itself now."""
