@@ -229,7 +229,7 @@ def test_pairs_that_are_not_a_rig(tmp_path: Path) -> None:
     (tmp_path / "right.yaml").unlink()
     with pytest.raises(ValueError, match=r"partner .* is not beside it"):
         Calibration.from_file(tmp_path / "left.yaml")
-    with pytest.raises(ValueError, match=r"folder without left.yaml and right.yaml"):
+    with pytest.raises(ValueError, match=r"holds left.yaml but not right.yaml \(ROS "):
         Calibration.from_file(tmp_path)
     tar = tmp_path / "calibrationdata.tar.gz"
     with tarfile.open(tar, "w:gz") as t:
