@@ -1695,10 +1695,17 @@ def depth_map(
         )
         stage("refine")
     elif post_refine:
-        from stereovision.refine import refine_disparity
+        from stereovision.refine import _refine
 
-        ref = refine_disparity(
-            gl, gr, disp, conf, min_disparity=min_disparity, max_disparity=max_disparity
+        # the Gabor map over this range: refine_disparity's fixed-point warning is not for it
+        ref = _refine(
+            gl,
+            gr,
+            disp,
+            conf,
+            min_disparity=min_disparity,
+            max_disparity=max_disparity,
+            warn_fixed_point=False,
         )
         filled = ~measured & np.isfinite(ref.disparity)
         disp, conf = ref.disparity, ref.confidence

@@ -167,7 +167,7 @@ def _warn_if_mostly_above_range(d: npt.NDArray[np.float32], lo: float, hi: float
         "map is d * 16 (divide by 16; its -16 is no match), a 16-bit disparity PNG d * 256 "
         "(stereovision.export.read_disparity_png)",
         UserWarning,
-        stacklevel=3,
+        stacklevel=4,
     )
 
 
@@ -228,6 +228,33 @@ def refine_disparity(
         has a value, a parameter is unknown, no number (a bool, a string) or out of range,
         ``fill_plane`` not a bool.
     """
+    return _refine(
+        left,
+        right,
+        disparity,
+        confidence,
+        min_disparity=min_disparity,
+        max_disparity=max_disparity,
+        warn_fixed_point=True,
+        **params,
+    )
+
+
+def _refine(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    disparity: npt.ArrayLike,
+    confidence: npt.ArrayLike | None,
+    *,
+    min_disparity: float,
+    max_disparity: float,
+    warn_fixed_point: bool,
+    **params: object,
+) -> RefineResult:
+    """:func:`refine_disparity`; ``warn_fixed_point=False`` for the pipeline's own maps
+    (depth_map, fusion), which come from a matcher over this range: the fixed-point warning
+    is for a caller's map, and fired inside depth_map on a map whose values lay above a
+    range the caller had set (tests/test_depth.py's point image, 99 % above 16 px)."""
     # the valid keys and the nearest spelling too ("unknown refinement parameter(s):
     # ['win_sigmma']" named neither), as the matchers' own parameters are refused
     refuse_unknown("refinement parameter", params, DEFAULTS, "stereovision.refine.DEFAULTS")
@@ -267,7 +294,8 @@ def refine_disparity(
                 f"{name}: expected a finite number in float32, the kernel's precision, got "
                 f"{number_shown(v)}"
             )
-    _warn_if_mostly_above_range(dsp, lo, hi)
+    if warn_fixed_point:
+        _warn_if_mostly_above_range(dsp, lo, hi)
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:

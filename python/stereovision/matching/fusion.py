@@ -235,16 +235,17 @@ def remeasure(
     numpy.ndarray
         ``(H, W)`` float32, NaN exactly where ``disparity`` is.
     """
-    from stereovision.refine import refine_disparity
+    from stereovision.refine import _refine
 
     d = _check_map(disparity, "disparity", None)
-    r = refine_disparity(
+    r = _refine(
         left,
         right,
         d,
         confidence,
         min_disparity=min_disparity,
         max_disparity=max_disparity,
+        warn_fixed_point=False,  # a matcher's map over this range, not a caller's
         fills=(),
     )
     return np.where(np.isfinite(r.disparity), r.disparity, d).astype(np.float32)
