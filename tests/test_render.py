@@ -2430,6 +2430,14 @@ def test_point_cloud_names_python_ints_beyond_float32s_range() -> None:
         np.testing.assert_array_equal(cloud.points, [[0, 0, 1], [1, 1, 4]])
 
 
+def test_point_cloud_takes_none_as_a_missing_coordinate_beside_a_python_int() -> None:
+    """An object array (a list holding a Python int past int64, or None) was cast element by
+    element with float() since 289e16dc: None, which NumPy's cast makes NaN (a missing
+    coordinate: the point is dropped), became float()'s bare TypeError."""
+    cloud = render.point_cloud([[0, 0, 1], [None, 1, 2], [1, 1, 4]])
+    np.testing.assert_array_equal(cloud.points, [[0, 0, 1], [1, 1, 4]])
+
+
 def test_view_names_a_link_whose_target_moved(tmp_path: Path) -> None:
     """``view data`` of a link whose target moved (an output folder on a disk since unmounted)
     was "no such file or folder: data", of a name ls lists; the link's target is named, as

@@ -1752,7 +1752,9 @@ def points_as_float32(raw: np.ndarray) -> tuple[np.ndarray, str | None]:
         wide_flat = np.empty(len(flat))
         for i, v in enumerate(flat):
             try:
-                wide_flat[i] = float(v)  # what is no number: float32's cast raised as much
+                # NumPy's own element cast, as the array cast had it: None is NaN (a missing
+                # coordinate, dropped), not float()'s TypeError; what is no number raises
+                wide_flat[i] = v
             except OverflowError:
                 wide_flat[i], over_flat[i] = (math.inf if v > 0 else -math.inf), True
         wide, over = wide_flat.reshape(raw.shape), over_flat.reshape(raw.shape)
