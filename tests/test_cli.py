@@ -1528,6 +1528,19 @@ def test_eval_of_an_image_file_says_it_is_a_file(data_dir: Path) -> None:
     )
 
 
+@pytest.mark.parametrize("command", ["eval", "bench"])
+def test_eval_and_bench_of_a_device_say_it_is_no_folder(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`eval /dev/null` (or a pipe) said "is a file" of what is no file; load_scene's words
+    (aae87eaf) say what it is."""
+    assert main([command, "/dev/null"]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: /dev/null: is not a folder (a device or a pipe); give a scene "
+        "folder (holding left.png, right.png)\n"
+    )
+
+
 def test_info_on_a_scene_folder_reads_its_calibration(
     data_dir: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

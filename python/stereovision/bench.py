@@ -349,7 +349,9 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
             gone = f" ({_broken_link(Path(d))})" if Path(d).is_symlink() else ""
             raise FileNotFoundError(f"scene folder not found: {d}{gone}")
         if not Path(d).is_dir():  # find_scenes: "scene root not found"
-            raise ValueError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
+            # /dev/null or a pipe is no file either (load_scene's words, aae87eaf)
+            what = "is a file" if Path(d).is_file() else "is not a folder (a device or a pipe)"
+            raise ValueError(f"{d}: {what}; give a scene folder (holding left.png, right.png)")
         found, half = scan_scenes(d)
         if not found:
             # eval's line: a half scene skipped, or a JPEG pair, was not named

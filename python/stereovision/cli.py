@@ -2130,7 +2130,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
             gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
             raise FileNotFoundError(f"scene folder not found: {d}{gone}")
         if not p.is_dir():  # find_scenes said "scene root not found" of an existing image
-            raise CliError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
+            # /dev/null or a pipe is no file either (load_scene's words, aae87eaf)
+            what = "is a file" if p.is_file() else "is not a folder (a device or a pipe)"
+            raise CliError(f"{d}: {what}; give a scene folder (holding left.png, right.png)")
         found, half = scan_scenes(p)
         if not found:
             raise CliError(_no_scene_under(p, d, half))
