@@ -633,6 +633,16 @@ def test_kalibr_defaults_pinhole_radtan_and_ignores_other_keys(tmp_path: Path) -
     np.testing.assert_array_equal(rig.T, [-0.1, 0.0, 0.0])
 
 
+def test_kalibr_camchain_ending_in_a_document_marker_is_read(tmp_path: Path) -> None:
+    """A camchain ending in "---" (a second, empty document) was "cannot parse ... as Kalibr
+    YAML: expected a single document in the stream"; its first document is read, as the plain
+    YAML (a712fb3d) and ROS readers read theirs."""
+    path = _kalibr_pair(tmp_path, _KALIBR_CAM, _KALIBR_CAM + _KALIBR_POSE)
+    path.write_text(path.read_text() + "---\n")
+    for read in (Calibration.from_kalibr, Calibration.from_file):
+        np.testing.assert_array_equal(read(path).T, [-0.1, 0.0, 0.0])
+
+
 def test_kalibr_cameras_are_ordered_by_number_not_text(tmp_path: Path) -> None:
     """cam10 comes after cam9 in the chain (a text sort put it first and refused the pair)."""
     path = tmp_path / "camchain.yaml"

@@ -2454,7 +2454,9 @@ class Calibration:
 
         p, text = cls._read_text(path)
         try:
-            doc = yaml.safe_load(text)
+            # the first document, as the plain YAML and ROS readers take it (a712fb3d): a file
+            # ending in "---" (a second, empty one) was "expected a single document"
+            doc = next((d for d in yaml.safe_load_all(text) if d is not None), None)
         except (yaml.YAMLError, ValueError, RecursionError, LookupError, AttributeError) as exc:
             # not YAMLError alone: "2024-13-01" was a bare "month must be in 1..12", "!!bool x"
             # a KeyError (as _from_plain_yaml catches)
