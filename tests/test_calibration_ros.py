@@ -643,6 +643,18 @@ def test_kalibr_camchain_ending_in_a_document_marker_is_read(tmp_path: Path) -> 
         np.testing.assert_array_equal(read(path).T, [-0.1, 0.0, 0.0])
 
 
+def test_kalibr_camera_that_holds_itself_is_refused(tmp_path: Path) -> None:
+    """A recursive alias in a camchain (T_cn_cnm1: &a [*a, *a]) hung from_kalibr (NumPy's cast
+    of the list holding itself), as the plain YAML reader did before 15f74bf2."""
+    path = _kalibr_pair(tmp_path, _KALIBR_CAM, _KALIBR_CAM + "  T_cn_cnm1: &a [*a, *a]\n")
+    with pytest.raises(ValueError) as exc:
+        Calibration.from_kalibr(path)
+    assert str(exc.value) == (
+        f"{path}:cam1: T_cn_cnm1 holds itself (a YAML alias inside its own anchor, "
+        "'T_cn_cnm1: &a [*a]'): write its numbers out"
+    )
+
+
 def test_kalibr_cameras_are_ordered_by_number_not_text(tmp_path: Path) -> None:
     """cam10 comes after cam9 in the chain (a text sort put it first and refused the pair)."""
     path = tmp_path / "camchain.yaml"

@@ -2474,6 +2474,16 @@ class Calibration:
         i, j = chain.index(left), chain.index(right)
         if j <= i:
             raise ValueError(f"{p}: {right!r} must come after {left!r} in the chain")
+        for name in (left, right):
+            cam = doc[name]
+            for key, value in cam.items() if isinstance(cam, dict) else [(name, cam)]:
+                if _holds_itself(value):
+                    # "T_cn_cnm1: &a [*a, *a]": NumPy's cast of the list holding itself hung,
+                    # as the plain YAML reader's did (15f74bf2)
+                    raise ValueError(
+                        f"{p}:{name}: {key} holds itself (a YAML alias inside its own anchor, "
+                        f"'{key}: &a [*a]'): write its numbers out"
+                    )
         cams = [_kalibr_camera(doc[name], f"{p}:{name}") for name in (left, right)]
         if cams[0]["resolution"] != cams[1]["resolution"]:
             raise ValueError(
