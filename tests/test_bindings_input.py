@@ -1438,6 +1438,22 @@ def test_refine_disparity_reads_a_fill_given_as_a_list_pair() -> None:
         )
 
 
+def test_refine_disparity_refuses_bytes_or_a_dict_as_a_fill_pair() -> None:
+    """572c0f16 read any item of two as a fill pair: bytes (b"\\x10\\x00": 16, 0) and a
+    dict ({0: 16.0, 1: 0.3}) were taken, refused before as the tuple alone was read."""
+    a = np.random.default_rng(0).random((8, 12), dtype=np.float32)
+    for bad, shown in (
+        (b"\x10\x00", "b'\\x10\\x00'"),
+        (bytearray(b"\x10\x00"), "bytearray(b'\\x10\\x00')"),
+        ({0: 16.0, 1: 0.3}, "{0: 16.0, 1: 0.3}"),
+    ):
+        with pytest.raises(ValueError) as err:
+            _core.refine_disparity(a, a, a, a, *REFINE_ARGS[:10], [bad], 0.1, True, 1.0)
+        assert str(err.value) == (
+            f"invalid parameter `fills`: element 0 ({shown}): expected a (sigma, min_score) pair"
+        )
+
+
 def test_mcgm_curves_refuses_a_huge_image_before_copying_it() -> None:
     """``mcgm_curves`` copied ``img`` before its kernel's 32-bit size check, which
     ``mcgm_log`` (1eeb7ba4) and the matchers make from the shape first: a broadcast

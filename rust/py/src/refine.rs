@@ -136,8 +136,16 @@ fn fills_arg(ob: &Bound<'_, PyAny>) -> PyResult<Vec<(f32, f32)>> {
         let item = item?;
         // any sequence of two, not a tuple alone: a list pair ([[16, 0.3]], JSON's) was
         // "element 0 ([16, 0.3]): expected a (sigma, min_score) pair" of a pair
+        // bytes (b"\x10\x00": 16, 0) and a dict ({0: 16, 1: 0.3}) index as two numbers but
+        // are no pair: taken since the list pair was, refused before as the tuple alone read
         let pair = || -> Option<(Bound<'_, PyAny>, Bound<'_, PyAny>)> {
-            if item.is_instance_of::<pyo3::types::PyString>() || item.len().ok()? != 2 {
+            use pyo3::types::{PyByteArray, PyBytes, PyDict, PyString};
+            if item.is_instance_of::<PyString>()
+                || item.is_instance_of::<PyBytes>()
+                || item.is_instance_of::<PyByteArray>()
+                || item.is_instance_of::<PyDict>()
+                || item.len().ok()? != 2
+            {
                 return None;
             }
             Some((item.get_item(0).ok()?, item.get_item(1).ok()?))
