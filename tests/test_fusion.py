@@ -1276,7 +1276,7 @@ def test_fuse_pair_passes_its_range_to_the_remeasure_and_the_member_check(
 
         return call
 
-    monkeypatch.setattr(refine, "refine_disparity", spy("refine", refine.refine_disparity))
+    monkeypatch.setattr(refine, "_refine", spy("refine", refine._refine))
     monkeypatch.setattr(mcgm, "edge_filters", spy("sides", mcgm.edge_filters))
     sc = load_scene(data_dir / "middlebury2001" / "tsukuba")
     gl, gr = as_gray_float(sc.left, "left"), as_gray_float(sc.right, "right")
