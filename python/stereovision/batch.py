@@ -316,13 +316,9 @@ def _scan(
         )
     if not r.is_dir():
         raise NotADirectoryError(f"input is not a folder: {r}")
-    try:
-        # one that cannot be listed (no permission) was os.walk's warning, then "no pair
-        # under" it naming the layouts, as if it held none of them
-        with os.scandir(r):
-            pass
-    except OSError as e:
-        raise type(e)(f"cannot search input folder {r}: {e.strerror or e}") from None
+    # one that cannot be listed (no permission) was os.walk's warning, then "no pair under" it
+    # naming the layouts, as if it held none of them
+    _must_list(r, "input folder")
     cal = as_path(calib, "calib") if calib is not None else None
     if cal is not None and not cal.exists():
         # a link whose target moved: which file is missing is said, as depth --calib says it
@@ -570,6 +566,16 @@ def _not_listed(err: OSError) -> None:
         "in it, if any, are left out",
         stacklevel=2,
     )
+
+
+def _must_list(folder: Path, what: str) -> None:
+    """Raise the listing error of a top folder ``_walk`` would only warn of, naming it
+    (``PermissionError`` for no permission, another :class:`OSError` of its kind else)."""
+    try:
+        with os.scandir(folder):
+            pass
+    except OSError as e:
+        raise type(e)(f"cannot search {what} {folder}: {e.strerror or e}") from None
 
 
 def _walk(

@@ -2304,19 +2304,15 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
         # a link whose target moved: its target named, as load_scene's words name it
         gone = f" ({_broken_link(r)})" if r.is_symlink() and not r.exists() else ""
         raise FileNotFoundError(f"scene root not found: {r}{gone}")
-    try:
-        # one that cannot be listed (no permission) was the walk's warning that its pairs are
-        # left out, then eval's "no scene under" it, as if it held none (as batch's input was)
-        with os.scandir(r):
-            pass
-    except OSError as e:
-        raise type(e)(f"cannot search scene root {r}: {e.strerror or e}") from None
+    from stereovision.batch import _must_list, _walk
+
+    # one that cannot be listed (no permission) was the walk's warning that its pairs are left
+    # out, then eval's "no scene under" it, as if it held none (as batch's input was)
+    _must_list(r, "scene root")
     # Links followed: Path.rglob does not enter a link to a folder, so scenes linked into a
     # folder were not found. As batch's walk, a link to a folder inside the root (or holding
     # it: a loop), or to one entered already, is an alias, not entered: `latest -> run3` listed
     # run3's scenes twice and `bench` counted them twice in its mean.
-    from stereovision.batch import _walk
-
     found: list[Path] = []
     skipped: list[tuple[Path, str]] = []
     for folder, dirs, files, _ in _walk(r):
