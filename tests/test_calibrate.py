@@ -1428,7 +1428,9 @@ def test_cli_pairs_images_on_their_numbers(tmp_path):
     assert calmod._pair_by_number(stamps_l, stamps_r) == stamps_r
 
 
-def test_a_rational_model_whose_pole_lies_past_the_image_is_not_said_to_fold() -> None:
+def test_a_rational_model_whose_pole_lies_past_the_image_is_not_said_to_fold(
+    cached_corners: None,
+) -> None:
     """distortion='rational' on the StereoPi pairs: the right model grows out to a normalised
     radius of 1.01 (the image's corners need 0.70) and turns back only past it, near the pole of
     its denominator at r = 1.21 (a ray 50 degrees off the axis, outside the 53-degree view). The
@@ -1455,7 +1457,7 @@ def test_a_rational_model_whose_pole_lies_past_the_image_is_not_said_to_fold() -
     assert calmod._radial_is_monotonic(cal.K2, cal.D2, cal.image_size)
 
 
-def test_a_folding_model_auto_chose_is_not_answered_with_auto() -> None:
+def test_a_folding_model_auto_chose_is_not_answered_with_auto(cached_corners: None) -> None:
     """Five StereoPi pairs with distortion='auto' (too few views to compare models: the first
     candidate, k1k2p1p2): its model turns back inside the image, and the warning said to
     "calibrate with distortion='auto'", the option just used. It now names a simpler model and
@@ -2523,7 +2525,9 @@ def test_outlier_floor_both_cameras_in_model_selection_and_a_worse_refinement_re
     assert not rep.refined and rep.rms == fixed.rms
 
 
-def test_calibrate_from_videos_warning_points_at_the_callers_line(tmp_path: Path) -> None:
+def test_calibrate_from_videos_warning_points_at_the_callers_line(
+    cached_corners: None, tmp_path: Path
+) -> None:
     """calibrate()'s warnings had ``stacklevel=2``, right for calibrate() only: through
     calibrate_from_video (or calibrate_from_bag) they named a line of calibrate.py."""
     import warnings
@@ -2786,7 +2790,9 @@ def _pairs_at_tilts(tilts_deg: list[tuple[float, float]]) -> tuple[list[Any], li
     return left, right
 
 
-def test_boards_held_at_one_tilt_are_refused_and_a_small_spread_warned() -> None:
+def test_boards_held_at_one_tilt_are_refused_and_a_small_spread_warned(
+    cached_corners: None,
+) -> None:
     """Pairs of a board only moved about, never turned, fix no focal length: these four were
     calibrated in silence to 738 px for 700 (scaled copies of a sample pair to 777 px for 533,
     shifted ones refused in words about the R and T the user never gave). Now a plane spread
@@ -2843,7 +2849,9 @@ def test_a_left_camera_mounted_upside_down_is_named(cached_corners: None) -> Non
     ), said
 
 
-def test_mutation_audit_tilt_spread_sign_and_a_spread_past_the_warning() -> None:
+def test_mutation_audit_tilt_spread_sign_and_a_spread_past_the_warning(
+    cached_corners: None,
+) -> None:
     """Mutation audit of 56188f0: a plane's normal has no sign, so boards whose normals point
     170 degrees apart lie 10 degrees apart (a turn about the board's own normal, the existing
     case, flips no normal); a spread of 20 degrees (past TILT_SPREAD_WARN_DEG) is calibrated
