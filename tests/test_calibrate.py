@@ -1172,7 +1172,7 @@ def test_max_pairs_records_the_pairs_it_left_out(
 
 
 def test_too_few_boards_among_the_pairs_max_pairs_kept_names_the_ones_it_left_out(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], cached_corners: None
 ) -> None:
     """``--max-pairs 3`` of 13 pairs, one of the three kept without the board: the error said
     "found in both images of only 2 of 3 pairs", as if 3 pairs had been given; it adds that
@@ -1195,7 +1195,7 @@ def test_too_few_boards_among_the_pairs_max_pairs_kept_names_the_ones_it_left_ou
 
 
 def test_max_pairs_names_kept_and_left_out_pairs_by_one_numbering(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], cached_corners: None
 ) -> None:
     """Two sessions' images of the same file names (``a/left01.jpg``, ``b/left01.jpg``) are
     told apart by their place in the list (``13:left01.jpg / right01.jpg``). ``--max-pairs``
