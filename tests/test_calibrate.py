@@ -145,9 +145,10 @@ _CORNER_CACHE: dict[Any, Any] = {}
 
 
 def _cached_find_corners(image: Any, pattern: tuple[int, int] = (9, 6)) -> Any:
-    """find_corners memoised by image content (a later call on the same image is free)."""
+    """find_corners memoised by image content (a later call on the same image is free): its
+    bytes, shape and dtype (a turned or re-encoded image is another key), and the pattern."""
     arr = np.ascontiguousarray(image)
-    key = (hashlib.sha1(arr.tobytes()).hexdigest(), arr.shape, tuple(pattern))
+    key = (hashlib.sha1(arr.tobytes()).hexdigest(), arr.shape, arr.dtype.str, tuple(pattern))
     if key not in _CORNER_CACHE:
         _CORNER_CACHE[key] = find_corners(arr, pattern)
     c = _CORNER_CACHE[key]
