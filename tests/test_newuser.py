@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from importlib import resources
 from pathlib import Path
 
@@ -672,6 +672,35 @@ def _chessboard_pairs(n: int) -> tuple[list[Path], list[Path]]:
     return [folder / f"left{i}.jpg" for i in ids], [folder / f"right{i}.jpg" for i in ids]
 
 
+_CORNERS: dict[tuple[str, tuple[int, ...], str, tuple[int, int]], object] = {}
+
+
+@pytest.fixture
+def cached_corners() -> Iterator[None]:
+    """``calibrate.find_corners`` memoised by image content and pattern for the tests of
+    progress: the same six pairs are searched once in this file, not once per calibration
+    (0.7 s a board; what these tests read is the progress, not the search). Its own
+    MonkeyPatch: a test's ``monkeypatch.undo()`` (of its stderr) leaves it in place."""
+    import hashlib
+
+    from stereovision import calibrate as calmod
+
+    find = calmod.find_corners
+
+    def cached(image: object, pattern: tuple[int, int] = (9, 6)) -> object:
+        arr = np.ascontiguousarray(image)
+        key = (hashlib.sha1(arr.tobytes()).hexdigest(), arr.shape, arr.dtype.str, tuple(pattern))
+        if key not in _CORNERS:
+            _CORNERS[key] = find(arr, pattern)
+        hit = _CORNERS[key]
+        return None if hit is None else np.array(hit, copy=True)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(calmod, "find_corners", cached)
+        yield
+
+
+@pytest.mark.usefixtures("cached_corners")
 def test_calibrate_reports_its_progress() -> None:
     """calibrate said nothing until it was done (30 StereoPi pairs: 22 s, 14 s of them finding
     the boards and 8 s choosing the distortion model); its ``progress`` callback now hears each
@@ -690,6 +719,7 @@ def test_calibrate_reports_its_progress() -> None:
     np.testing.assert_array_equal(cal.T, plain.T)
 
 
+@pytest.mark.usefixtures("cached_corners")
 def test_calibrate_progress_reaches_its_total_when_a_fit_ends_early(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -753,6 +783,7 @@ class _Terminal:
         return True
 
 
+@pytest.mark.usefixtures("cached_corners")
 def test_calibrate_draws_progress_bars_on_a_terminal_only(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -926,6 +957,7 @@ def test_one_scene_folder_for_both_images_says_what_to_type(
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.usefixtures("cached_corners")
 def test_reading_a_calibration_recording_reports_its_progress(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1007,6 +1039,7 @@ def test_a_scene_folder_beside_an_abbreviated_option_still_says_what_to_type(
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.usefixtures("cached_corners")
 def test_a_recording_announcing_fewer_frames_than_it_holds_never_reports_past_its_total(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
