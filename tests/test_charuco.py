@@ -4,12 +4,13 @@ image edges, errors, the printable board and the CLI."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import math
 import re
 import struct
 import subprocess
-import sys
 import warnings
 import zlib
 from dataclasses import replace
@@ -386,12 +387,20 @@ def test_board_png_prints_at_its_true_size() -> None:
 # ---------------------------------------------------------------------------------------- CLI
 
 
-def _cli(*args: str, timeout: int = 120) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "stereovision.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    """``stereovision *args`` run in-process (1 s of CPU a subprocess spent importing; no test
+    here is about the process): its exit status (``main``'s, or argparse's ``SystemExit``),
+    stdout and stderr, as ``subprocess.run`` gives them."""
+    from stereovision.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(list(args))
+        except SystemExit as stop:
+            code = stop.code if isinstance(stop.code, int) else 1
+    return subprocess.CompletedProcess(
+        ["stereovision", *args], code, out.getvalue(), err.getvalue()
     )
 
 
