@@ -85,6 +85,13 @@ def rig() -> dict[str, Any]:
     return {"poses": poses, "left": left, "right": right}
 
 
+@pytest.fixture(scope="module")
+def six(rig: dict[str, Any]) -> tuple[Any, Any]:
+    """The first 6 pairs calibrated with ``BOARD``: one calibration that the tests which only
+    read it share (each made the same one of its own)."""
+    return calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+
+
 # ---------------------------------------------------------------------------------- detection
 
 
@@ -212,11 +219,11 @@ def test_stereo_calibration_recovers_the_rig_through_cut_boards(rig: dict[str, A
     assert "ChArUco 10x7 squares" in rep.summary() and "DICT_5X5_100" in rep.board
 
 
-def test_dictionary_auto_calibrates_the_same(rig: dict[str, Any]) -> None:
+def test_dictionary_auto_calibrates_the_same(rig: dict[str, Any], six: tuple[Any, Any]) -> None:
     """dictionary='auto' settles on DICT_5X5_50 (a prefix of 5X5_100): the same corners, the
     same calibration."""
     sub = slice(0, 6)
-    a, ra = calibrate(rig["left"][sub], rig["right"][sub], board=BOARD)
+    a, ra = six  # calibrate(rig["left"][sub], rig["right"][sub], board=BOARD)
     auto = CharucoBoard("10x7", 0.03, 0.022)
     b, rb = calibrate(rig["left"][sub], rig["right"][sub], board=auto)
     assert "DICT_5X5_50" in rb.board
@@ -248,8 +255,8 @@ def test_pairs_with_too_few_common_corners_are_rejected_by_name(rig: dict[str, A
     assert len(rep.used_pairs) == 4
 
 
-def test_report_pictures_with_partial_boards(rig: dict[str, Any], tmp_path: Path) -> None:
-    _, rep = calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+def test_report_pictures_with_partial_boards(six: tuple[Any, Any], tmp_path: Path) -> None:
+    _, rep = six
     paths = rep.write(tmp_path)
     page = paths["html"].read_text()
     assert "ChArUco 10x7 squares" in page and f"{rep.corners_used} corners used" in page
@@ -643,14 +650,14 @@ def test_cli_board_written_again_keeps_no_copy_of_itself(tmp_path: Path) -> None
     assert sorted(p.name for p in tmp_path.iterdir()) == ["board.png"]
 
 
-def test_each_cameras_stereo_rms_pools_every_corner(rig: dict[str, Any]) -> None:
+def test_each_cameras_stereo_rms_pools_every_corner(six: tuple[Any, Any]) -> None:
     """Each camera's share of the stereo RMS is over all its corners, so a view of a cut board
     (fewer corners) weighs less; a mutation audit found it checked on whole boards only, where
     the mean of the views' RMS is the same. Independently: cv2.stereoCalibrateExtended, re-run
     from the solution, gives each view's board pose; cv2.projectPoints the pooled residuals."""
     from stereovision.calibrate import board_object_points
 
-    cal, rep = calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+    cal, rep = six
     names = rep.used_pairs
     assert len({len(rep._ids[n]) for n in names}) > 1  # views with different corner counts
     grid = board_object_points(BOARD.inner, BOARD.square_size)
@@ -1104,7 +1111,7 @@ def test_the_dpi_a_too_large_board_suggests_is_accepted_typed_back(
 
 
 def test_the_triangulated_square_sides_pair_partial_boards_corners_by_their_ids(
-    rig: dict[str, Any],
+    six: tuple[Any, Any],
 ) -> None:
     """The report's square sides are measured between grid neighbours, which a cut board's
     corners must be placed by their ids to find. A fourth mutation audit found them placed in
@@ -1112,7 +1119,7 @@ def test_the_triangulated_square_sides_pair_partial_boards_corners_by_their_ids(
     corners are still neighbours) while the spread went from 0.45 % of the square to 152 %.
     Independently: cv2.stereoRectify (alpha 0), cv2.undistortPoints and cv2.triangulatePoints,
     each corner at its id in the 9x6 grid."""
-    cal, rep = calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+    cal, rep = six
     assert any(len(rep._ids[n]) < BOARD.n_corners for n in rep.used_pairs)  # cut boards
     R1, R2, P1, P2, *_ = cv2.stereoRectify(
         cal.K1, cal.D1, cal.K2, cal.D2, cal.image_size, cal.R, cal.T.reshape(3, 1),
