@@ -161,7 +161,8 @@ def test_the_wrong_layout_finds_fewer_corners() -> None:
     """An even-rowed board printed in the legacy layout: read with the current one, fewer
     corners (the two layouts put the markers in different squares)."""
     true = CharucoBoard("8x6", 0.04, 0.03, "DICT_5X5_100", legacy=True)
-    img = render_charuco(true, K1, D1, np.array([0.1, -0.2, 0.0]), np.array([-0.15, -0.1, 0.5]))
+    rv, tv = np.array([0.1, -0.2, 0.0]), np.array([-0.15, -0.1, 0.5])
+    img = render_charuco(true, K1, D1, rv, tv, supersample=SS)
     right = find_charuco_corners(img, true)
     wrong = find_charuco_corners(img, CharucoBoard("8x6", 0.04, 0.03, "DICT_5X5_100", False))
     assert right is not None and len(right[0]) == true.n_corners
@@ -1163,7 +1164,8 @@ def test_a_cut_legacy_board_is_not_read_in_the_other_layout_a_square_off() -> No
     err = np.linalg.norm(got[1] - _project(true, got[0], rv, tv, K1, D1), axis=1)
     assert err.max() < 0.5
     # the board in full view: either layout's count and squares still agree on the legacy one
-    full = render_charuco(true, K1, D1, np.array([0.1, -0.2, 0.0]), np.array([-0.22, -0.15, 0.7]))
+    rv, tv = np.array([0.1, -0.2, 0.0]), np.array([-0.22, -0.15, 0.7])
+    full = render_charuco(true, K1, D1, rv, tv, supersample=SS)
     found = CharucoBoard("11x8", 0.04, 0.03, "DICT_7X7_100").resolve(full)
     assert found is not None and found.legacy is True
 
