@@ -7,8 +7,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import subprocess
-import sys
 import warnings
 from dataclasses import replace
 from fractions import Fraction
@@ -505,32 +503,25 @@ def test_kittis_road_under_the_live_maps(data_dir: Path) -> None:
         assert math.degrees(math.acos(min(1.0, float(plane.normal @ gt.normal)))) < 0.5, kw
 
 
-def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
+def test_cli_depth_ground(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``stereovision depth --ground`` run in process (``cli.main``, its stdout and stderr
+    captured): what it writes and says, and its two refusals (status 2, one line)."""
+    from stereovision.cli import main
+
     kitti = data_dir / "kitti2015" / "000005_10"
-    cli = [sys.executable, "-m", "stereovision.cli", "depth"]
+    cli = ["depth"]  # stereovision depth
     pair = [str(kitti / "left.png"), str(kitti / "right.png")]
-    run = subprocess.run(
-        [
-            *cli,
-            *pair,
-            "--calib",
-            str(kitti / "calib.txt"),
-            "--ground",
-            "--grid",
-            "0.1",
-            "-o",
-            str(tmp_path),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert run.returncode == 0, run.stderr
-    assert "ground plane: camera 1.6" in run.stdout
+    code = main([*cli, *pair, "--calib", str(kitti / "calib.txt"), "--ground", "--grid", "0.1",
+                 "-o", str(tmp_path)])  # fmt: skip
+    run = capsys.readouterr()
+    assert code == 0, run.err
+    assert "ground plane: camera 1.6" in run.out
     info = json.loads((tmp_path / "ground.json").read_text())
     assert info["height_m"] == pytest.approx(1.62, abs=0.03)
     assert info["camera_in_floor"][2][3] == info["height_m"]
-    assert "static_transform_publisher --x 0 --y 0 --z 1.6" in run.stdout
+    assert "static_transform_publisher --x 0 --y 0 --z 1.6" in run.out
     mask = cv2.imread(str(tmp_path / "obstacles.png"), cv2.IMREAD_GRAYSCALE)
     assert mask.shape == (375, 1242) and 0.05 < (mask > 0).mean() < 0.6
     grid = cv2.imread(str(tmp_path / "map.png"), cv2.IMREAD_GRAYSCALE)
@@ -541,15 +532,13 @@ def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
     assert math.degrees(scan["angle_max"] - scan["angle_min"]) == pytest.approx(81.2, abs=1.0)
     hits = [r for r in scan["ranges"] if isinstance(r, float)]
     assert len(hits) > 700 and min(hits) > 3.0  # KITTI: cars from about 5 m on
-    assert "beams on an obstacle, the nearest" in run.stdout
+    assert "beams on an obstacle, the nearest" in run.out
     # --max-depth bounds the obstacles and the scan too, not only the depth outputs; filled
     # pixels (no depth of their own) count within it
     near = tmp_path / "near"
-    run = subprocess.run(
-        [*cli, *pair, "--calib", str(kitti / "calib.txt"), "--ground", "--max-depth", "10",
-         "-o", str(near)], capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert run.returncode == 0, run.stderr
+    code = main([*cli, *pair, "--calib", str(kitti / "calib.txt"), "--ground", "--max-depth",
+                 "10", "-o", str(near)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
     depth_near = np.load(near / "depth.npy")
     mask_near = cv2.imread(str(near / "obstacles.png"), cv2.IMREAD_GRAYSCALE) > 0
     kcal = Calibration.from_file(kitti / "calib.txt")
@@ -561,17 +550,14 @@ def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
     hits_near = [r for r in scan_near["ranges"] if isinstance(r, float)]
     # Z <= 10 m within a half field of view of 40.6 degrees: at most 10 / cos(40.6) = 13.2 m away
     assert max(hits) > 14.0 and 100 < len(hits_near) and max(hits_near) < 13.2
-    run = subprocess.run(
-        [*cli, *pair, "--ground", "-o", str(tmp_path / "x")], capture_output=True, text=True,
-        timeout=120,
-    )  # fmt: skip
-    assert run.returncode == 2 and run.stderr.count("\n") == 1
-    assert "--ground needs --calib" in run.stderr
-    run = subprocess.run(
-        [*cli, *pair, "--calib", str(kitti / "calib.txt"), "--grid", "0.1", "-o", str(tmp_path)],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert run.returncode == 2 and "--grid needs --ground" in run.stderr
+    capsys.readouterr()
+    code = main([*cli, *pair, "--ground", "-o", str(tmp_path / "x")])
+    run = capsys.readouterr()
+    assert code == 2 and run.err.count("\n") == 1
+    assert "--ground needs --calib" in run.err
+    code = main([*cli, *pair, "--calib", str(kitti / "calib.txt"), "--grid", "0.1", "-o",
+                 str(tmp_path)])  # fmt: skip
+    assert code == 2 and "--grid needs --ground" in capsys.readouterr().err
 
 
 def test_occupancy_grid_of_the_rendered_box(scene: dict, tmp_path: Path) -> None:
