@@ -3286,7 +3286,10 @@ def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     """Save wrote its files one by one into the folder: a writer that failed midway (disk full)
     left a partial set there. A Save is now all or nothing: written into a staging folder and
     moved into place once every file is; a failure leaves the folder as it was (absent when it
-    was), no staging folder behind, and the Save's line names the file that failed."""
+    was), no staging folder behind, and the Save's line names the file that failed.
+
+    Its 27 Saves are of one pair from one pose: the 3-D view is rendered once (the first Save)
+    and that image handed to the others, which write it as render.png all the same."""
 
     from stereovision.gui import bundled_data_dir
     from stereovision.gui.app import SAVE_WRITE_ORDER, SAVED_DEPTH_FILES, SAVED_FILES
@@ -3295,6 +3298,14 @@ def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     app = _scene_app("test-save-all-or-nothing", [bundled_data_dir(), tmp_path])
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
+    render, rendered = app._render_for_save, []
+
+    def render_once(view, camera=None):
+        if not rendered:
+            rendered.append(render(view, camera))
+        return rendered[0]
+
+    monkeypatch.setattr(app, "_render_for_save", render_once)
     failing = _disk_full_at(monkeypatch)
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "notes.txt").write_text("mine")
