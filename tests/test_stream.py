@@ -525,14 +525,20 @@ def test_stream_no_tf_leaves_the_floor_transform_out_of_the_bag(
 
 @SLOW_PIPELINED
 def test_stream_averages_a_still_noisy_rig(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Six PNG frames of the still scene with fresh noise each (8 grey levels): with --temporal
     the matcher gets the running mean (1, 2, ... 6 frames), its noise down by more than half on
-    the last pair; the moving videos above restart on every pair and pass through."""
+    the last pair; the moving videos above restart on every pair and pass through. Its three
+    streams check the same first pair: its features are found once
+    (:func:`_features_once_per_image`)."""
     from stereovision.temporal import TemporalFilter
     from tests.test_exposure import noisy
 
+    _features_once_per_image(monkeypatch)
     scene = data_dir / SCENE
     rng = np.random.default_rng(0)
     clean = {s: cv2.imread(str(scene / f"{s}.png")) for s in ("left", "right")}
