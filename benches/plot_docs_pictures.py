@@ -69,10 +69,12 @@ def save_png(image: Any, out: Path) -> Path:
     im = Image.fromarray(image) if isinstance(image, np.ndarray) else image.convert("RGB")
     buf = io.BytesIO()
     im.save(buf, "PNG", optimize=True)
-    palette = im.quantize(256, method=Image.Quantize.MEDIANCUT, kmeans=2)
+    palette = None  # made only for a file too large (seconds of CPU: 2 s for demo_render)
     for dither in (Image.Dither.FLOYDSTEINBERG, Image.Dither.NONE):  # dithered if it fits
         if buf.tell() <= MAX_BYTES:
             break
+        if palette is None:
+            palette = im.quantize(256, method=Image.Quantize.MEDIANCUT, kmeans=2)
         buf = io.BytesIO()
         im.quantize(palette=palette, dither=dither).save(buf, "PNG", optimize=True)
     if buf.tell() > MAX_BYTES:
