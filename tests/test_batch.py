@@ -198,7 +198,7 @@ def test_batch_runs_skips_and_records_failures(
     shutil.copy(scenes / "middlebury2001/tsukuba/right.png", scenes / "seq/right_0001.png")
     with (
         distributed.LocalCluster(
-            n_workers=2,
+            n_workers=1,  # one pair to redo: a second worker process would start for nothing
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
@@ -419,8 +419,12 @@ def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
         run_batch(tmp_path / "taken", tmp_path / "o")
 
 
-def test_batch_ctrl_c_keeps_finished_pairs(data_dir: Path, tmp_path: Path) -> None:
-    """SIGINT in the middle: exit 130, finished pairs written and recorded, a re-run continues."""
+def test_batch_ctrl_c_keeps_finished_pairs(
+    data_dir: Path, tmp_path: Path, in_process_dask: None
+) -> None:
+    """SIGINT in the middle: exit 130, finished pairs written and recorded, a re-run continues.
+    The interrupted run is a process of its own with real worker processes; the re-run, whose
+    point is the bookkeeping (what is skipped, what is done), has its worker in process."""
     root = tmp_path / "in"
     for i in range(12):
         _half(data_dir / "middlebury2001/tsukuba", root / f"s{i:02d}")
