@@ -267,30 +267,33 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFix
     assert "recalibrate" not in out
 
 
-def test_cli_check_cannot_tell(tmp_path: Path) -> None:
+def test_cli_check_cannot_tell(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A pair too plain to judge: exit 3 (not 1, a verdict on the rig, nor 2, an error), with
-    and without --fix; --fix says in one line that it wrote nothing, and writes nothing."""
+    and without --fix; --fix says in one line that it wrote nothing, and writes nothing. In
+    process (main returns the exit status), but for --help, which exits as argparse's does."""
+    from stereovision.cli import main
+
     flat, flat_r = tmp_path / "flat.png", tmp_path / "flat_r.png"  # one file twice warns
     cv2.imwrite(str(flat), np.full((375, 450), 128, np.uint8))
     cv2.imwrite(str(flat_r), np.full((375, 450), 130, np.uint8))
     rig = _rig(450, 375, (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
     fixed = tmp_path / "fixed.yaml"
     for extra in ([], ["--fix", str(fixed)], ["--json", "--fix", str(fixed)]):
-        run = subprocess.run([*SV, "check", str(flat), str(flat_r), "--calib", str(rig), *extra],
-                             capture_output=True, text=True, timeout=120)  # fmt: skip
-        assert run.returncode == 3, (extra, run.stderr)
-        out = json.loads(run.stdout) if "--json" in extra else run.stdout
+        code = main(["check", str(flat), str(flat_r), "--calib", str(rig), *extra])
+        run = capsys.readouterr()
+        assert code == 3, (extra, run.err)
+        out = json.loads(run.out) if "--json" in extra else run.out
         if "--json" in extra:
             assert out["ok"] is None and out["matches"] == 0
         else:
             assert out.startswith("rectification: cannot tell, only 0 feature matches")
         if extra:
-            assert run.stderr == (
+            assert run.err == (
                 f"stereovision: not corrected, nothing written to {fixed}: too little texture "
                 "to tell the rows (give a textured pair)\n"
             )
         else:
-            assert run.stderr == ""
+            assert run.err == ""
         assert not fixed.exists()
     run = subprocess.run([*SV, "check", "--help"], capture_output=True, text=True, timeout=120)
     assert "3 when the pair has too little texture to tell" in " ".join(run.stdout.split())
@@ -304,11 +307,16 @@ CONES_AS_GIVEN = (
 )
 
 
-def test_cli_check_fix_says_once_what_it_cannot_correct(data_dir: Path, tmp_path: Path) -> None:
+def test_cli_check_fix_says_once_what_it_cannot_correct(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """--fix on a pair that fails the check in a way no drift explains: exit 1 (a verdict), not
     2 (an error), and one line after the check's, not the check's line again as an error. Cones
     as given is rectified: the line says that the raw rig's calibration may rectify it twice
-    (it said "calibrate the rig again" alone); not of a swapped pair."""
+    (it said "calibrate the rig again" alone); not of a swapped pair. In process: main returns
+    the exit status."""
+    from stereovision.cli import main
+
     cones = data_dir / "middlebury2003" / "cones"
     pair = [str(cones / "left.png"), str(cones / "right.png")]
     fixed = tmp_path / "fixed.yaml"
@@ -321,11 +329,11 @@ def test_cli_check_fix_says_once_what_it_cannot_correct(data_dir: Path, tmp_path
     )  # fmt: skip
     for images, turn, f, said, why in cases:
         rig = _rig(450, 375, turn, f=f).save(tmp_path / "rig.yaml")
-        run = subprocess.run([*SV, "check", *images, "--calib", str(rig), "--fix", str(fixed)],
-                             capture_output=True, text=True, timeout=120)  # fmt: skip
-        assert run.returncode == 1, run.stderr
-        assert run.stdout.startswith(said) and run.stdout.count("\n") == 1
-        assert run.stderr == f"stereovision: not corrected, nothing written to {fixed}: {why}\n"
+        code = main(["check", *images, "--calib", str(rig), "--fix", str(fixed)])
+        run = capsys.readouterr()
+        assert code == 1, run.err
+        assert run.out.startswith(said) and run.out.count("\n") == 1
+        assert run.err == f"stereovision: not corrected, nothing written to {fixed}: {why}\n"
         assert not fixed.exists()
 
 
