@@ -2476,18 +2476,24 @@ def test_cli_capture_warning_while_reading_goes_above_the_frames_bar(
     assert capsys.readouterr().out.splitlines()[-1].startswith("3 pairs saved in")
 
 
+@pytest.fixture(scope="module")
+def long_videos(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """400 numbered frames a side (1 s to write), read only: shared by the tests they outlast."""
+    return _videos(tmp_path_factory.mktemp("long"), 400, 400)
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 @pytest.mark.parametrize(
     ("sig", "status", "what"), [(2, 130, "interrupted"), (15, 143, "terminated (SIGTERM)")]
 )
 def test_cli_capture_stopped_says_what_it_kept(
-    tmp_path: Path, sig: int, status: int, what: str
+    tmp_path: Path, long_videos: tuple[Path, Path], sig: int, status: int, what: str
 ) -> None:
     """Ctrl-C or SIGTERM mid-capture: one line saying how many pairs were saved and kept (it
     said "stereovision: interrupted" alone), every pair whole."""
     import signal
 
-    left, right = _videos(tmp_path, 400, 400)
+    left, right = long_videos
     out = tmp_path / "pairs"
     proc = subprocess.Popen(
         [sys.executable, "-m", "stereovision", "capture", "--left", str(left), "--right",
