@@ -1392,6 +1392,21 @@ def _board(
     if pose is None:
         img = np.full((BOARD_SIZE[1], BOARD_SIZE[0]), 60, np.uint8)
     else:
+        img = _rendered_board(pose, right, charuco)
+    return _stamp(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), n)
+
+
+#: :func:`_rendered_board`'s renders (read only), by pose, camera and board: the sequences
+#: show the same few poses again and again (the 11-frame SEQUENCE: 19 boards, 7 renders).
+_RENDERS: dict[tuple[bytes, bytes, bool, bool], np.ndarray] = {}
+
+
+def _rendered_board(pose: tuple[np.ndarray, np.ndarray], right: bool, charuco: bool) -> np.ndarray:
+    """The board at ``pose`` as the left or right camera sees it, grey, unstamped; rendered
+    once per pose (the renders are deterministic) and handed out read only."""
+    key = (np.asarray(pose[0], float).tobytes(), np.asarray(pose[1], float).tobytes(), right,
+           charuco)  # fmt: skip
+    if key not in _RENDERS:
         rv, tv = pose
         if right:
             rv = cv2.Rodrigues(RIG_R @ cv2.Rodrigues(rv)[0])[0].ravel()
@@ -1404,7 +1419,9 @@ def _board(
             img = render_chessboard(
                 K, D, rv, tv, pattern=(9, 6), square_size=SQUARE, image_size=BOARD_SIZE
             )
-    return _stamp(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), n)
+        img.setflags(write=False)
+        _RENDERS[key] = img
+    return _RENDERS[key]
 
 
 def _pose(
