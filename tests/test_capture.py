@@ -1685,6 +1685,13 @@ def test_a_second_capture_on_an_ended_source_is_a_source_error(tmp_path: Path) -
         assert len(capture(cam, tmp_path / "c").saved) == 3
 
 
+@pytest.fixture(scope="module")
+def five_still_frames(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str]:
+    """``_still_noisy_sequence(..., 5)``'s patterns, written once for the tests that only read
+    them (the same frames each time: its noise is seeded)."""
+    return _still_noisy_sequence(data_dir, tmp_path_factory.mktemp("still5"), 5)
+
+
 def test_temporal_capture_saves_the_mean_of_still_frames(data_dir: Path, tmp_path: Path) -> None:
     """``temporal=4``: a pair per 4 frames of a still view, each with less noise than one frame
     (Immerkaer's estimate, which the texture raises too: measured 5.74 -> 3.21-3.27 grey
@@ -1708,14 +1715,17 @@ def test_temporal_capture_saves_the_mean_of_still_frames(data_dir: Path, tmp_pat
 
 
 def test_a_temporal_mean_the_source_ends_is_said_unsaved(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path,
+    five_still_frames: tuple[str, str],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     """``--temporal 3`` over 5 still frames saved the mean of the first 3 and dropped the last
     2 frames' mean without a word ("1 pair saved (end of stream); 5 pairs read"); a line says
     it now. 6 frames (two whole means) leave nothing unsaved, and no such line."""
     from stereovision.cli import main
 
-    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "five_frames", 5)
+    lpat, rpat = five_still_frames
     lines: list[str] = []
     with StereoCamera(lpat, rpat) as cam:
         result = capture(cam, tmp_path / "five", temporal=3, log=lines.append)
@@ -1733,12 +1743,12 @@ def test_a_temporal_mean_the_source_ends_is_said_unsaved(
 
 
 def test_a_temporal_mean_the_source_ends_before_the_count_is_said_unsaved(
-    data_dir: Path, tmp_path: Path
+    five_still_frames: tuple[str, str], tmp_path: Path
 ) -> None:
     """``temporal=3, count=4`` over 5 still frames: the end is an error ("1 of 4 pairs were
     saved"), and the last 2 frames' mean was dropped without the line the end without a count
     says (fc77903); it is said before the error."""
-    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "five_frames", 5)
+    lpat, rpat = five_still_frames
     lines: list[str] = []
     with StereoCamera(lpat, rpat) as cam, pytest.raises(SourceError, match="1 of 4 pairs"):
         capture(cam, tmp_path / "five", temporal=3, count=4, log=lines.append)
@@ -1751,13 +1761,16 @@ def test_a_temporal_mean_the_source_ends_before_the_count_is_said_unsaved(
 
 @pytest.mark.parametrize("where", ["read_within", "temporal_average"])
 def test_a_temporal_mean_an_interrupt_cuts_is_said_unsaved(
-    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str
+    five_still_frames: tuple[str, str],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    where: str,
 ) -> None:
     """Ctrl-C while ``temporal=2`` awaits its 4th frame (``read_within``), or averages it
     (``temporal_average``, after 3cc84f4f): the pair of frames 1-2 is saved, frame 3's
     unfinished mean was dropped without a word; a line says so before the interrupt goes on
     (the CLI then says the pairs kept)."""
-    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "still", 5)
+    lpat, rpat = five_still_frames
     real = getattr(capmod, where)
     calls = []
 
