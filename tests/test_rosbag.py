@@ -32,6 +32,19 @@ def kitti_filled(data_dir: Path) -> sv.DepthResult:
     return sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
 
 
+@pytest.fixture(scope="module")
+def kitti_floor(kitti_filled: sv.DepthResult) -> tuple[Any, Any]:
+    """``kitti_filled``'s floor (:func:`fit_ground_plane`, seeded: the same plane each time) and
+    the :func:`laser_scan` of its filled point image over it, found once for the tests that
+    only read them (1.2 s a test)."""
+    from stereovision.ground import fit_ground_plane, laser_scan
+
+    res = kitti_filled
+    plane = fit_ground_plane(res.disparity, res.calibration)
+    assert plane is not None
+    return plane, laser_scan(res.point_image(filled=True), plane, res.calibration)
+
+
 def _read(path: Path) -> dict[str, list]:
     from rosbags.rosbag2 import Reader
     from rosbags.typesys import Stores, get_typestore
@@ -665,7 +678,7 @@ def test_bag_of_a_rig_with_doffs_and_its_own_right_camera(data_dir: Path, tmp_pa
 
 
 def test_bag_fields_of_a_filled_map_and_its_floor_scan(
-    kitti_filled: sv.DepthResult, tmp_path: Path
+    kitti_filled: sv.DepthResult, kitti_floor: tuple[Any, Any], tmp_path: Path
 ) -> None:
     """Second mutation audit, on the default (filled) map written with a ``ground`` as
     ``stream --bag`` does: the scan is stamped as the frame (to the ns) and carries the
@@ -675,13 +688,11 @@ def test_bag_fields_of_a_filled_map_and_its_floor_scan(
     without its calibration is refused (not rosbags' or numpy's error part-way)."""
     import dataclasses
 
-    from stereovision.ground import fit_ground_plane, laser_scan
+    from stereovision.ground import laser_scan
     from stereovision.rosbag import BagWriter
 
     res = kitti_filled
-    plane = fit_ground_plane(res.disparity, res.calibration)
-    assert plane is not None
-    want = laser_scan(res.point_image(filled=True), plane, res.calibration)
+    plane, want = kitti_floor
     lean = laser_scan(res.point_image(filled=False), plane, res.calibration)
     assert not np.array_equal(want.ranges, lean.ranges)  # the filled pixels count
     stamp = 1_700_000_000_123_456_789
@@ -784,7 +795,7 @@ def test_the_disparity_focal_length_is_fx_for_non_square_pixels(
 
 
 def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
-    kitti_filled: sv.DepthResult, tmp_path: Path
+    kitti_filled: sv.DepthResult, kitti_floor: tuple[Any, Any], tmp_path: Path
 ) -> None:
     """REP 105: the scan is in the floor frame (``base_footprint``), the images and cloud in the
     camera's optical frame; without a transform between the two (the bag had none), RViz and a
@@ -795,16 +806,13 @@ def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
     an obstacle point at its beam's angle and range. A scan given without a floor has none."""
     from scipy.spatial.transform import Rotation
 
-    from stereovision.ground import fit_ground_plane, laser_scan
     from stereovision.rosbag import BagWriter
 
     res = kitti_filled
-    plane = fit_ground_plane(res.disparity, res.calibration)
-    assert plane is not None
+    plane, scan = kitti_floor
     stamp = 1_700_000_000_123_456_789
     with BagWriter(tmp_path / "run", points=False) as bag:
         bag.write(res, stamp, ground=plane)
-        scan = laser_scan(res.point_image(filled=True), plane, res.calibration)
         bag.write(res, stamp + 1, scan=scan)
     topics = _read(tmp_path / "run")
     ((recorded, tf),) = topics["/tf"]  # absolute (tf's topic), once: the frame with a floor
