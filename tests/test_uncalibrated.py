@@ -499,6 +499,16 @@ def test_rectify_points_refuses_other_layouts() -> None:
         rect.rectify_points(np.column_stack([pts, np.ones(3)]))
 
 
+@pytest.fixture(scope="module")
+def books_rectification_json(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> str:
+    """OpenCV's books pair rectified once for the module and saved: the JSON text of a good
+    rectification file, which a test damages a field of (only read, never changed)."""
+    books = data_dir / "opencv_uncalibrated" / "books"
+    left, right = (cv2.imread(str(books / f"{s}.jpg")) for s in ("left", "right"))
+    good = rectify_uncalibrated(left, right).save(tmp_path_factory.mktemp("books") / "good.json")
+    return good.read_text()
+
+
 @pytest.mark.parametrize(
     ("field", "value", "message"),
     [
@@ -517,28 +527,34 @@ def test_rectify_points_refuses_other_layouts() -> None:
     ],
 )
 def test_a_damaged_rectification_file_is_refused(
-    data_dir: Path, tmp_path: Path, field: str, value: object, message: str
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    books_rectification_json: str,
+    field: str,
+    value: object,
+    message: str,
 ) -> None:
     """A file whose homographies are NaN or singular, or whose sizes are 0 or less, was read
     without a word: ``depth --rectification`` warped the pair to black and wrote its disparity
     map (exit 0). Now the file and what is wrong with it are named, and the CLI exits 1."""
+    from stereovision.cli import main
+
     books = data_dir / "opencv_uncalibrated" / "books"
-    left, right = (cv2.imread(str(books / f"{s}.jpg")) for s in ("left", "right"))
-    good = rectify_uncalibrated(left, right).save(tmp_path / "good.json")
-    data = json.loads(good.read_text())
+    data = json.loads(books_rectification_json)
     data[field] = value
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(data))
     expected = f"usable uncalibrated rectification: {re.escape(message)}"
     with pytest.raises(ValueError, match=expected):
         UncalibratedRectification.load(bad)
-    run = subprocess.run(
-        [sys.executable, "-m", "stereovision.cli", "depth", str(books / "left.jpg"),
-         str(books / "right.jpg"), "--rectification", str(bad), "-o", str(tmp_path / "out")],
-        capture_output=True, text=True,
-    )  # fmt: skip
-    assert run.returncode != 0 and "Traceback" not in run.stderr
-    assert message in run.stderr and not (tmp_path / "out" / "disparity.pfm").exists()
+    capsys.readouterr()
+    # in process: main returns the exit status (an exception escaping it fails the test)
+    status = main(["depth", str(books / "left.jpg"), str(books / "right.jpg"),
+                   "--rectification", str(bad), "-o", str(tmp_path / "out")])  # fmt: skip
+    err = capsys.readouterr().err
+    assert status != 0 and "Traceback" not in err
+    assert message in err and not (tmp_path / "out" / "disparity.pfm").exists()
 
 
 def test_cli_rectify_books_one_verdict(
