@@ -458,11 +458,14 @@ def test_a_folding_homography_is_refused(data_dir: Path, monkeypatch: pytest.Mon
     ("name", "share"),
     [("middlebury2003/cones", 0), ("kitti2015/000005_10", 0), ("eth3d/playground", 3)],
 )
-def test_left_and_right_swapped_are_named(data_dir: Path, name: str, share: int) -> None:
+def test_left_and_right_swapped_are_named(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, name: str, share: int
+) -> None:
     """A pair given the wrong way round rectified without complaint, its disparities inverted
     (the near scene shifted least): refused, with the share of matches a left image's would
     have (measured swapped: cones 0 %, KITTI 0 %, ETH3D playground 3 %; the right order 100,
     100 and 97 %)."""
+    _features_once(monkeypatch)  # the swapped pair's images are the same two: SIFT once each
     sc = load_scene(data_dir / name)
     assert rectify_uncalibrated(sc.left, sc.right).model == "quasi-euclidean"
     with pytest.raises(ValueError, match=rf"left and right look swapped: {share} % of the \d+"):
@@ -562,7 +565,10 @@ def test_a_damaged_rectification_file_is_refused(
 
 
 def test_cli_rectify_books_one_verdict(
-    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """OpenCV's hand-held books pair: the report said the rows agree to 0.25 px over 91 matches,
     then "rectification: cannot tell, 18 consistent feature matches" (SIFT run anew on the
@@ -571,6 +577,7 @@ def test_cli_rectify_books_one_verdict(
     one verdict, its counts said."""
     from stereovision.cli import main
 
+    _features_once(monkeypatch)  # the CLI's rectify and check find the same SIFT matches again
     books = data_dir / "opencv_uncalibrated" / "books"
     left, right = cv2.imread(str(books / "left.jpg")), cv2.imread(str(books / "right.jpg"))
     rect = rectify_uncalibrated(left, right)
