@@ -221,7 +221,7 @@ def test_refine_refuses_what_is_not_a_drift(data_dir: Path) -> None:
 
 
 def test_cli_check_fix(data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from stereovision.cli import main  # in-process but for the refusals' exit 2 and words
+    from stereovision.cli import main  # in process: main returns the exit status, 2 a refusal
 
     cones = data_dir / "middlebury2003" / "cones"
     img = cv2.imread(str(cones / "left.png"))
@@ -237,19 +237,14 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFix
     assert "rectification ok" in lines[1] and lines[2].endswith(str(fixed))
     code = main(["check", *pair, "--calib", str(fixed)])
     assert code == 0 and capsys.readouterr().out.startswith("rectification ok")
-    run = subprocess.run(
-        [*SV, "check", *pair, "--fix", str(tmp_path / "x.yaml")],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert run.returncode == 2 and "--fix needs --calib" in run.stderr
+    code = main(["check", *pair, "--fix", str(tmp_path / "x.yaml")])
+    assert code == 2 and "--fix needs --calib" in capsys.readouterr().err
     # --fix naming the calibration it corrects replaced the original: refused, the file kept
     before = bumped.read_bytes()
-    run = subprocess.run([*SV, "check", *pair, "--calib", str(bumped), "--fix", str(bumped)],
-                         capture_output=True, text=True, timeout=120)  # fmt: skip
-    assert run.returncode == 2 and run.stdout == ""
-    assert run.stderr == (
+    code = main(["check", *pair, "--calib", str(bumped), "--fix", str(bumped)])
+    said = capsys.readouterr()
+    assert code == 2 and said.out == ""
+    assert said.err == (
         f"stereovision: error: --fix {bumped}: is the calibration ({bumped}); give another "
         "file name\n"
     )
