@@ -3281,7 +3281,7 @@ def test_save_all_or_nothing_names_a_folder_with_a_control_character_not_its_sta
 
 
 def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
-    tmp_path, monkeypatch
+    tmp_path, tmp_path_factory, monkeypatch
 ):
     """Save wrote its files one by one into the folder: a writer that failed midway (disk full)
     left a partial set there. A Save is now all or nothing: written into a staging folder and
@@ -3289,14 +3289,24 @@ def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     was), no staging folder behind, and the Save's line names the file that failed.
 
     Its 27 Saves are of one pair from one pose: the 3-D view is rendered once (the first Save)
-    and that image handed to the others, which write it as render.png all the same."""
+    and that image handed to the others, which write it as render.png all the same. The pair is
+    the middle quarter of the demo's cones (225 x 188, its calibration's principal point moved
+    with the crop): every file a Save writes, at a quarter of the pixels to write."""
 
     from stereovision.gui import bundled_data_dir
     from stereovision.gui.app import SAVE_WRITE_ORDER, SAVED_DEPTH_FILES, SAVED_FILES
 
     assert sorted(SAVE_WRITE_ORDER) == sorted(SAVED_FILES + SAVED_DEPTH_FILES)
-    app = _scene_app("test-save-all-or-nothing", [bundled_data_dir(), tmp_path])
-    app._load_scene(bundled_data_dir() / "cones")
+    scene = tmp_path_factory.mktemp("quarter-cones")
+    for side in ("left", "right"):
+        image = cv2.imread(str(bundled_data_dir() / "cones" / f"{side}.png"))
+        assert cv2.imwrite(str(scene / f"{side}.png"), image[94:282, 112:337])
+    (scene / "calib.txt").write_text(
+        "cam0=[700 0 113; 0 700 93; 0 0 1]\ncam1=[700 0 113; 0 700 93; 0 0 1]\ndoffs=0\n"
+        "baseline=160\nwidth=225\nheight=188\nndisp=64\n"
+    )
+    app = _scene_app("test-save-all-or-nothing", [tmp_path, scene])
+    app._load_scene(scene)
     _run(app, app.recompute)
     render, rendered = app._render_for_save, []
 
