@@ -23,11 +23,12 @@ SV = [sys.executable, "-m", "stereovision.cli"]
 CONES = Path(str(resources.files("stereovision") / "data" / "cones"))  # the bundled scene
 
 
-def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
+def test_demo_writes_outputs_and_prints_figures(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "demo"
-    proc = subprocess.run(
-        [*SV, "demo", "-o", str(out)], capture_output=True, text=True, check=False
-    )
+    rc = main(["demo", "-o", str(out)])  # in process: a new Python costs ~1.2 s CPU
+    proc = subprocess.CompletedProcess([], rc, *capsys.readouterr())
     assert proc.returncode == 0, proc.stderr
     assert "bad-2.0" in proc.stdout and "density" in proc.stdout
     assert "  rectification ok: median |dy| 0.0" in proc.stdout  # 0.09 px
@@ -226,7 +227,9 @@ def test_depth_coverage_of_a_map_without_any_disparity_says_so() -> None:
     )
 
 
-def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: Path) -> None:
+def test_errors_are_one_line_and_keep_earlier_outputs(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "o"
     out.mkdir()
     keep = out / "disparity.png"
@@ -252,8 +255,8 @@ def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: 
         ],
         ["eval", str(tmp_path / "nowhere")],
     ]
-    for argv in cases:
-        proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+    for argv in cases:  # in process (main returns the exit status): ~1.2 s CPU less a case
+        proc = subprocess.CompletedProcess(argv, main(argv), *capsys.readouterr())
         assert proc.returncode == 2, (argv, proc.stdout, proc.stderr)
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("stereovision: error:"), proc.stderr
@@ -1139,7 +1142,9 @@ def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir:
     assert "<<" not in proc.stderr and "astype" not in proc.stderr, proc.stderr
 
 
-def test_eval_treats_a_gt_without_known_pixels_as_no_gt(data_dir: Path, tmp_path: Path) -> None:
+def test_eval_treats_a_gt_without_known_pixels_as_no_gt(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A gt_disp.pfm that is all +inf (unknown) was evaluated: every figure NaN, printed as
     ``NaN`` in the --json line (not JSON) and as ``nan`` in the table's mean; exit 0."""
     import json
@@ -1154,14 +1159,15 @@ def test_eval_treats_a_gt_without_known_pixels_as_no_gt(data_dir: Path, tmp_path
     gt = read_pfm(blank / "gt_disp.pfm")
     write_pfm(blank / "gt_disp.pfm", np.full_like(gt, np.inf))
     argv = ["eval", "--json", "--no-opencv", "--method", "fast"]
-    proc = subprocess.run([*SV, *argv, str(tmp_path)], capture_output=True, text=True, check=False)
+    # in process (main returns the exit status): a new Python each costs ~1.2 s CPU
+    proc = subprocess.CompletedProcess(argv, main([*argv, str(tmp_path)]), *capsys.readouterr())
     assert proc.returncode == 0, proc.stderr
     rows = [json.loads(ln, parse_constant=_no_constant) for ln in proc.stdout.splitlines()]
     assert [Path(r["scene"]).name for r in rows] == ["a_tsukuba"]
     assert proc.stderr.strip() == (
         f"skipped {blank}: no ground truth: gt_disp.pfm has no known (finite) pixel"
     )
-    alone = subprocess.run([*SV, *argv, str(blank)], capture_output=True, text=True, check=False)
+    alone = subprocess.CompletedProcess(argv, main([*argv, str(blank)]), *capsys.readouterr())
     assert alone.returncode == 2 and alone.stdout == "", alone.stdout
     assert alone.stderr.strip() == (
         f"stereovision: error: {blank}: no ground truth: gt_disp.pfm has no known (finite) "
