@@ -23,6 +23,16 @@ SV = [sys.executable, "-m", "stereovision.cli"]
 CONES = Path(str(resources.files("stereovision") / "data" / "cones"))  # the bundled scene
 
 
+def _in_process(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> subprocess.CompletedProcess[str]:
+    """``stereovision *argv`` run by cli.main in this Python, as subprocess.run would report it
+    (main returns the exit status): a new Python costs ~1.2 s CPU of imports."""
+    capsys.readouterr()
+    rc = main(argv)
+    return subprocess.CompletedProcess(argv, rc, *capsys.readouterr())
+
+
 def test_demo_writes_outputs_and_prints_figures(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -264,15 +274,10 @@ def test_errors_are_one_line_and_keep_earlier_outputs(
     assert keep.read_bytes() == b"earlier result"
 
 
-def test_eval_json_one_object_per_scene(data_dir: Path) -> None:
+def test_eval_json_one_object_per_scene(data_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     import json
 
-    proc = subprocess.run(
-        [*SV, "eval", str(data_dir / "middlebury2001" / "tsukuba"), "--json"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    proc = _in_process(["eval", str(data_dir / "middlebury2001" / "tsukuba"), "--json"], capsys)
     assert proc.returncode == 0, proc.stderr
     rows = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
     assert len(rows) == 1
@@ -302,7 +307,9 @@ def test_eval_mean_line_has_every_column(
     assert float(m[2]) < sgbm_fill  # ours after the fill beats SGBM-3WAY + fill on tsukuba (3.3)
 
 
-def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> None:
+def test_eval_goes_on_past_a_damaged_scene(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """One undecodable scene among several is reported in one line and the rest evaluated;
     the exit status is 1 (as batch's for a failed pair). Alone it is the usual error."""
     import json
@@ -313,10 +320,7 @@ def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> No
     bad = tmp_path / "b_broken"
     shutil.copytree(good, bad)
     (bad / "left.png").write_bytes(b"not a png")
-    proc = subprocess.run(
-        [*SV, "eval", str(tmp_path), "--json", "--no-opencv"],
-        capture_output=True, text=True, check=False,
-    )  # fmt: skip
+    proc = _in_process(["eval", str(tmp_path), "--json", "--no-opencv"], capsys)
     assert proc.returncode == 1, proc.stderr
     rows = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
     assert [Path(r["scene"]).name for r in rows] == ["a_tsukuba"]
@@ -324,19 +328,17 @@ def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> No
     err = proc.stderr.strip().splitlines()
     assert len(err) == 2 and err[0].startswith(f"failed {bad}: ") and "left.png" in err[0]
     assert err[1] == "stereovision: 1 of 2 scenes failed (above)"
-    alone = subprocess.run([*SV, "eval", str(bad)], capture_output=True, text=True, check=False)
+    alone = _in_process(["eval", str(bad)], capsys)
     assert alone.returncode == 2 and alone.stderr.count("\n") == 1 and "left.png" in alone.stderr
 
 
 def test_depth_refuses_an_output_under_a_file_before_matching(
-    data_dir: Path, tmp_path: Path
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     img = str(data_dir / "middlebury2001" / "tsukuba" / "left.png")
     (tmp_path / "a.txt").write_text("x")
-    proc = subprocess.run(
-        [*SV, "depth", img, img.replace("left", "right"), "-o", str(tmp_path / "a.txt" / "out")],
-        capture_output=True, text=True, check=False,
-    )  # fmt: skip
+    argv = ["depth", img, img.replace("left", "right"), "-o", str(tmp_path / "a.txt" / "out")]
+    proc = _in_process(argv, capsys)
     assert proc.returncode == 2 and proc.stdout == ""  # no matcher line: it never ran
     assert proc.stderr.strip().endswith("a.txt is a file, not a folder")
 
@@ -1266,7 +1268,9 @@ def test_json_line_writes_arrays_paths_and_numpy_keys_nested() -> None:
     assert json_ready(np.array([[1, 2]]).T) == [[1], [2]]
 
 
-def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) -> None:
+def test_eval_with_no_scene_to_evaluate_fails(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Two scenes without ground truth: both skipped, nothing evaluated, and the exit status
     was 0 (an empty table)."""
     for name in ("a", "b"):
@@ -1274,7 +1278,7 @@ def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) ->
         for side in ("left", "right"):
             src = data_dir / "stereopi_rig" / "scene_photo" / f"{side}.png"
             (tmp_path / name / f"{side}.png").write_bytes(src.read_bytes())
-    proc = subprocess.run([*SV, "eval", str(tmp_path)], capture_output=True, text=True, check=False)
+    proc = _in_process(["eval", str(tmp_path)], capsys)
     assert proc.returncode == 2, proc.stderr
     err = proc.stderr.strip().splitlines()
     assert err[:2] == [f"skipped {tmp_path / n}: no ground truth (gt_disp.pfm)" for n in "ab"]
@@ -1463,16 +1467,15 @@ def test_rectify_writes_a_rectified_pair_as_given(
     )
 
 
-def test_eval_counts_a_scene_given_twice_once(data_dir: Path) -> None:
+def test_eval_counts_a_scene_given_twice_once(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`eval middlebury2001 middlebury2001/tsukuba` evaluated tsukuba twice, and the mean
     line counted it twice (2.5 % for fast instead of the two scenes' 2.0 %)."""
     import json
 
     both = [str(data_dir / "middlebury2001"), str(data_dir / "middlebury2001" / "tsukuba")]
-    proc = subprocess.run(
-        [*SV, "eval", *both, "--json", "--no-opencv", "--method", "fast"],
-        capture_output=True, text=True, check=False,
-    )  # fmt: skip
+    proc = _in_process(["eval", *both, "--json", "--no-opencv", "--method", "fast"], capsys)
     assert proc.returncode == 0, proc.stderr
     rows = [json.loads(line) for line in proc.stdout.splitlines()]
     assert [r["scene"] for r in rows] == ["middlebury2001/tsukuba", "middlebury2001/venus"]
@@ -1501,7 +1504,9 @@ def test_eval_says_which_folders_it_skipped_and_skips_hidden_ones(
     )
 
 
-def test_rectify_refuses_to_overwrite_its_input_images(data_dir: Path, tmp_path: Path) -> None:
+def test_rectify_refuses_to_overwrite_its_input_images(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`rectify rect/left_rect.png rect/right_rect.png -o rect` wrote its outputs over the
     images it was given, without a word."""
     scene = data_dir / "stereopi_rig" / "scene_photo"
@@ -1511,9 +1516,7 @@ def test_rectify_refuses_to_overwrite_its_input_images(data_dir: Path, tmp_path:
         (rect / f"{side}_rect.png").write_bytes((scene / f"{side}.png").read_bytes())
     before = (rect / "left_rect.png").read_bytes()
     pair = [str(rect / "left_rect.png"), str(rect / "right_rect.png")]
-    proc = subprocess.run(
-        [*SV, "rectify", *pair, "-o", str(rect)], capture_output=True, text=True, check=False
-    )
+    proc = _in_process(["rectify", *pair, "-o", str(rect)], capsys)
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr == (
         f"stereovision: error: -o {rect / 'left_rect.png'}: is the left image "
@@ -1523,10 +1526,12 @@ def test_rectify_refuses_to_overwrite_its_input_images(data_dir: Path, tmp_path:
     assert sorted(p.name for p in rect.iterdir()) == ["left_rect.png", "right_rect.png"]
 
 
-def test_eval_of_an_image_file_says_it_is_a_file(data_dir: Path) -> None:
+def test_eval_of_an_image_file_says_it_is_a_file(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`eval scene/left.png` said 'scene root not found' of a file that exists."""
     img = data_dir / "middlebury2001" / "tsukuba" / "left.png"
-    proc = subprocess.run([*SV, "eval", str(img)], capture_output=True, text=True, check=False)
+    proc = _in_process(["eval", str(img)], capsys)
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr == (
         f"stereovision: error: {img}: is a file; give a scene folder (holding left.png, "
