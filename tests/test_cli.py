@@ -96,11 +96,13 @@ def test_closed_pipe_stops_quietly(tmp_path: Path) -> None:
     assert codes[-1] == 141, codes
 
 
-def test_warnings_are_one_line(tmp_path: Path, data_dir: Path) -> None:
+def test_warnings_are_one_line(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A swapped pair runs, and the CLI says so in one line (not Python's file:line echo)."""
     scene = data_dir / "middlebury2003" / "cones"
     argv = ["depth", str(scene / "right.png"), str(scene / "left.png"), "-o", str(tmp_path)]
-    proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+    proc = _in_process(argv, capsys)  # main sets the one-line warning format itself
     assert proc.returncode == 0, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1, proc.stderr
@@ -359,12 +361,11 @@ def test_depth_reads_16_bit_images_whole(tmp_path: Path, data_dir: Path) -> None
     assert bad2 < 2.5
 
 
-def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path) -> None:
+def test_depth_warns_about_one_image_given_twice(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     img = str(data_dir / "middlebury2001" / "tsukuba" / "left.png")
-    proc = subprocess.run(
-        [*SV, "depth", img, img, "--method", "fast", "-o", str(tmp_path)],
-        capture_output=True, text=True, check=False,
-    )  # fmt: skip
+    proc = _in_process(["depth", img, img, "--method", "fast", "-o", str(tmp_path)], capsys)
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr.splitlines()[0].startswith("stereovision: warning: ")
     assert "are the same image: every disparity comes out 0" in proc.stderr
