@@ -11,6 +11,7 @@ import sys
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -31,6 +32,22 @@ def _in_process(
     capsys.readouterr()
     rc = main(argv)
     return subprocess.CompletedProcess(argv, rc, *capsys.readouterr())
+
+
+@pytest.fixture
+def in_process_dask(monkeypatch: pytest.MonkeyPatch) -> None:
+    """batch's LocalCluster with its worker a thread of this process (as test_batch's fixture
+    of the name), for tests whose point is the command line's words or paths, not Dask's
+    processes: a worker process starts Python, NumPy and OpenCV, about 2 s of CPU a run."""
+    import distributed
+
+    real = distributed.LocalCluster
+
+    def in_process(*args: Any, **kwargs: Any) -> Any:
+        kwargs.pop("env", None)  # a worker process's environment: none to set in process
+        return real(*args, **{**kwargs, "processes": False})
+
+    monkeypatch.setattr(distributed, "LocalCluster", in_process)
 
 
 def test_demo_writes_outputs_and_prints_figures(
@@ -428,6 +445,7 @@ def test_depth_same_image_with_a_calibration_for_another_size_says_only_that(
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.usefixtures("in_process_dask")
 def test_resized_pair_size_error_gives_cli_advice(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -3899,6 +3917,7 @@ def test_a_folder_with_a_newline_is_shown_escaped_in_an_argparse_error(tmp_path:
 
 
 @pytest.mark.parametrize("command", ["depth", "batch", "rectify"])
+@pytest.mark.usefixtures("in_process_dask")
 def test_output_folder_dot_slash_dash_is_a_folder(
     data_dir: Path,
     tmp_path: Path,
