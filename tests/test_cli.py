@@ -1144,7 +1144,9 @@ def test_depth_refuses_a_link_put_under_an_output_name_an_earlier_run_wrote(
     assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
 
 
-def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir: Path) -> None:
+def test_a_12_bit_pair_gets_one_warning_line_per_image(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A 12-bit pair in 16-bit PNGs printed four warning lines, two per image (the 8-bit copy's
     and the grey image's conversions each warned)."""
     src = data_dir / "middlebury2001" / "tsukuba"
@@ -1153,7 +1155,7 @@ def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir:
         cv2.imwrite(str(tmp_path / f"{side}.png"), crop.astype(np.uint16) * 16)
     argv = ["depth", str(tmp_path / "left.png"), str(tmp_path / "right.png")]
     argv += ["-o", str(tmp_path / "out"), "--max-disparity", "16", "--method", "fast"]
-    proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+    proc = _in_process(argv, capsys)
     assert proc.returncode == 0, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert [line.split(":")[2] for line in lines] == [" left", " right"], proc.stderr
@@ -3872,16 +3874,15 @@ def test_output_folder_dash_is_refused_not_made(
     ],
 )
 def test_a_path_with_a_control_character_is_shown_escaped_on_one_line(
-    tmp_path: Path, name: str, shown: str
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    name: str,
+    shown: str,
 ) -> None:
     right = CONES / "right.png"
-    proc = subprocess.run(
-        [*SV, "depth", name, str(right), "-o", str(tmp_path / "d.png")],
-        capture_output=True,
-        text=True,
-        check=False,
-        cwd=tmp_path,
-    )
+    monkeypatch.chdir(tmp_path)
+    proc = _in_process(["depth", name, str(right), "-o", str(tmp_path / "d.png")], capsys)
     assert proc.returncode == 2
     assert proc.stderr == f"stereovision: error: image file not found: {shown}\n"
 
