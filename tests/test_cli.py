@@ -1918,15 +1918,16 @@ def test_json_line_writes_a_non_finite_key_as_a_string() -> None:
     }
 
 
-def test_check_plot_keeps_a_file_it_replaces(data_dir: Path, tmp_path: Path) -> None:
+def test_check_plot_keeps_a_file_it_replaces(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """``--plot`` over an existing file (the user's picture of the same name) replaced it
     without a word; it is copied aside as NAME.previous.png and stderr says so in one line."""
     scene = data_dir / "middlebury2001" / "tsukuba"
     plot = tmp_path / "plot.png"
     plot.write_bytes(b"my picture")
-    run = subprocess.run([*SV, "check", str(scene / "left.png"), str(scene / "right.png"),
-                          "--plot", str(plot)], capture_output=True, text=True,
-                         timeout=120)  # fmt: skip
+    argv = ["check", str(scene / "left.png"), str(scene / "right.png"), "--plot", str(plot)]
+    run = _in_process(argv, capsys)
     assert run.returncode == 0, run.stderr
     kept = tmp_path / "plot.previous.png"
     assert kept.read_bytes() == b"my picture"
