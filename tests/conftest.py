@@ -5,6 +5,7 @@ from __future__ import annotations
 import signal
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -65,3 +66,22 @@ def crop_terrace(
         return dst
 
     return crop
+
+
+@pytest.fixture
+def in_process_dask(monkeypatch: pytest.MonkeyPatch) -> None:
+    """batch's LocalCluster with its worker a thread of this process, for the tests whose point
+    is batch's bookkeeping (skips, redos, summary, errors) or the command line's words and
+    paths, not Dask's processes: started and closed by each run as before, at a sixth of the
+    CPU (a worker process starts Python, NumPy and OpenCV: about 2 s of CPU a run, ~0.3 s in
+    process). Tests of the cluster itself (its
+    workers, signals, memory, what reaches a worker) keep real worker processes."""
+    import distributed
+
+    real = distributed.LocalCluster
+
+    def in_process(*args: Any, **kwargs: Any) -> Any:
+        kwargs.pop("env", None)  # a worker process's environment: none to set in process
+        return real(*args, **{**kwargs, "processes": False})
+
+    monkeypatch.setattr(distributed, "LocalCluster", in_process)

@@ -129,22 +129,6 @@ def _not_ours(out: Path, pair: str, name: str) -> str:
     )
 
 
-@pytest.fixture
-def in_process_dask(monkeypatch: pytest.MonkeyPatch) -> None:
-    """batch's LocalCluster with its worker a thread of this process, for the tests whose point
-    is batch's bookkeeping (skips, redos, summary, errors), not Dask's processes: started and
-    closed by each run as before, at a sixth of the CPU (a worker process starts Python, NumPy
-    and OpenCV: about 2 s of CPU a run, ~0.3 s in process). Tests of the cluster itself (its
-    workers, signals, memory, what reaches a worker) keep real worker processes."""
-    real = distributed.LocalCluster
-
-    def in_process(*args: Any, **kwargs: Any) -> Any:
-        kwargs.pop("env", None)  # a worker process's environment: none to set in process
-        return real(*args, **{**kwargs, "processes": False})
-
-    monkeypatch.setattr(distributed, "LocalCluster", in_process)
-
-
 def test_batch_runs_skips_and_records_failures(
     scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -11,7 +11,6 @@ import sys
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
@@ -32,22 +31,6 @@ def _in_process(
     capsys.readouterr()
     rc = main(argv)
     return subprocess.CompletedProcess(argv, rc, *capsys.readouterr())
-
-
-@pytest.fixture
-def in_process_dask(monkeypatch: pytest.MonkeyPatch) -> None:
-    """batch's LocalCluster with its worker a thread of this process (as test_batch's fixture
-    of the name), for tests whose point is the command line's words or paths, not Dask's
-    processes: a worker process starts Python, NumPy and OpenCV, about 2 s of CPU a run."""
-    import distributed
-
-    real = distributed.LocalCluster
-
-    def in_process(*args: Any, **kwargs: Any) -> Any:
-        kwargs.pop("env", None)  # a worker process's environment: none to set in process
-        return real(*args, **{**kwargs, "processes": False})
-
-    monkeypatch.setattr(distributed, "LocalCluster", in_process)
 
 
 def test_demo_writes_outputs_and_prints_figures(
