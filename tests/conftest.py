@@ -85,3 +85,39 @@ def in_process_dask(monkeypatch: pytest.MonkeyPatch) -> None:
         return real(*args, **{**kwargs, "processes": False})
 
     monkeypatch.setattr(distributed, "LocalCluster", in_process)
+
+
+@pytest.fixture
+def sift_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The rows check's SIFT features and mutual matches (:mod:`stereovision.rectification_check`,
+    used by :mod:`stereovision.uncalibrated` too) found once per image and pair of descriptor
+    sets, by content: pure functions, copies handed out. Each check still fits and judges its
+    pair's matches."""
+    import hashlib
+
+    from stereovision import rectification_check as rc
+    from stereovision import uncalibrated
+
+    def key(*arrays: Any) -> tuple:
+        return tuple((a.shape, a.dtype.str, hashlib.sha1(a.tobytes()).digest()) for a in arrays)
+
+    features, matches = rc._features, rc._mutual_matches
+    found: dict[tuple, Any] = {}
+    matched: dict[tuple, Any] = {}
+
+    def features_once(gray: Any) -> Any:
+        k = key(gray)
+        if k not in found:
+            found[k] = features(gray)
+        pts, desc = found[k]
+        return pts.copy(), None if desc is None else desc.copy()
+
+    def matches_once(da: Any, db: Any) -> Any:
+        k = key(da, db)
+        if k not in matched:
+            matched[k] = matches(da, db)
+        return matched[k].copy()
+
+    for module in (rc, uncalibrated):
+        monkeypatch.setattr(module, "_features", features_once)
+        monkeypatch.setattr(module, "_mutual_matches", matches_once)

@@ -3,10 +3,8 @@ through that calibration, the bag it records and the tools that read it back."""
 
 from __future__ import annotations
 
-import hashlib
 import warnings
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -27,39 +25,6 @@ def _chessboard_rig() -> object:
     d2 = np.array([-0.28925, 0.10495, -0.00054, 0.00024, 0.0])
     rot = cv2.Rodrigues(np.array([0.006627, 0.004007, -0.003493]))[0]
     return Calibration(k1, d1, k2, d2, rot, np.array([-0.08317, 0.000934, -0.000134]), (640, 480))
-
-
-def _features_once(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The rows check's SIFT features and mutual matches (:mod:`stereovision.rectification_check`,
-    used by :mod:`stereovision.uncalibrated` too) found once per image and pair of descriptor
-    sets, by content: pure functions, copies handed out. Each check still fits and judges its
-    pair's matches."""
-    from stereovision import rectification_check as rc
-    from stereovision import uncalibrated
-
-    def key(*arrays: Any) -> tuple:
-        return tuple((a.shape, a.dtype.str, hashlib.sha1(a.tobytes()).digest()) for a in arrays)
-
-    features, matches = rc._features, rc._mutual_matches
-    found: dict[tuple, Any] = {}
-    matched: dict[tuple, Any] = {}
-
-    def features_once(gray: Any) -> Any:
-        k = key(gray)
-        if k not in found:
-            found[k] = features(gray)
-        pts, desc = found[k]
-        return pts.copy(), None if desc is None else desc.copy()
-
-    def matches_once(da: Any, db: Any) -> Any:
-        k = key(da, db)
-        if k not in matched:
-            matched[k] = matches(da, db)
-        return matched[k].copy()
-
-    for module in (rc, uncalibrated):
-        monkeypatch.setattr(module, "_features", features_once)
-        monkeypatch.setattr(module, "_mutual_matches", matches_once)
 
 
 def test_a_rectified_chessboard_is_not_said_unrectified(
@@ -132,6 +97,7 @@ def test_info_lists_the_topics_of_a_bag_without_a_pair(
     assert out == "" and err.count("\n") == 1
 
 
+@pytest.mark.usefixtures("sift_once")  # both depth runs check the same rectified pair's rows
 def test_rectify_with_a_calibration_writes_the_rectified_pair_s(
     data_dir: Path,
     tmp_path: Path,
@@ -144,7 +110,6 @@ def test_rectify_with_a_calibration_writes_the_rectified_pair_s(
     rig was only to be had in Python (`calib.rectified_calibration()`). It writes
     `calib_rect.yaml`, with which depth on the rectified pair is the raw pair's, bit for bit;
     a later run without --calib removes it with the rest of its run's files."""
-    _features_once(monkeypatch)  # both depth runs check the same rectified pair's rows
     rig = _chessboard_rig()
     rig.save(tmp_path / "rig.yaml")  # type: ignore[attr-defined]
     board = data_dir / "chessboard"

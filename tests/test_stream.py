@@ -313,39 +313,8 @@ def test_stream_scales_a_calibration_made_at_another_resolution(
     assert "frames are kept at 640x480" in cap.err and "calibration is for" not in cap.err
 
 
-def _features_once_per_image(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The rectification check's SIFT features and mutual matches found once per image (and
-    pair of descriptor sets), by content: a stream of repeated frames checks them again and
-    again. Each check still fits and judges its pair's matches."""
-    import hashlib
-
-    from stereovision import rectification_check as rc
-
-    def key(*arrays: Any) -> tuple:
-        return tuple((a.shape, a.dtype.str, hashlib.sha1(a.tobytes()).digest()) for a in arrays)
-
-    features, matches = rc._features, rc._mutual_matches
-    found: dict[tuple, Any] = {}
-    matched: dict[tuple, Any] = {}
-
-    def features_once(gray: Any) -> Any:
-        k = key(gray)
-        if k not in found:
-            found[k] = features(gray)
-        pts, desc = found[k]
-        return pts.copy(), None if desc is None else desc.copy()
-
-    def matches_once(da: Any, db: Any) -> Any:
-        k = key(da, db)
-        if k not in matched:
-            matched[k] = matches(da, db)
-        return matched[k].copy()
-
-    monkeypatch.setattr(rc, "_features", features_once)
-    monkeypatch.setattr(rc, "_mutual_matches", matches_once)
-
-
 @SLOW_PIPELINED
+@pytest.mark.usefixtures("sift_once")
 def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
     data_dir: Path,
     tmp_path: Path,
@@ -355,8 +324,7 @@ def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
     """Eight pairs, the right camera 'bumped' 3 px down from pair 4 on; checked every 2nd pair:
     pairs 0 and 2 pass, 4 and 6 fail, and one warning names pair 4 (pipelined and not). The
     frames repeat (two distinct pairs): their features are found once each
-    (:func:`_features_once_per_image`)."""
-    _features_once_per_image(monkeypatch)
+    (the ``sift_once`` fixture)."""
     scene = data_dir / SCENE
     paths = {}
     for side in ("left", "right"):
@@ -524,6 +492,7 @@ def test_stream_no_tf_leaves_the_floor_transform_out_of_the_bag(
 
 
 @SLOW_PIPELINED
+@pytest.mark.usefixtures("sift_once")
 def test_stream_averages_a_still_noisy_rig(
     data_dir: Path,
     tmp_path: Path,
@@ -534,11 +503,10 @@ def test_stream_averages_a_still_noisy_rig(
     the matcher gets the running mean (1, 2, ... 6 frames), its noise down by more than half on
     the last pair; the moving videos above restart on every pair and pass through. Its three
     streams check the same first pair: its features are found once
-    (:func:`_features_once_per_image`)."""
+    (the ``sift_once`` fixture)."""
     from stereovision.temporal import TemporalFilter
     from tests.test_exposure import noisy
 
-    _features_once_per_image(monkeypatch)
     scene = data_dir / SCENE
     rng = np.random.default_rng(0)
     clean = {s: cv2.imread(str(scene / f"{s}.png")) for s in ("left", "right")}
