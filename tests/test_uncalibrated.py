@@ -4,7 +4,6 @@ have is known from the GT), StereoPi's raw pair, OpenCV's hand-held books pair; 
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -12,7 +11,6 @@ import re
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
@@ -46,38 +44,6 @@ def perturbation(size: tuple[int, int], k_cam: np.ndarray | None = None) -> np.n
     rot = cv2.Rodrigues(np.radians([0.3, 0.5, 1.5]))[0]
     out: np.ndarray = longer @ rot @ np.linalg.inv(k_cam)
     return out
-
-
-def _features_once(monkeypatch: pytest.MonkeyPatch) -> None:
-    """:mod:`stereovision.uncalibrated`'s SIFT features and their mutual matches memoised by
-    content, for a test that rectifies or checks one pair many times (each about 0.1 s of CPU):
-    what such a test is about comes after the matches, which are the same every time."""
-    seen: dict[tuple[str, ...], Any] = {}
-
-    def key(name: str, *arrays: np.ndarray) -> tuple[str, ...]:
-        digest = hashlib.sha1()
-        for a in arrays:
-            digest.update(np.ascontiguousarray(a).tobytes())
-        return (name, *(f"{a.shape}{a.dtype.str}" for a in arrays), digest.hexdigest())
-
-    features, matches = uncalibrated._features, uncalibrated._mutual_matches
-
-    def features_once(gray: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        k = key("features", gray)
-        if k not in seen:
-            seen[k] = features(gray)
-        pts, desc = seen[k]
-        return pts.copy(), None if desc is None else desc.copy()
-
-    def matches_once(da: np.ndarray, db: np.ndarray) -> np.ndarray:
-        k = key("matches", da, db)
-        if k not in seen:
-            seen[k] = matches(da, db)
-        pairs: np.ndarray = seen[k].copy()
-        return pairs
-
-    monkeypatch.setattr(uncalibrated, "_features", features_once)
-    monkeypatch.setattr(uncalibrated, "_mutual_matches", matches_once)
 
 
 def expected_disparity(
@@ -458,6 +424,7 @@ def test_a_folding_homography_is_refused(data_dir: Path, monkeypatch: pytest.Mon
     ("name", "share"),
     [("middlebury2003/cones", 0), ("kitti2015/000005_10", 0), ("eth3d/playground", 3)],
 )
+@pytest.mark.usefixtures("sift_once")  # the swapped pair's images are the same two: SIFT once each
 def test_left_and_right_swapped_are_named(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch, name: str, share: int
 ) -> None:
@@ -465,7 +432,6 @@ def test_left_and_right_swapped_are_named(
     (the near scene shifted least): refused, with the share of matches a left image's would
     have (measured swapped: cones 0 %, KITTI 0 %, ETH3D playground 3 %; the right order 100,
     100 and 97 %)."""
-    _features_once(monkeypatch)  # the swapped pair's images are the same two: SIFT once each
     sc = load_scene(data_dir / name)
     assert rectify_uncalibrated(sc.left, sc.right).model == "quasi-euclidean"
     with pytest.raises(ValueError, match=rf"left and right look swapped: {share} % of the \d+"):
@@ -564,6 +530,9 @@ def test_a_damaged_rectification_file_is_refused(
     assert message in err and not (tmp_path / "out" / "disparity.pfm").exists()
 
 
+@pytest.mark.usefixtures(
+    "sift_once"
+)  # the CLI's rectify and check find the same SIFT matches again
 def test_cli_rectify_books_one_verdict(
     data_dir: Path,
     tmp_path: Path,
@@ -577,7 +546,6 @@ def test_cli_rectify_books_one_verdict(
     one verdict, its counts said."""
     from stereovision.cli import main
 
-    _features_once(monkeypatch)  # the CLI's rectify and check find the same SIFT matches again
     books = data_dir / "opencv_uncalibrated" / "books"
     left, right = cv2.imread(str(books / "left.jpg")), cv2.imread(str(books / "right.jpg"))
     rect = rectify_uncalibrated(left, right)
@@ -774,12 +742,12 @@ def test_hartleys_homographies_keep_the_images_upright(
         rectify_uncalibrated(sc.left, sc.right, model="projective")
 
 
+@pytest.mark.usefixtures("sift_once")  # each pair's matches twice, fitted with other options
 def test_options_of_the_fit_are_used(data_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """``ransac_px`` is the fundamental matrix's threshold (cones: 500 matches fit within 0.3 px,
     524 within 1, 537 within 3), ``matches`` counts those that fit, not all SIFT matches; and
     ``model="quasi-euclidean"`` refuses a hand-held pair the turned cameras do not fit (OpenCV's
     books: median residual 2.62 px), which ``"auto"`` rectifies with Hartley's homographies."""
-    _features_once(monkeypatch)  # each pair's matches twice, fitted with other options
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     counts = [rectify_uncalibrated(sc.left, sc.right, ransac_px=p).matches for p in (0.3, 3.0)]
     assert counts[0] + 20 < counts[1]
@@ -791,11 +759,11 @@ def test_options_of_the_fit_are_used(data_dir: Path, monkeypatch: pytest.MonkeyP
         rectify_uncalibrated(left, right, model="quasi-euclidean")
 
 
+@pytest.mark.usefixtures("sift_once")  # cones' matches fitted three times
 def test_ransac_px_takes_numpy_reals(data_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """``ransac_px=np.float32(1.0)`` or ``np.int64(1)`` was refused as "not a positive number
     of pixels" (only Python int and float passed), where check()'s tolerance takes NumPy reals:
     both now fit as 1.0 does; a bool, 0 and NaN are still refused, naming it."""
-    _features_once(monkeypatch)  # cones' matches fitted three times
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     want = rectify_uncalibrated(sc.left, sc.right, ransac_px=1.0)
     for v in (np.float32(1.0), np.int64(1)):
@@ -1356,6 +1324,7 @@ def test_the_coarse_probe_needs_16_rows_16_columns_and_100_disparities(data_dir:
     assert span(flat, flat, (w, h)) is None  # no disparity at all: no percentile to take
 
 
+@pytest.mark.usefixtures("sift_once")  # the 14 checks match cones' raw pair alike
 def test_check_keeps_a_match_only_when_both_its_points_lie_in_the_rectified_pair(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1374,7 +1343,6 @@ def test_check_keeps_a_match_only_when_both_its_points_lie_in_the_rectified_pair
         _mutual_matches,
     )
 
-    _features_once(monkeypatch)  # the 14 checks match cones' raw pair alike
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     w, h = sc.left.shape[1] - 60, sc.left.shape[0] - 50  # the rectified size, not the input's
     gl, gr = (cv2.cvtColor(i, cv2.COLOR_BGR2GRAY) for i in (sc.left, sc.right))
@@ -1495,6 +1463,7 @@ def test_the_coarse_probe_searches_three_spans_below_the_features(
 
 
 @pytest.mark.parametrize("side", ["left", "right"])
+@pytest.mark.usefixtures("sift_once")  # the 8 fits below match cones alike
 def test_an_epipole_on_the_image_border_is_in_the_image(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch, side: str
 ) -> None:
@@ -1503,7 +1472,6 @@ def test_an_epipole_on_the_image_border_is_in_the_image(
     0.01 px inside the image's first or last pixel centres (exactly on them the SVD's rounding
     decides) are refused as seeing it in the image; half a pixel beyond those centres, not as
     such (the other image's epipole at infinity)."""
-    _features_once(monkeypatch)  # the 8 fits below match cones alike
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     h, w = sc.left.shape[:2]
     fundamental = cv2.findFundamentalMat
@@ -1905,6 +1873,7 @@ def _small_cones(data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
     return left, right
 
 
+@pytest.mark.usefixtures("sift_once")  # check() matches the pair rectify_uncalibrated matched
 def test_a_pair_taken_at_different_exposures_is_rectified_from_its_features(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1914,7 +1883,6 @@ def test_a_pair_taken_at_different_exposures_is_rectified_from_its_features(
     something textured". The darker view is brought to the other's level for the features (530
     matches); check() reads the pair alike. Pairs of one exposure (at most 1.08 apart measured
     on the real pairs) are given to SIFT as they are."""
-    _features_once(monkeypatch)  # check() matches the pair rectify_uncalibrated matched
     left, right = _small_cones(data_dir)
     dark = right // 4
     rect = rectify_uncalibrated(left, dark, model="projective")  # the features are the point
