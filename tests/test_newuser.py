@@ -672,31 +672,17 @@ def _chessboard_pairs(n: int) -> tuple[list[Path], list[Path]]:
     return [folder / f"left{i}.jpg" for i in ids], [folder / f"right{i}.jpg" for i in ids]
 
 
-_CORNERS: dict[tuple[str, tuple[int, ...], str, tuple[int, int]], object] = {}
-
-
 @pytest.fixture
 def cached_corners() -> Iterator[None]:
-    """``calibrate.find_corners`` memoised by image content and pattern for the tests of
-    progress: the same six pairs are searched once in this file, not once per calibration
+    """``calibrate.find_corners`` memoised by image content and pattern (test_calibrate's cache)
+    for the tests of progress: the same six pairs are searched once, not once per calibration
     (0.7 s a board; what these tests read is the progress, not the search). Its own
     MonkeyPatch: a test's ``monkeypatch.undo()`` (of its stderr) leaves it in place."""
-    import hashlib
-
     from stereovision import calibrate as calmod
-
-    find = calmod.find_corners
-
-    def cached(image: object, pattern: tuple[int, int] = (9, 6)) -> object:
-        arr = np.ascontiguousarray(image)
-        key = (hashlib.sha1(arr.tobytes()).hexdigest(), arr.shape, arr.dtype.str, tuple(pattern))
-        if key not in _CORNERS:
-            _CORNERS[key] = find(arr, pattern)
-        hit = _CORNERS[key]
-        return None if hit is None else np.array(hit, copy=True)
+    from tests.test_calibrate import _cached_find_corners
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(calmod, "find_corners", cached)
+        mp.setattr(calmod, "find_corners", _cached_find_corners)
         yield
 
 
