@@ -43,7 +43,8 @@ UNDISTORT_TOL = 1e-12
 #: corners of a wide lens the iteration creeps: a StereoPi rig's 320x240 camera (k1 0.53, k2
 #: -3.09, k3 4.93) had 3.1 % of its pixels flagged at 100 rounds, 1.2 % at 1000 (all within
 #: 34 px of a corner: those cycle, and OpenCV's solver takes them over). Points that converge
-#: stop where they did; only the others go on.
+#: stop where they did, a point back on its iterate of two rounds before stops there (the
+#: rounds after would repeat it); only the others go on.
 UNDISTORT_MAX_ITER = 1000
 #: Rays whose squared sine of their angle is below this are treated as parallel (angle below
 #: 1e-6 rad: at a 0.1 m baseline that is beyond 100 km).
@@ -138,8 +139,9 @@ def undistort_normalized(
     rational terms ``k4..k6``, tangential ``p1, p2``, thin prism ``s1..s4``) by the fixed-point
     iteration ``x <- (x_d - delta(x)) / radial(x)`` started at ``x = x_d``, stopping when the
     update is below ``tol``. A point the iteration does not settle on within ``max_iter``
-    rounds (near a wide lens' corners it can cycle around the preimage) gets
-    ``cv2.undistortPoints``' solution when the model maps that back within ``tol`` of it.
+    rounds, or that comes back to its iterate of two rounds before (near a wide lens' corners
+    it can 2-cycle around the preimage, for ever), gets ``cv2.undistortPoints``' solution when
+    the model maps that back within ``tol`` of it.
 
     Parameters
     ----------
@@ -215,6 +217,10 @@ def undistort_normalized(
     # points with a few creeping near a corner went through all N every round)
     idx = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
     xa, ya, xda, yda = x[idx], y[idx], xd[idx], yd[idx]
+    # each point's iterate of the round before (none yet): a point back where it was two rounds
+    # ago repeats that 2-cycle for ever, never converging (the StereoPi corners within 21 to 95
+    # rounds), and ran all max_iter rounds before OpenCV's solution below took it over
+    xp, yp = np.full_like(xa, np.nan), np.full_like(ya, np.nan)
     with np.errstate(all="ignore"):
         for _ in range(max_iter):
             if not idx.size:
@@ -230,7 +236,9 @@ def undistort_normalized(
             x[idx], y[idx] = xn, yn
             done = step < tol
             converged[idx[done]] = True
-            going = ~(done | ~np.isfinite(step))
+            cycling = (xn == xp) & (yn == yp)
+            going = ~(done | ~np.isfinite(step) | cycling)
+            xp, yp = xa[going], ya[going]
             idx, xa, ya, xda, yda = idx[going], xn[going], yn[going], xda[going], yda[going]
         # Near a wide lens' corners the fixed point can repel: the iteration 2-cycles (a step of
         # 0.3 for ever) where the model has a preimage, 1.2 % of a StereoPi camera's pixels
