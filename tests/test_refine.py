@@ -632,6 +632,18 @@ def test_min_disparity_defaults_to_zero_a_confidence_of_one_is_read_and_3d_is_na
         (((True, 0.3),), "fill sigma must be a number, got True"),
         (((16.0, False),), "fill min_score must be a number, got False"),
         ((("16", "0.3"),), "fill sigma must be a number, got '16'"),
+        # bytes and a dict unpack as two numbers: b"\x10\x00" was taken as (16, 0), refused by
+        # the kernel in these words
+        (
+            [b"\x10\x00"],
+            "invalid parameter `fills`: element 0 (b'\\x10\\x00'): expected a (sigma, min_score) "
+            "pair",
+        ),
+        (
+            [(16.0, 0.3), {0: 16, 1: 0.3}],
+            "invalid parameter `fills`: element 1 ({0: 16, 1: 0.3}): expected a (sigma, "
+            "min_score) pair",
+        ),
     ],
 )
 def test_fills_entries_are_numbers_as_every_other_parameter(fills: object, said: str) -> None:

@@ -299,7 +299,24 @@ def _refine(
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:
-        pairs = [(s, m) for s, m in fills_raw]  # type: ignore[attr-defined]
+        items = list(fills_raw)  # type: ignore[call-overload]
+    except TypeError as exc:
+        raise ValueError(
+            f"fills must be a sequence of (sigma, min_score), got {fills_raw!r}"
+        ) from exc
+    for pos, item in enumerate(items):
+        # text, bytes and a dict unpack as two values but are no pair: b"\x10\x00" was read
+        # as (16, 0) where the kernel refuses it; in the kernel's words (a text or bytes
+        # `fills` itself is no sequence of pairs, said below)
+        if isinstance(item, (str, bytes, bytearray, dict)) and not isinstance(
+            fills_raw, (str, bytes, bytearray)
+        ):
+            raise ValueError(
+                f"invalid parameter `fills`: element {pos} ({item!r}): expected a (sigma, "
+                "min_score) pair"
+            )
+    try:
+        pairs = [(s, m) for s, m in items]
     except (TypeError, ValueError) as exc:
         raise ValueError(
             f"fills must be a sequence of (sigma, min_score), got {fills_raw!r}"
