@@ -677,6 +677,25 @@ def test_a_range_read_from_an_array_is_its_number() -> None:
     np.testing.assert_array_equal(got.confidence, base.confidence)
 
 
+@pytest.mark.parametrize(
+    ("name", "fill"),
+    [("left", "value"), ("right", "value"), ("disparity", "np.nan"), ("confidence", "value")],
+)
+def test_a_masked_array_is_refused_as_depth_from_disparity_refuses_it(name: str, fill: str) -> None:
+    """np.asarray read a numpy.ma array's data: a masked disparity's values were refined as
+    measured ones (masked 99 px beside 3 px), a masked image's pixels as the image's. Refused
+    as depth_from_disparity refuses a masked map, saying what to pass."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    args: dict[str, object] = {"left": a, "right": a, "disparity": a, "confidence": np.ones_like(a)}
+    args[name] = np.ma.masked_array(args[name], mask=np.eye(20, 30, dtype=bool))
+    with pytest.raises(ValueError) as err:
+        refine_disparity(**args, max_disparity=8)  # type: ignore[arg-type]
+    assert str(err.value) == (
+        f"{name}: a masked array (numpy.ma) with 20 masked pixels, whose values would be read "
+        f"as real ones; pass {name}.filled({fill})"
+    )
+
+
 @pytest.mark.parametrize("name", ["left", "right", "disparity", "confidence"])
 def test_a_complex_array_is_named_not_cast_to_its_real_part(name: str) -> None:
     """A complex image, map or confidence was cast to float32 with only NumPy's ComplexWarning:

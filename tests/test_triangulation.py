@@ -763,6 +763,22 @@ def test_a_map_of_three_dimensions_or_another_calibration_is_refused() -> None:
         triangulate(np.zeros((3, 2)), np.zeros((3, 2)), {})  # type: ignore[arg-type]
 
 
+def test_a_masked_map_is_refused_naming_its_masked_pixels() -> None:
+    """np.asarray read a numpy.ma map's data: its masked pixels' values came out as depths and
+    points (a masked 10 px gave 8.4 m). A map with masked pixels is refused, saying what to
+    pass; one with a mask of nothing gives the plain map's depths."""
+    c = rect_calib()
+    d = np.ma.masked_array(np.full((2, 3), 10.0), mask=[[True, False, False], [False, False, True]])
+    for call in (depth_from_disparity, reproject):
+        with pytest.raises(ValueError) as err:
+            call(d, c)
+        assert str(err.value) == (
+            "disparity: a masked array (numpy.ma) with 2 masked pixels, whose values would be "
+            "read as real ones; pass disparity.filled(np.nan)"
+        )
+        np.testing.assert_array_equal(call(np.ma.masked_array(d.data), c), call(d.data, c))
+
+
 @pytest.mark.parametrize("call", ["triangulate", "depth", "reproject"])
 def test_an_unknown_unit_is_named(call: str) -> None:
     """'km' (not among the units) was untested on these three: a mutant letting it through

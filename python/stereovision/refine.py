@@ -112,6 +112,10 @@ _LOW_UINT16_EFFECT = ", its contrast then below the refinement's var_floor"
 
 
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
+    from stereovision.triangulation import _refuse_masked
+
+    # the masked pixels' values were refined as measured ones (depth_from_disparity's rule)
+    _refuse_masked(a, name, "np.nan" if name == "disparity" else "value")
     if name in ("left", "right"):
         # "left must be real numbers, got dtype object" (a path: "<U8") of cv2.imread's None
         refuse_no_image(a, name)
@@ -225,8 +229,9 @@ def refine_disparity(
         An image that is None (``cv2.imread``'s answer for a file it cannot read) or a path,
         shapes differ, an array is not real (complex), an image is empty, not finite or has
         values outside ``[0, 1]``, a confidence is NaN or outside ``[0, 1]`` where the disparity
-        has a value, a parameter is unknown, no number (a bool, a string) or out of range,
-        ``fill_plane`` not a bool.
+        has a value, an array is a :mod:`numpy.ma` one with masked pixels (pass
+        ``disparity.filled(np.nan)``: NaN is no estimate), a parameter is unknown, no number (a
+        bool, a string) or out of range, ``fill_plane`` not a bool.
     """
     return _refine(
         left,
