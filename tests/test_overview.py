@@ -470,8 +470,15 @@ def test_the_depth_caption_names_the_limits_and_no_fill_it_did_not_make(terrace_
     near = res.filtered(max_depth=float(np.nanmedian(res.depth)))
     share = 100 * float(np.isfinite(near.depth).mean())
     assert share < 60.0
+    # the 16 measured pixels without a depth before the cut are told from the 138,464 it cut
     assert overview_image(near, "terrace").captions["depth"] == (
-        f"depth (m) on {share:.1f} %, none where filled or beyond the limits"
+        f"depth (m) on {share:.1f} %, none where filled, beyond the limits or too far to tell"
+    )
+    # a max_depth that cut nothing: "beyond the limits" was said of those 16 pixels alone
+    far = res.filtered(max_depth=1e6)
+    share = 100 * float(np.isfinite(far.depth).mean())
+    assert overview_image(far, "terrace").captions["depth"] == (
+        f"depth (m) on {share:.1f} %, none where filled or too far to tell"
     )
     # the Gabor channel's: holes where the disparity has none, every measured pixel a depth
     unfilled = dataclasses.replace(

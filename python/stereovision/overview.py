@@ -147,8 +147,10 @@ class Overview:
         pixels get none, so its holes are not the disparity's; ``"... none where filled or
         too far to tell"`` where measured pixels got none, their disparity not above its
         uncertainty ``sigma_d``; ``"... none where filled or beyond the limits"`` for a
-        :meth:`~stereovision.depth.DepthResult.filtered` result; the share alone when every
-        pixel with a disparity has a depth).
+        :meth:`~stereovision.depth.DepthResult.filtered` result, ``"... or too far to tell"``
+        added where its range, the calibration's depth of the disparity, could not have cut
+        the measured pixels without one; the share alone when every pixel with a disparity has
+        a depth).
     """
 
     image: npt.NDArray[np.uint8]
@@ -289,6 +291,27 @@ def cv2_text(text: str) -> str:
     return ascii_text.translate(_CONTROL_AS_QUESTION_MARK)
 
 
+def _cut_by_limits(result: Any, dropped: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:
+    """The ``dropped`` pixels (measured, no depth) a filtered result's limits may have cut:
+    all of them when it has limits, but, for a range alone (``min_depth``, ``max_depth``) and
+    a calibration, only those whose disparity's depth lies outside it; the others had no depth
+    to cut (too far to tell). A result cut by ``--max-depth`` said "beyond the limits" of
+    those too (even of a limit that cut nothing), telling cut pixels from too-far ones
+    nowhere."""
+    limits = getattr(result, "limits", None) or {}
+    calib = getattr(result, "calibration", None)
+    if not limits:
+        return np.zeros_like(dropped)
+    if calib is None or not set(limits) <= {"min_depth", "max_depth"}:
+        return dropped  # a sigma limit's cut is not told by the disparity: one reason
+    from stereovision.triangulation import _depth
+
+    z = _depth(np.asarray(result.disparity, np.float64), calib, "m")
+    with np.errstate(invalid="ignore"):
+        outside = (z < limits.get("min_depth", -np.inf)) | (z > limits.get("max_depth", np.inf))
+    return dropped & outside
+
+
 def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     """The overview of a :class:`~stereovision.depth.DepthResult`.
 
@@ -390,13 +413,17 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         lost = valid & ~has_depth
         filled = lost & (np.asarray(result.confidence) == 0)
         why = ["filled"] if filled.any() else []
-        if getattr(result, "limits", None):
-            why.append("beyond the limits")  # (and any of the measured ones below: one reason)
-        elif (lost & ~filled).any():
-            # measured, not above its sigma_d: a one-sigma depth interval reaching infinity
-            # (depth_counts' "dropped"; playground's gabor map: 5449 px, said nowhere)
+        # measured, no depth: not above its sigma_d, a one-sigma depth interval reaching
+        # infinity (depth_counts' "dropped"; playground's gabor map: 5449 px, said nowhere),
+        # or, filtered, cut by the limits
+        dropped = lost & ~filled
+        cut = _cut_by_limits(result, dropped)
+        if cut.any():
+            why.append("beyond the limits")
+        if (dropped & ~cut).any():
             why.append("too far to tell")
-        caption_text = f"{share}, none where {' or '.join(why)}" if why else share
+        said = ", ".join(why[:-1]) + " or " + why[-1] if len(why) > 1 else "".join(why)
+        caption_text = f"{share}, none where {said}" if why else share
         # the reasons where the caption stays clear of the bar's labels (left of their column)
         reach = pw + _BAR_GAP + _BAR_W + _LABEL_X
         if cv2.getTextSize(caption_text, _FONT, _CAPTION_SCALE, 1)[0][0] > reach:
