@@ -738,6 +738,27 @@ def test_maps_must_be_real_arrays() -> None:
         table1_report(ones, ones > 0)
 
 
+def test_a_masked_map_is_refused_as_depth_from_disparity_refuses_it() -> None:
+    """np.asarray read a numpy.ma map's data: a masked GT pixel was scored (n_gt 6 of a map
+    with one of its 6 masked), a masked estimate's pixel compared. Refused, saying what to
+    pass, as depth_from_disparity refuses a masked map."""
+    gt = np.ma.masked_array(np.full((2, 3), 5.0), mask=[[True, False, False], [False] * 3])
+    est = np.full((2, 3), 5.0)
+    for call, args, name in (
+        (dense_metrics, (est, gt), "gt"),
+        (dense_metrics, (gt, est), "disparity"),
+        (depth_metrics, (est, gt), "gt"),
+        (depth_metrics, (gt, est), "depth"),
+    ):
+        with pytest.raises(ValueError) as err:
+            call(*args)
+        assert str(err.value) == (
+            f"{name}: a masked array (numpy.ma) with 1 masked pixel, whose values would be read "
+            f"as real ones; pass {name}.filled(np.nan)"
+        )
+    assert dense_metrics(est, gt.filled(np.nan)).n_gt == 5
+
+
 def test_table1_report_refuses_a_bool_seed() -> None:
     ones = np.ones((3, 3))
     with pytest.raises(ValueError, match=r"^seed must be an integer >= 0 or None, got True"):

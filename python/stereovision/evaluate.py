@@ -67,6 +67,10 @@ def _real_2d(a: object, name: str, field: str = "disparity") -> npt.NDArray[np.f
     from stereovision._validate import not_a_result
 
     not_a_result(a, name, field)
+    from stereovision.triangulation import _refuse_masked
+
+    # a masked GT's pixels were scored by their data (depth_from_disparity's rule)
+    _refuse_masked(a, name, "np.nan")  # non-finite: unknown, no estimate
     arr = np.asarray(a)
     if arr.ndim != 2 or arr.dtype.kind not in "iuf":
         raise ValueError(
@@ -203,7 +207,8 @@ def dense_metrics(
     Raises
     ------
     ValueError
-        On non-2-D input, mismatched shapes, non-positive thresholds or a mask that is
+        On non-2-D input, a :mod:`numpy.ma` map with masked pixels (pass
+        ``gt.filled(np.nan)``), mismatched shapes, non-positive thresholds or a mask that is
         not bool, integer or 0/1 floats.
 
     Warns
@@ -391,7 +396,8 @@ def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     Raises
     ------
     ValueError
-        On mismatched shapes or non-real input.
+        On mismatched shapes, non-real input or a :mod:`numpy.ma` map with masked pixels
+        (pass ``gt.filled(np.nan)``).
     TypeError
         If a whole ``DepthResult`` is given for a map (its ``depth`` is meant).
     """
@@ -400,6 +406,10 @@ def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     # a whole result was "depth maps must be real arrays, got object and float32"
     not_a_result(depth, "depth", "depth")
     not_a_result(gt, "gt", "depth")
+    from stereovision.triangulation import _refuse_masked
+
+    _refuse_masked(depth, "depth", "np.nan")  # non-finite: missing
+    _refuse_masked(gt, "gt", "np.nan")
     e = np.asarray(depth)
     g = np.asarray(gt)
     if e.dtype.kind not in "iuf" or g.dtype.kind not in "iuf":

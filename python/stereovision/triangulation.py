@@ -397,8 +397,8 @@ def _refuse_masked(a: object, name: str, fill: str) -> None:
         n = int(np.count_nonzero(np.ma.getmaskarray(a)))
         if n:
             raise ValueError(
-                f"{name}: a masked array (numpy.ma) with {n} masked pixels, whose values would "
-                f"be read as real ones; pass {name}.filled({fill})"
+                f"{name}: a masked array (numpy.ma) with {n} masked pixel{'s' * (n != 1)}, "
+                f"whose values would be read as real ones; pass {name}.filled({fill})"
             )
 
 
