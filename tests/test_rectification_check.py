@@ -981,6 +981,45 @@ def test_cli_check_fix_that_still_fails_writes_nothing_and_exits_1(
     assert not fixed.exists()
 
 
+def test_cli_check_fix_of_a_passing_pair_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--fix on a pair whose rows agree already wrote a "correction" of the noise (tsukuba
+    through its identity rig, 0.07 px: turned 0.006 degrees, written): nothing is corrected or
+    written now, one line says so and the status is 0; with --json stdout is the check's
+    object, without "fixed". A file already at OUT is kept as it was."""
+    from stereovision import rectification_check
+
+    w, h = 64, 48
+    img = np.random.default_rng(0).integers(0, 256, (h, w), np.uint8)
+    pair = [str(tmp_path / "l.png"), str(tmp_path / "r.png")]
+    cv2.imwrite(pair[0], img)
+    cv2.imwrite(pair[1], np.roll(img, -2, axis=1))
+    rig = str(_rig(w, h, (0.0, 0.0, 0.0)).save(tmp_path / "rig.yaml"))
+    passing = RectificationCheck(385, 0.07, 0.47, -0.05, -0.08, 0.0, True, 0.5, size=(w, h))
+    monkeypatch.setattr(rectification_check, "check_rectification", lambda *a, **k: passing)
+    monkeypatch.setattr(
+        rectification_check,
+        "refine_rectification",
+        lambda *a, **k: (_rig(w, h, (0.1, 0, 0)), passing),
+    )
+    fixed = tmp_path / "fixed.yaml"
+    said = (
+        f"stereovision: not corrected, nothing written to {fixed}: the rows agree already (rows "
+        "median |dy| 0.07 px over 385 matches, tolerance 0.5): the calibration still rectifies "
+        "this rig (a smaller --tolerance corrects a pair within it)\n"
+    )
+    assert sv.cli.main(["check", *pair, "--calib", rig, "--fix", str(fixed)]) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith("rectification ok: median |dy| 0.07 px") and out.count("\n") == 1
+    assert err == said and not fixed.exists()
+    fixed.write_text("mine")
+    assert sv.cli.main(["check", *pair, "--calib", rig, "--fix", str(fixed), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out) == passing.as_dict() and err == said
+    assert fixed.read_text() == "mine" and not list(tmp_path.glob("*.previous*"))
+
+
 @pytest.mark.parametrize("alpha", [5.0, -1, "1"])
 def test_alpha_out_of_range_is_refused_with_or_without_a_calibration(alpha: object) -> None:
     """check_rectification without a calibration took any alpha without a word, and
