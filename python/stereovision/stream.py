@@ -960,7 +960,7 @@ def run_stream(
         Seconds between reports (0: one per pair; inf: the last, partial one alone).
     check : bool
         Check that the first (rectified) pair's features lie on common rows
-        (:func:`~stereovision.rectification_check.check_rectification`, 35-480 ms) and warn
+        (:func:`~stereovision.rectification_check.check_rectification`, 0.1-0.85 s) and warn
         when they do not: a spoiled calibration, or raw cameras without one.
     check_every : int, optional
         Also check every ``check_every``-th pair (in the grab thread when pipelined), and warn
