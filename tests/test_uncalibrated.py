@@ -855,14 +855,14 @@ def test_rectify_gives_a_float_pair_s_linear_warp_as_opencv_does() -> None:
     """The clip of cubic and Lanczos's overshoot ran under every method: a float64 pair's linear
     warp (the default) had pixels moved by an ulp (0.7000000000000001 -> 0.7, 34 of 768 here),
     and a colour float pair's rectify took ~1.8x as long. Methods that stay within the pixels
-    (nearest, linear, area) give OpenCV's warp as it is."""
+    (nearest, linear) give OpenCV's warp as it is."""
     img = np.full((24, 32), 0.7)
     shift = np.array([[1.01, 0.013, 0.37], [0.002, 0.99, 0.31], [1e-5, 0.0, 1.0]])
     rect = UncalibratedRectification(
         shift, shift, (32, 24), (32, 24), np.eye(3), 40, 0.1, 0.2, (1.0, 8.0), 16, (0.0, 0.0),
         (1.0, 1.0),
     )  # fmt: skip
-    for method in (cv2.INTER_NEAREST, cv2.INTER_LINEAR, cv2.INTER_AREA):
+    for method in (cv2.INTER_NEAREST, cv2.INTER_LINEAR):
         warp = cv2.warpPerspective(img, shift, (32, 24), flags=method)
         assert warp.max() > 0.7 or method == cv2.INTER_NEAREST  # OpenCV's own ulp kept
         np.testing.assert_array_equal(rect.rectify(img, img, interpolation=method)[0], warp)
@@ -876,7 +876,7 @@ def test_rectify_names_an_interpolation_that_is_no_warp_method(interpolation: ob
     """True, "linear" or None were OpenCV's bare cv2.error "Overload resolution failed", 5 and
     -1 its "Unknown interpolation method", and 99 or INTER_LINEAR | WARP_INVERSE_MAP warped
     without a word (the latter with the inverse homographies: another pair). Each is a
-    ValueError naming interpolation; the five methods (2.0 read as 2, INTER_CUBIC) still warp."""
+    ValueError naming interpolation; the four methods (2.0 read as 2, INTER_CUBIC) still warp."""
     img = np.tile(np.array([0, 100], np.uint8), (8, 6))
     half = np.array([[1.0, 0, 0.5], [0, 1, 0], [0, 0, 1]])
     rect = UncalibratedRectification(
@@ -887,8 +887,32 @@ def test_rectify_names_an_interpolation_that_is_no_warp_method(interpolation: ob
         rect.rectify(img, img, interpolation=interpolation)
     cubic, _ = rect.rectify(img, img, interpolation=cv2.INTER_CUBIC)
     np.testing.assert_array_equal(rect.rectify(img, img, interpolation=2.0)[0], cubic)
-    for method in (cv2.INTER_NEAREST, cv2.INTER_AREA, cv2.INTER_LANCZOS4, np.int64(1)):
+    for method in (cv2.INTER_NEAREST, cv2.INTER_LANCZOS4, np.int64(1)):
         assert rect.rectify(img, img, interpolation=method)[0].shape == (8, 12)
+
+
+def test_rectify_refuses_inter_area_which_a_warp_does_as_linear() -> None:
+    """rectify(interpolation=cv2.INTER_AREA) gave INTER_LINEAR's very pixels (warpPerspective
+    does INTER_AREA as linear), not the averaging its name promises: refused, naming what to
+    give instead (3.0 read as 3, as the others)."""
+    img = np.tile(np.array([0, 100], np.uint8), (8, 6))
+    half = np.array([[0.5, 0, 0.25], [0, 0.5, 0], [0, 0, 1]])  # a shrink: area would average
+    rect = UncalibratedRectification(
+        half, half, (6, 4), (12, 8), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16, (0.0, 0.0),
+        (1.0, 1.0),
+    )  # fmt: skip
+    said = (
+        "interpolation: cv2.INTER_AREA averages only in a resize; a warp does INTER_LINEAR for "
+        "it (the same pixels): give cv2.INTER_LINEAR, or resize the rectified pair with "
+        "INTER_AREA"
+    )
+    for area in (cv2.INTER_AREA, 3.0, np.int32(3)):
+        with pytest.raises(ValueError) as err:
+            rect.rectify(img, img, interpolation=area)
+        assert str(err.value) == said
+    np.testing.assert_array_equal(
+        rect.rectify(img, img)[0], cv2.warpPerspective(img, half, (6, 4), flags=cv2.INTER_AREA)
+    )
 
 
 def test_rectify_gives_a_one_channel_image_back_with_its_channel() -> None:
