@@ -304,6 +304,22 @@ def test_find_pairs_keeps_the_case_of_left_and_takes_the_last_left(tmp_path: Pat
     ]
 
 
+def test_find_pairs_pairs_images_whose_extensions_differ_in_case(tmp_path: Path) -> None:
+    """``left.PNG`` + ``right.png`` (one camera's spelling and a tool's) were two half pairs,
+    "no right.PNG beside left.PNG" and "no left.png beside right.png": one pair now, a scene
+    with its calib.txt; the same for ``cam_left_1.JPG`` + ``cam_right_1.jpg``."""
+    _blank(tmp_path, "s/left.PNG", "s/right.png", "q/cam_left_1.JPG", "q/cam_right_1.jpg")
+    (tmp_path / "s/calib.txt").write_text("")
+    import stereovision.batch as batch
+
+    jobs, unpaired, _ = batch._scan(tmp_path)
+    assert [(j.name, j.left.name, j.right.name, j.calib) for j in jobs] == [
+        ("q/cam_1", "cam_left_1.JPG", "cam_right_1.jpg", None),
+        ("s", "left.PNG", "right.png", tmp_path / "s/calib.txt"),
+    ]
+    assert unpaired == []
+
+
 def _blank(root: Path, *names: str) -> None:
     """An 8 x 8 black image under each name (``find_pairs`` reads names only)."""
     for name in names:

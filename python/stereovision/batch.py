@@ -156,6 +156,26 @@ def _swap(path: Path, m: re.Match[str], to: str) -> Path:
     return path.with_name(path.stem[: m.start()] + new + path.stem[m.end() :] + path.suffix)
 
 
+def _by_suffix_case(names: set[str]) -> dict[str, list[str]]:
+    """``names`` by their spelling with the extension in lower case (``left.png`` for
+    ``left.PNG``), for :func:`_other_image`."""
+    spelt: dict[str, list[str]] = {}
+    for f in sorted(names):
+        p = Path(f)
+        spelt.setdefault(p.stem + p.suffix.lower(), []).append(f)
+    return spelt
+
+
+def _other_image(path: Path, names: set[str], spelt: dict[str, list[str]]) -> Path:
+    """The other image of a pair, ``path`` (:func:`_swap`'s), as spelt among ``names``: of the
+    same stem, its extension in any case (``right.png`` beside ``left.PNG``, a camera's and a
+    tool's spellings); ``path`` itself when it is there, or when none or two are."""
+    if path.name in names:
+        return path
+    found = spelt.get(path.stem + path.suffix.lower(), [])
+    return path.with_name(found[0]) if len(found) == 1 else path
+
+
 @dataclass(frozen=True)
 class _Unpaired:
     """An image named as one of a pair whose other image is not there."""
@@ -232,8 +252,9 @@ def find_pairs(
       as below).
     * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
       saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
-      in its place; the pair is named by its folder and the file name without ``left`` (and
-      separators around it), e.g. ``seq/0001``. Files without a counterpart are not pairs
+      in its place (its extension in any case: ``left.PNG`` + ``right.png``); the pair is
+      named by its folder and the file name without ``left`` (and separators around it), e.g.
+      ``seq/0001``. Files without a counterpart are not pairs
       (:func:`run_batch` reports them as failed pairs).
     * Two sibling camera folders (:data:`CAMERA_FOLDERS`: ``left/`` + ``right/``, ``L/`` +
       ``R/``, KITTI's ``image_2/`` + ``image_3/`` and ``image_0/`` + ``image_1/`` (a raw
@@ -367,12 +388,14 @@ def _scan(
                     name = rel if rel != "." else r.resolve().name
                     unpaired.append(_Unpaired(name, here / present, here / missing, side))
         images = [f for f in sorted(files) if Path(f).suffix.lower() in IMAGE_EXTS and f[0] != "."]
+        # left.PNG + right.png were two half pairs, "no right.PNG beside left.PNG" and back
+        by_case = _by_suffix_case(names)
         for f in images:
             p = here / f
             m = _last_left(p.stem)
             if m is None or f in paired or p in cam_taken:
                 continue
-            rp = _swap(p, m, "right")
+            rp = _other_image(_swap(p, m, "right"), names, by_case)
             if rp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, rp, "left"))
                 continue
@@ -389,7 +412,7 @@ def _scan(
             m = _last(_RIGHT_RE, p.stem)
             if m is None or f in paired or p in cam_taken or _last_left(p.stem) is not None:
                 continue
-            lp = _swap(p, m, "left")
+            lp = _other_image(_swap(p, m, "left"), names, by_case)
             if lp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, lp, "right"))
         # links not entered included: camera folders named by links to the input's own
@@ -758,6 +781,7 @@ def _lone_named_images(folder: Path, skip: frozenset[str] = frozenset()) -> set[
     for d, dirs, files, _ in _walk(folder, skip):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub, names = Path(d).relative_to(folder), set(files)
+        spelt = _by_suffix_case(names)
         for f in files:
             if Path(f).suffix.lower() not in IMAGE_EXTS or f[0] == ".":
                 continue
@@ -766,7 +790,7 @@ def _lone_named_images(folder: Path, skip: frozenset[str] = frozenset()) -> set[
             if other is None:
                 m = _last(_RIGHT_RE, Path(f).stem)
                 other = None if m is None else _swap(Path(f), m, "left")
-            if other is not None and other.name not in names:
+            if other is not None and _other_image(other, names, spelt).name not in names:
                 lone.add((sub / f).as_posix())
     return lone
 
