@@ -1860,6 +1860,37 @@ def test_a_folder_that_cannot_be_listed_is_warned_of(
     ]
 
 
+def test_a_folder_that_cannot_be_listed_is_warned_of_once_at_the_callers_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """seq/right/sub/ that cannot be listed, under a camera folder the search walks three
+    times (its images, its named images, the input's walk), was warned of three times, each
+    at ``<frozen os>`` (os.walk's onerror gave it): once now, at the line calling find_pairs."""
+    root = tmp_path / "in"
+    _blank(root, "seq/left/0001.png", "seq/right/0001.png", "seq/right/sub/0002.png")
+    listing = os.scandir
+    locked = str(root / "seq/right/sub")
+
+    def scandir(path: Any = ".") -> Any:
+        if not isinstance(path, int) and os.fspath(path) == locked:
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    with pytest.warns(UserWarning) as said:
+        line = sys._getframe().f_lineno + 1
+        jobs = find_pairs(root)
+    assert [j.name for j in jobs] == ["seq/0001"]
+    assert [(str(w.message), w.filename, w.lineno) for w in said] == [
+        (
+            f"cannot search folder {locked}: Permission denied; the pairs in it, if any, are "
+            "left out",
+            __file__,
+            line,
+        )
+    ]
+
+
 def test_an_input_folder_that_cannot_be_listed_is_an_error(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import contextvars
 import datetime as _dt
 import hashlib
 import json
@@ -314,6 +315,20 @@ def _scan(
     calib_unit: str | None = None,
     output: str | os.PathLike[str] | None = None,
 ) -> tuple[list[PairJob], list[_Unpaired], tuple[int, int] | None]:
+    """:func:`_search`, each folder that cannot be listed warned of once (:func:`_not_listed`)."""
+    token = _TOLD_UNLISTED.set(set())
+    try:
+        return _search(root, calib, calib_unit, output)
+    finally:
+        _TOLD_UNLISTED.reset(token)
+
+
+def _search(
+    root: str | os.PathLike[str],
+    calib: str | os.PathLike[str] | None = None,
+    calib_unit: str | None = None,
+    output: str | os.PathLike[str] | None = None,
+) -> tuple[list[PairJob], list[_Unpaired], tuple[int, int] | None]:
     """:func:`find_pairs`, and the images named as one of a pair without the other: a ``left``
     image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
     ``left`` one; named as their pair would be, after the pairs' names. Also the image size
@@ -579,16 +594,31 @@ def _output_below(root: Path, output: str | os.PathLike[str] | None) -> frozense
     return frozenset({out}) if below else frozenset()
 
 
+#: The warnings :func:`_not_listed` gave in one search of the input (:func:`_scan`), set for
+#: its length: a camera folder is walked three times (its images, its named ones, the input's
+#: walk), a folder in it that cannot be listed warned of three times.
+_TOLD_UNLISTED: contextvars.ContextVar[set[str] | None] = contextvars.ContextVar(
+    "stereovision_told_unlisted", default=None
+)
+
+
 def _not_listed(err: OSError) -> None:
     """Warn of a folder :func:`_walk` cannot list: os.walk passed over it (no permission, an
-    I/O error) without a word, its pairs left out of a run that said nothing was missing."""
-    from stereovision._validate import escaped
+    I/O error) without a word, its pairs left out of a run that said nothing was missing.
+    Once per search (:data:`_TOLD_UNLISTED`), at the caller's line outside the package: from
+    os.walk's ``onerror`` it was ``<frozen os>``'s."""
+    from stereovision._validate import escaped, user_stacklevel
 
-    warnings.warn(
+    message = (
         f"cannot search folder {escaped(str(err.filename))}: {err.strerror or err}; the pairs "
-        "in it, if any, are left out",
-        stacklevel=2,
+        "in it, if any, are left out"
     )
+    told = _TOLD_UNLISTED.get()
+    if told is not None:
+        if message in told:
+            return
+        told.add(message)
+    warnings.warn(message, stacklevel=user_stacklevel())
 
 
 def _must_list(folder: Path, what: str) -> None:
@@ -618,7 +648,12 @@ def _walk(
     folder that cannot be listed is warned of (:func:`_not_listed`)."""
     top_real = os.path.realpath(top)
     seen = {top_real}
-    for d, dirs, files in os.walk(top, followlinks=True, onerror=_not_listed):
+    # warned of here, not in os.walk's onerror: a frame of os's between the caller and the
+    # warning stopped user_stacklevel there
+    unlisted: list[OSError] = []
+    for d, dirs, files in os.walk(top, followlinks=True, onerror=unlisted.append):
+        while unlisted:
+            _not_listed(unlisted.pop(0))
         listed = list(dirs)
         keep = []
         # in name order, so that of two links to one folder the same one names its pairs on
@@ -641,6 +676,8 @@ def _walk(
             keep.append(x)
         dirs[:] = keep
         yield d, dirs, files, listed
+    while unlisted:  # the last folders os.walk tried
+        _not_listed(unlisted.pop(0))
 
 
 def _camera_folders(dirs: list[str]) -> list[tuple[str, str]]:
