@@ -2009,6 +2009,28 @@ def test_outputs_written_into_the_input_are_not_reported_as_half_pairs(tmp_path:
                                                                         "overview")]  # fmt: skip
 
 
+def test_outputs_of_a_pair_whose_image_was_deleted_are_not_reported_as_half_pairs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``batch 00 -o 00`` after 00/image_0/000001.png was deleted: the pair's outputs from the
+    run that did it (00/image_0/000001/disparity.png, overview.png) were reported again as
+    images without their pair, two failed pairs of this run. The summary lists them as that
+    pair's outputs: not reported; the half pair and an image there it does not list are."""
+    import stereovision.batch as batch
+
+    root = tmp_path / "00"
+    names = ["image_1/000001.png", "image_0/000001/disparity.png", "image_0/000001/overview.png"]
+    names += ["image_0/000001/mine.png"]
+    _blank(root, *[f"image_{cam}/000000.png" for cam in range(4)], *names)
+    pair = {"status": "done", "outputs": ["disparity.png", "disparity.pfm", "overview.png"]}
+    summary = {"version": 3, "pairs": {"image_0/000001": pair}}
+    (root / SUMMARY_NAME).write_text(json.dumps(summary))
+    monkeypatch.setattr(batch, "_run_jobs", lambda *args: None)  # only the search is looked at
+    res = batch.run_batch(root, root, progress=False)
+    assert res.unpaired == ["image_0/000001", "image_0/000001/mine"]
+    assert res.pending == ["image_0/000000", "image_2/000000"]
+
+
 def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_listed(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, in_process_dask: None
 ) -> None:

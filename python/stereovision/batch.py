@@ -2100,6 +2100,9 @@ def run_batch(
     out.mkdir(parents=True, exist_ok=True)
     with _output_lock(out):  # a second run into OUT would drop this one's records
         summary = _Summary(out, log)
+        # -o given as the input: the outputs of a pair one of whose images was deleted since
+        # (00/image_0/000001/disparity.png) were each reported as an image without its pair
+        unpaired = [u for u in unpaired if not _earlier_output(u.present, out, summary.pairs)]
         # the input folder of the runs that wrote OUT before (None for a new OUT)
         earlier_input = summary.data.get("input") if summary.pairs else None
         # the method by its name: --method fused after a run without --method (the default)
@@ -2386,6 +2389,33 @@ def run_batch(
         if interrupted:
             raise BatchInterrupted(result) from cause
         return result
+
+
+def _earlier_output(image: Path, out: Path, pairs: dict[str, Any]) -> bool:
+    """Whether ``image`` is an output a run recorded in ``out`` (one of the ``outputs`` of the
+    summary's pair whose folder holds it), not an input image.
+
+    Parameters
+    ----------
+    image : Path
+        An image the search found (inside ``out`` when ``-o`` is the input or lies in it).
+    out : Path
+        The output folder.
+    pairs : dict
+        The summary's pair records.
+
+    Returns
+    -------
+    bool
+        True for a file the summary lists as its pair's output.
+    """
+    try:
+        rel = Path(os.path.realpath(image.parent)).relative_to(os.path.realpath(out))
+    except ValueError:  # not under out
+        return False
+    entry = pairs.get(rel.as_posix())
+    outputs = entry.get("outputs") if isinstance(entry, dict) else None
+    return isinstance(outputs, list) and image.name in outputs
 
 
 def _remove_unstarted(out: Path, made: list[Path], fresh: bool) -> None:
