@@ -2665,6 +2665,36 @@ def test_the_progress_lines_estimate_the_time_left_from_the_pairs_pace(
     ]
 
 
+def test_the_time_left_does_not_count_pairs_that_failed_before_reaching_the_workers(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """3 pairs failing at once (an unreadable image, never sent to a worker) beside 1 done in
+    10 s said 'about 15 s left' for 6 more pairs: the pace counted them as done in those 10 s.
+    The pace is the workers' pairs' (done, or failed there: they took the time); before a
+    worker finished one, no time left is said."""
+    import stereovision.batch as batch
+
+    clock = [100.0]
+    monkeypatch.setattr(batch.time, "monotonic", lambda: clock[0])
+    bar = batch._Progress(10, enabled=True)  # stderr is not a terminal here: plain lines
+    clock[0] += 20.0
+    bar.started()
+    for _ in range(3):
+        bar.update(failed=True, instant=True)
+    clock[0] += 10.0
+    bar.update()
+    clock[0] += 10.0
+    bar.update(failed=True)  # failed in the worker, after 10 s of it
+    bar.close()
+    assert capsys.readouterr().err.splitlines() == [
+        "batch: 1/10 pairs, 1 failed, 20 s",
+        "batch: 2/10 pairs, 2 failed, 20 s",
+        "batch: 3/10 pairs, 3 failed, 20 s",
+        "batch: 4/10 pairs, 3 failed, 30 s, about 60 s left",
+        "batch: 5/10 pairs, 4 failed, 40 s, about 50 s left",
+    ]
+
+
 def test_scene_folders_linked_into_the_input_are_batched(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:
@@ -2790,8 +2820,18 @@ def test_an_image_that_cannot_be_read_when_sent_is_tried_again(
         return real_read(self)
 
     monkeypatch.setattr(Path, "read_bytes", read_bytes)
+    # a failure before the workers took none of their time: not counted in the time left's pace
+    finished: list[tuple[bool, bool]] = []
+    update = batch._Progress.update
+
+    def seen(bar: batch._Progress, failed: bool = False, instant: bool = False) -> None:
+        finished.append((failed, instant))
+        update(bar, failed, instant)
+
+    monkeypatch.setattr(batch._Progress, "update", seen)
     first = batch.run_batch(src, out, workers=1, max_disparity=16, progress=False)
     assert (first.processed, first.failed) == (["b"], ["a"])
+    assert finished == [(True, True), (False, False)]
     entry = _summary(out)["pairs"]["a"]
     assert entry["error"] == f"PermissionError: [Errno 13] Permission denied: '{denied}'"
     assert "fingerprint" not in entry and "options" not in entry

@@ -2445,7 +2445,10 @@ def _outputs_gone(out: Path, summary: _Summary, names: list[str]) -> list[str]:
 class _Progress:
     """A tqdm bar on a terminal; elsewhere (a log file, a pipe, a service's journal) a plain line
     on stderr every tenth of the pairs or every :data:`PROGRESS_SECONDS`, whichever comes first:
-    ``batch: 12/40 pairs, 1 failed, 31 s, about 72 s left``."""
+    ``batch: 12/40 pairs, 1 failed, 31 s, about 72 s left``. The time left is the pace of the
+    pairs the workers finished (done, or failed there) since they were up, times the pairs
+    left; a pair that failed before it reached them (an unreadable image) took none of that
+    time. The estimate shows once a worker has finished a pair."""
 
     def __init__(self, total: int, enabled: bool) -> None:
         from tqdm import tqdm
@@ -2456,6 +2459,7 @@ class _Progress:
         )
         self.plain = enabled and not tty
         self.total, self.n, self.failed = total, 0, 0
+        self.worked = 0  # pairs finished by the workers: the pace's (not the instant failures)
         self.step = max(1, math.ceil(total / 10))
         self.t0 = self.last = self.t_work = time.monotonic()
 
@@ -2465,21 +2469,29 @@ class _Progress:
         of the run's remaining time)."""
         self.t_work = time.monotonic()
 
-    def update(self, failed: bool = False) -> None:
+    def update(self, failed: bool = False, instant: bool = False) -> None:
+        """One pair finished: ``failed`` or done; ``instant`` when it failed before it reached
+        the workers (its files not read), a time the pace does not count."""
         self.bar.update(1)
         self.n += 1
         self.failed += failed
+        self.worked += not instant
         now = time.monotonic()
         if not self.plain or self.n >= self.total:  # the final line says the rest
             return
         if self.n % self.step and now - self.last < PROGRESS_SECONDS:
             return
         self.last = now
-        spent, pace = now - self.t0, (now - self.t_work) / self.n
+        spent = now - self.t0
+        # 3 unreadable pairs failed at once beside 1 done in 10 s said "about 15 s left" for 6
+        # more (60 s): the pace counted them as done in the same 10 s
+        left = ""
+        if self.worked:
+            pace = (now - self.t_work) / self.worked
+            left = f", about {pace * (self.total - self.n):.0f} s left"
         fails = f", {self.failed} failed" if self.failed else ""
         print(
-            f"batch: {self.n}/{self.total} pairs{fails}, {spent:.0f} s, about "
-            f"{pace * (self.total - self.n):.0f} s left",
+            f"batch: {self.n}/{self.total} pairs{fails}, {spent:.0f} s{left}",
             file=sys.stderr,
             flush=True,
         )
@@ -2598,7 +2610,7 @@ def _run_jobs(
                     # changes neither its size nor its time)
                     for key in ("options", "fingerprint"):
                         summary.pairs[job.name].pop(key, None)
-                record_failure(job, exc)
+                record_failure(job, exc, instant=True)
                 return True
             summary.pairs[job.name]["hashes"] = hashes
             fut = client.submit(process_pair, task, key=f"stereovision-{uuid.uuid4().hex}")
@@ -2606,7 +2618,9 @@ def _run_jobs(
             ac.add(fut)
             return True
 
-        def record_failure(job: PairJob, exc: BaseException, line: str | None = None) -> None:
+        def record_failure(
+            job: PairJob, exc: BaseException, line: str | None = None, instant: bool = False
+        ) -> None:
             entry = summary.pairs[job.name]
             entry.update(
                 status="failed",
@@ -2617,7 +2631,7 @@ def _run_jobs(
             failed.append(job.name)
             run["failed"] = len(failed)
             summary.record()
-            bar.update(failed=True)
+            bar.update(failed=True, instant=instant)
             if log is not None:
                 log(f"failed {escaped(job.name)}: {entry['error']}")
 
