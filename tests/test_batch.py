@@ -2940,6 +2940,43 @@ def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
     assert capsys.readouterr().out.startswith("0 processed, 2 skipped (done before), 1 skipped")
 
 
+def test_batch_searches_the_input_once_to_size_a_sizeless_calibration(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--calib of OpenCV stereo_calib output (no image size) searched the input twice: once in
+    cmd_batch for the first pair's left image that sizes it, to refuse it in the command
+    line's words, and again in run_batch (a large tree's walk, twice). Once now, its refusal in
+    the same words."""
+    from test_calibration import _opencv_stereo_calib
+
+    import stereovision.batch as batch
+
+    rig, out = tmp_path / "rig", tmp_path / "out"
+    rig.mkdir()
+    _opencv_stereo_calib(rig)
+    _blank(tmp_path / "in", "s/left.png", "s/right.png")
+    searches: list[Any] = []
+    search = batch._search
+
+    def counted(*args: Any) -> Any:
+        searches.append(args[0])
+        return search(*args)
+
+    monkeypatch.setattr(batch, "_search", counted)
+    monkeypatch.setattr(batch, "_run_jobs", lambda *args: None)  # the search alone looked at
+    args = ["batch", str(tmp_path / "in"), "-o", str(out), "--calib", str(rig)]
+    capsys.readouterr()
+    assert main(args) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {rig} is OpenCV stereo_calib output (intrinsics.yml + "
+        "extrinsics.yml), which holds neither the image size nor the unit of T (the board's "
+        "square size): pass --calib-unit (m, mm, cm, ft or in)\n"
+    )
+    assert len(searches) == 1 and not out.exists()
+    assert main([*args, "--calib-unit", "mm"]) == 0
+    assert len(searches) == 2
+
+
 def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], in_process_dask: None
 ) -> None:

@@ -314,11 +314,12 @@ def _scan(
     calib: str | os.PathLike[str] | None = None,
     calib_unit: str | None = None,
     output: str | os.PathLike[str] | None = None,
+    words: str = "api",
 ) -> tuple[list[PairJob], list[_Unpaired], tuple[int, int] | None]:
     """:func:`_search`, each folder that cannot be listed warned of once (:func:`_not_listed`)."""
     token = _TOLD_UNLISTED.set(set())
     try:
-        return _search(root, calib, calib_unit, output)
+        return _search(root, calib, calib_unit, output, words)
     finally:
         _TOLD_UNLISTED.reset(token)
 
@@ -328,6 +329,7 @@ def _search(
     calib: str | os.PathLike[str] | None = None,
     calib_unit: str | None = None,
     output: str | os.PathLike[str] | None = None,
+    words: str = "api",
 ) -> tuple[list[PairJob], list[_Unpaired], tuple[int, int] | None]:
     """:func:`find_pairs`, and the images named as one of a pair without the other: a ``left``
     image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
@@ -511,10 +513,18 @@ def _search(
     if cal is not None and (size is not None or not _sizeless(cal)):
         # One calibration for every pair: read it once here, so that a bad file is one error
         # now, not one failed pair per scene. (One that holds no size, without a pair whose
-        # left image decodes to size it, is each pair's error.)
-        from stereovision.calibration import Calibration
+        # left image decodes to size it, is each pair's error.) In the command line's words
+        # for it: cmd_batch searched the input a first time to size it so
+        if words == "cli":
+            from stereovision.cli import _HOMOGRAPHIES_USE, load_calibration
 
-        Calibration.from_file(cal, image_size=size, unit=calib_unit)
+            # batch has no --rectification, which the refusal of rectify's homographies named
+            homographies = f"batch takes no homographies; {_HOMOGRAPHIES_USE}"
+            load_calibration(cal, calib_unit, size=size, homographies=homographies)
+        else:
+            from stereovision.calibration import Calibration
+
+            Calibration.from_file(cal, image_size=size, unit=calib_unit)
     return unique, named, size
 
 
@@ -1969,7 +1979,7 @@ def run_batch(
         Whose words the errors recorded in ``summary.json`` (and given to ``log``) advise in:
         the Python API's, as raised (``calib.scaled_to((w, h))``, ``max_disparity``), or the
         command line's (``--calib``, ``--max-disparity``), as ``stereovision batch`` records
-        them.
+        them; so is a refusal of ``calib`` (``--calib-unit``, as the command says it).
 
     Returns
     -------
@@ -2074,7 +2084,7 @@ def run_batch(
     t0 = time.perf_counter()
     if calib_unit is not None and calib is None:
         raise ValueError("calib_unit is the unit of calib's file: give calib too")
-    jobs, unpaired, calib_size = _scan(input_dir, calib, calib_unit, output_dir)
+    jobs, unpaired, calib_size = _scan(input_dir, calib, calib_unit, output_dir, words)
     # a file in the way, or a folder that cannot be written: said as such, before a cluster
     # starts (it was "[Errno 17] File exists" or "[Errno 2] No such file or directory")
     check_output_folder(output_dir, "output folder")
@@ -2802,18 +2812,14 @@ def cmd_batch(args: argparse.Namespace) -> int:
         from stereovision.cli import _HOMOGRAPHIES_USE, load_calibration
 
         # refused in the CLI's words (--calib-unit), before a cluster starts; one that holds
-        # no image size (OpenCV stereo_calib output) read at run_batch's: the first pair's
-        sizeless = args.calib is not None and _sizeless(Path(args.calib))
-        size = None
-        if sizeless:
-            with contextlib.suppress(OSError):  # no input folder: run_batch says so
-                size = _calib_size(Path(args.calib), _scan(args.input, output=args.output)[0])
-        if size is not None or not sizeless:
+        # no image size (OpenCV stereo_calib output) is read at the first pair's size by
+        # run_batch's search of the input, in these words too (words="cli"): searched here
+        # first to size it, the input was searched twice
+        if not (args.calib is not None and _sizeless(Path(args.calib))):
             # batch has no --rectification, which the refusal of rectify's homographies named
             load_calibration(
                 args.calib,
                 args.calib_unit,
-                size=size,
                 homographies=f"batch takes no homographies; {_HOMOGRAPHIES_USE}",
             )
     if args.scheduler is not None:
