@@ -318,6 +318,18 @@ def test_find_pairs_pairs_images_whose_extensions_differ_in_case(tmp_path: Path)
         ("s", "left.PNG", "right.png", tmp_path / "s/calib.txt"),
     ]
     assert unpaired == []
+    # left.PNG beside left.png: right.png is left.png's (as before, left.PNG has no pair)
+    _blank(tmp_path / "two", "left.png", "left.PNG", "right.png", "x_left.PNG", "x_left.png")
+    _blank(tmp_path / "two", "x_right.png")
+    jobs, unpaired, _ = batch._scan(tmp_path / "two")
+    assert [(j.name, j.left.name, j.right.name) for j in jobs] == [
+        ("two", "left.png", "right.png"),
+        ("x", "x_left.png", "x_right.png"),
+    ]
+    assert [(u.name, u.present.name, u.missing.name) for u in unpaired] == [
+        ("two~2", "left.PNG", "right.PNG"),
+        ("x~2", "x_left.PNG", "x_right.PNG"),
+    ]
 
 
 def _blank(root: Path, *names: str) -> None:

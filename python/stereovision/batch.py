@@ -167,11 +167,16 @@ def _by_suffix_case(names: set[str]) -> dict[str, list[str]]:
     return spelt
 
 
-def _other_image(path: Path, names: set[str], spelt: dict[str, list[str]]) -> Path:
-    """The other image of a pair, ``path`` (:func:`_swap`'s), as spelt among ``names``: of the
-    same stem, its extension in any case (``right.png`` beside ``left.PNG``, a camera's and a
-    tool's spellings); ``path`` itself when it is there, or when none or two are."""
+def _other_image(path: Path, names: set[str], spelt: dict[str, list[str]], own: str) -> Path:
+    """The other image of the pair of the image named ``own``, ``path`` (:func:`_swap`'s), as
+    spelt among ``names``: of the same stem, its extension in any case (``right.png`` beside
+    ``left.PNG``, a camera's and a tool's spellings); ``path`` itself when it is there, or when
+    none or two are, or ``own`` has another spelling too (``left.PNG`` beside ``left.png``,
+    whose ``right.png`` it is: not guessed)."""
     if path.name in names:
+        return path
+    mine = Path(own)
+    if len(spelt.get(mine.stem + mine.suffix.lower(), [])) != 1:
         return path
     found = spelt.get(path.stem + path.suffix.lower(), [])
     return path.with_name(found[0]) if len(found) == 1 else path
@@ -412,7 +417,7 @@ def _search(
             m = _last_left(p.stem)
             if m is None or f in paired or p in cam_taken:
                 continue
-            rp = _other_image(_swap(p, m, "right"), names, by_case)
+            rp = _other_image(_swap(p, m, "right"), names, by_case, f)
             if rp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, rp, "left"))
                 continue
@@ -429,7 +434,7 @@ def _search(
             m = _last(_RIGHT_RE, p.stem)
             if m is None or f in paired or p in cam_taken or _last_left(p.stem) is not None:
                 continue
-            lp = _other_image(_swap(p, m, "left"), names, by_case)
+            lp = _other_image(_swap(p, m, "left"), names, by_case, f)
             if lp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, lp, "right"))
         # links not entered included: camera folders named by links to the input's own
@@ -837,7 +842,7 @@ def _lone_named_images(folder: Path, skip: frozenset[str] = frozenset()) -> set[
             if other is None:
                 m = _last(_RIGHT_RE, Path(f).stem)
                 other = None if m is None else _swap(Path(f), m, "left")
-            if other is not None and _other_image(other, names, spelt).name not in names:
+            if other is not None and _other_image(other, names, spelt, f).name not in names:
                 lone.add((sub / f).as_posix())
     return lone
 
