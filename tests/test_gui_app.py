@@ -3417,11 +3417,37 @@ def test_rectify_controller_without_a_calibration(data_dir):
     assert app.state.source_label.count("(rectified from features)") == 1
 
     async def with_calib() -> None:
-        app.calib = object()
+        from types import SimpleNamespace
+
+        app.calib = SimpleNamespace(image_size=(app.pair[0].shape[1], app.pair[0].shape[0]))
         await app.rectify_from_features()
 
     asyncio.run(with_calib())
     assert app.state.rows_label == "this pair has a calibration: it is rectified with it"
+
+
+def test_rectify_with_a_calib_that_fits_no_camera_mode_says_it_does_not_fit():
+    """Cameras in a mode --calib does not fit (another aspect ratio): "Rectify" said "this pair
+    has a calibration: it is rectified with it", of a pair no computation could use it on."""
+    calib = syn.calibration()  # 160x120
+    frame = np.zeros((120, 320, 3), np.uint8)  # twice as wide
+
+    class Cameras:
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    app = _scene_app("test-rectify-unfit", [], source=Cameras(), calib=calib)
+    app._grab()
+    _run(app, app.rectify_from_features)
+    assert app.state.rows_label == (
+        "the calibration does not fit this pair (calibration is for 160x120 images, the "
+        "frames are 320x120: another aspect ratio (a camera mode that crops), which needs its own "
+        "calibration): Rectify finds no homographies for a pair with one (start the page "
+        "without --calib to rectify from features)"
+    )
 
 
 def test_rectify_uses_a_pair_already_rectified_as_given(data_dir):

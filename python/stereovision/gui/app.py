@@ -2787,8 +2787,23 @@ class StereoApp:
             self._fail(ValueError(NO_PAIR))
             return
         if self.calib is not None:
+            from stereovision.calibration import fit_to_frames
+
+            left = self.pair[0]
+            said = "this pair has a calibration: it is rectified with it"
+            try:
+                fit_to_frames(self.calib, (left.shape[1], left.shape[0]))
+            except ValueError as exc:
+                # cameras in a mode --calib fits not (another aspect ratio): it was said to
+                # rectify the pair, which no computation could use
+                said = (
+                    f"the calibration does not fit this pair ({exc}): Rectify finds no "
+                    "homographies for a pair with one"
+                )
+                if self.calib is self.source_calib:
+                    said += " (start the page without --calib to rectify from features)"
             with self.state:
-                self.state.rows_label = "this pair has a calibration: it is rectified with it"
+                self.state.rows_label = said
             return
         from stereovision.rectification_check import already_rectified
         from stereovision.uncalibrated import rectify_uncalibrated
