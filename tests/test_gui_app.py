@@ -2551,6 +2551,31 @@ def test_a_failed_render_of_a_dragged_view_is_not_said_as_written(tmp_path, monk
     assert MOUSE_RENDER not in app.state.save_label
 
 
+def test_the_save_hint_says_where_a_typed_folder_goes(tmp_path, monkeypatch):
+    """A bare name typed in the save field goes into the first --data folder, not the current
+    one: only the field's tooltip said so. The line under the field says where it goes."""
+    pytest.importorskip("trame")
+    from stereovision.gui.app import SAVE_HINT, StereoApp
+    from stereovision.gui.sources import display_path
+
+    data = tmp_path / "scenes"
+    (tmp_path / "here").mkdir()
+    data.mkdir()
+    monkeypatch.chdir(tmp_path / "here")
+    app = StereoApp.__new__(StereoApp)  # the save field's rule alone: a page takes 0.7 s
+    app.folders = AllowedFolders([data])
+    app._save_roots = list(app.folders.roots)
+    app._offered_save_dir = display_path(data.resolve() / "saved")
+    shown = display_path(data.resolve())  # absolute: outside the current folder
+    assert app._save_hint("mine") == (
+        f"a Save writes into {shown}/mine (relative to the --data folder {shown})"
+    )
+    # relative to the current folder, as the field shows paths; absolute
+    assert app._save_hint("../scenes/typed") == f"a Save writes into {shown}/typed"
+    assert app._save_hint(str(data / "abs")) == f"a Save writes into {shown}/abs"
+    assert app._save_hint("../outside") == SAVE_HINT  # refused by the Save, in its words
+
+
 def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
     """The save field showed the --data folder's absolute path (the README's picture: a
     temporary /tmp/sv-.../scenes/saved). It shows it relative to the current directory when

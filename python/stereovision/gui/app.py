@@ -1706,9 +1706,7 @@ class StereoApp:
         the list and the next Save went home."""
         st = self.state
         st.save_dir_title = self._save_title(st.save_dir)
-        st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
-        if self._offered_save_folder_refused():
-            st.save_hint = READ_ONLY_SAVE_HINT  # a read-only data set: save goes home
+        st.save_hint = self._save_hint(st.save_dir)
         f = self.folders
         self.state.scenes = [{"title": f.label(p), "value": str(p)} for p in f.scenes()]
         home = self._home_saves()
@@ -1809,8 +1807,30 @@ class StereoApp:
         except (ValueError, OSError):
             return ""
 
+    def _save_hint(self, typed: str | None) -> str:
+        """The line under the save field: where a typed folder goes, in sight. A bare name
+        (``mine``) goes into the first ``--data`` folder, not the current one, which only the
+        field's tooltip said."""
+        text = str(typed or "").strip()
+        if not self._save_roots:
+            return NO_SAVE_HINT
+        if text in ("", self._offered_save_dir):
+            # a read-only data set: save goes home
+            return READ_ONLY_SAVE_HINT if self._offered_save_folder_refused() else SAVE_HINT
+        try:
+            folder = self._typed_save_folder(text)
+            p = expand_home(text)
+            in_data = not p.is_absolute() and real_path(Path.cwd() / p) != folder
+        except (ValueError, OSError):  # the Save says why
+            return SAVE_HINT
+        where = f"a Save writes into {display_path(folder)}"
+        if in_data:
+            where += f" (relative to the --data folder {display_path(self._save_roots[0])})"
+        return where
+
     def _on_save_dir(self, save_dir: str | None = None, **_: Any) -> None:
         self.state.save_dir_title = self._save_title(save_dir)
+        self.state.save_hint = self._save_hint(save_dir)
 
     def _fail(
         self,
