@@ -5479,6 +5479,37 @@ def test_a_source_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     assert str(info.value) == f"left source not found: {tmp_path / 'none.mp4'}"
 
 
+def test_a_source_out_of_reach_is_said_unreadable_not_missing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A video behind a folder this user may not enter (EACCES), or a link to one, was "left
+    source not found: v.mp4 (a link to secret/v.mp4, which does not exist)": it is there."""
+    import errno
+
+    (tmp_path / "secret").mkdir()
+    (tmp_path / "secret" / "v.mp4").write_bytes(b"x")
+    link = tmp_path / "v.mp4"
+    link.symlink_to("secret/v.mp4")
+    stat = os.stat
+
+    def denied(p: Any, *args: Any, **kwargs: Any) -> Any:  # as for a user other than root
+        if "secret" in os.fspath(p) or (os.fspath(p) == str(link) and not args and not kwargs):
+            raise PermissionError(errno.EACCES, "Permission denied", os.fspath(p))
+        return stat(p, *args, **kwargs)
+
+    monkeypatch.setattr(os, "stat", denied)
+    with pytest.raises(PermissionError) as info:
+        StereoCamera(link, link)
+    assert str(info.value) == (
+        f"left source cannot be read: {link} (a link to secret/v.mp4): Permission denied"
+    )
+    with pytest.raises(PermissionError) as info:
+        StereoCamera(tmp_path / "secret" / "v.mp4", link)
+    assert str(info.value) == (
+        f"left source cannot be read: {tmp_path / 'secret' / 'v.mp4'}: Permission denied"
+    )
+
+
 def test_a_source_path_with_a_null_byte_is_named(tmp_path: Path) -> None:
     """A path holding a null byte (a name pasted from a C string) was "left source not found:
     a<NUL>b.mp4", the byte printed raw; it is refused as the io writers refuse it (34a60829)."""

@@ -1572,6 +1572,19 @@ def _paired_in_order_note(camera: Any) -> str | None:
     )
 
 
+def _out_of_reach(path: str) -> str | None:
+    """Why ``path``, which ``os.path.exists`` says is not there, cannot be reached when it may
+    be there (``Permission denied``: a folder on its way, or a link's, this user may not
+    enter), else None (it is not there)."""
+    try:
+        os.stat(path)
+    except PermissionError as exc:
+        return exc.strerror or "Permission denied"
+    except (OSError, ValueError):
+        return None
+    return None
+
+
 class StereoCamera(PairSource):
     """Two video sources read as synchronised pairs.
 
@@ -1752,9 +1765,16 @@ class StereoCamera(PairSource):
             if "%" not in path and "://" not in path and not os.path.exists(path):
                 if re.search(r"[*?[]", path):  # "not found" said nothing of the pattern
                     raise FileNotFoundError(_glob_hint(side, path))
+                link = os.path.islink(path)
+                denied = _out_of_reach(path)
+                if denied is not None:
+                    # there, behind a folder this user may not enter: "not found" (or a link's
+                    # target "which does not exist") sent the user looking for a moved file
+                    to = f" (a link to {escaped(os.readlink(path))})" if link else ""
+                    raise PermissionError(f"{side} source cannot be read: {path}{to}: {denied}")
                 # a link whose target moved (a recording on a disk since unmounted) was "not
                 # found" alone, of a name ls lists: its target is named, as io's readers name it
-                gone = f" ({_broken_link(Path(path))})" if os.path.islink(path) else ""
+                gone = f" ({_broken_link(Path(path))})" if link else ""
                 raise FileNotFoundError(f"{side} source not found: {path}{gone}")
             # before any OpenCV call: such a name crashed the process there
             _refuse_non_utf8(path, f"{side} source")
