@@ -2227,6 +2227,35 @@ def test_cli_folder_source_is_one_line_naming_its_pattern(
     assert capsys.readouterr().err == said
 
 
+def test_cli_float32_tiff_sequence_is_saved_with_format_tiff(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A float32 TIFF sequence could not be captured from the CLI: its pairs failed as .png
+    ("... .tiff holds float32"), no option chose .tiff, and -o was left made and empty. The
+    refusal names --format tiff and leaves no folder; --format tiff saves them as they are."""
+    from stereovision.cli import main
+
+    rng = np.random.default_rng(0)
+    frames = [rng.random((6, 8)).astype(np.float32) for _ in range(2)]
+    for side in ("left", "right"):
+        for i, f in enumerate(frames):
+            cv2.imwrite(str(tmp_path / f"{side}{i:02d}.tif"), f)
+    src = ["--left", str(tmp_path / "left%02d.tif"), "--right", str(tmp_path / "right%02d.tif")]
+    out = tmp_path / "out"
+    assert main(["capture", *src, "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: cannot save the left image (float32) as .png without loss: that "
+        "format would write it as 8 bits; .tiff holds float32: give --format tiff\n"
+    )
+    assert not out.exists()
+    assert main(["capture", *src, "-o", str(out), "--format", "tiff"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "left_0001.tiff", "left_0002.tiff", "right_0001.tiff", "right_0002.tiff"
+    ]  # fmt: skip
+    got = cv2.imread(str(out / "right_0002.tiff"), cv2.IMREAD_UNCHANGED)
+    np.testing.assert_array_equal(got, np.dstack([frames[1]] * 3))  # grey made BGR, values kept
+
+
 def test_cli_missing_camera_is_one_line_naming_its_device(
     tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

@@ -3288,6 +3288,7 @@ def capture(
     # File exists" or "[Errno 2] No such file or directory")
     check_output_folder(out, "output folder")
     _refuse_own_output(getattr(camera, "sources", None), out, ext, "output folder")
+    made = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
     stale = remove_stale_temps(out)
     if stale and log is not None:
@@ -3438,6 +3439,13 @@ def capture(
                         lp = out / PAIR_NAME.format(side="left", index=index, ext=ext)
                         log(f"saved {lp.name} {rp.name} (skew {frame.skew_ms:.2f} ms)")
                     raise
+        except ValueError:
+            # a frame the format cannot hold (float32 as .png) fails the first pair: the folder
+            # made for it was left behind, empty
+            if made and not saved:
+                with contextlib.suppress(OSError):
+                    out.rmdir()
+            raise
         except OSError as exc:
             # a full disk, a card turned read-only: the pairs saved before are said, as for a
             # source's failure (the error said neither them nor, from a write, the file)
@@ -3725,8 +3733,9 @@ def cmd_capture(args: argparse.Namespace) -> int:
             "--every and --temporal: give one (--temporal saves a pair per still view)"
         )
     check_output_folder(args.output, "-o")  # before the cameras are opened
+    ext = "." + getattr(args, "format", "png")
     if not args.from_bag:
-        _refuse_own_output({"left": args.left, "right": args.right}, args.output, ".png", "-o")
+        _refuse_own_output({"left": args.left, "right": args.right}, args.output, ext, "-o")
     cam = open_source(args, fps=args.fps)
     saved = [0]  # the pairs this run saved, as capture says them (not another capture's)
     bar = _FramesBar()
@@ -3750,7 +3759,13 @@ def cmd_capture(args: argparse.Namespace) -> int:
             temporal=args.temporal,
             read_timeout=cli_read_timeout(args),
             progress=bar.update,
+            ext=ext,
         )
+    except ValueError as exc:
+        # "... .tiff holds float32" of a float32 image sequence: no option chose .tiff
+        if ext != ".tiff" and re.search(r"\.tiff holds \w+$", str(exc)):
+            raise ValueError(f"{exc}: give --format tiff") from None
+        raise
     except KeyboardInterrupt as exc:
         # what was kept, as `batch` says it (it was "stereovision: interrupted" alone)
         from stereovision._interrupt import Terminated
@@ -3838,6 +3853,13 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument("--fps", type=positive_rate, help="requested frame rate")
     p.add_argument("-o", "--output", required=True, help="output directory")
+    p.add_argument(
+        "--format",
+        choices=("png", "tiff"),
+        default="png",
+        help="image format of the saved pairs: png (8 or 16 bits, default) or tiff (float32 "
+        "frames too, a float TIFF sequence's)",
+    )
     p.add_argument("--count", type=int, help="pairs to save (default: until a source ends)")
     p.add_argument("--chessboard", metavar="COLSxROWS", help="auto-capture distinct board poses")
     p.add_argument(
