@@ -1494,6 +1494,36 @@ def test_a_link_to_a_missing_file_typed_on_the_page_names_its_target(tmp_path: P
         assert str(err.value) == f"no such file: {name} (a link to {target}, which does not exist)"
 
 
+def test_a_file_typed_on_the_page_out_of_reach_is_said_unreadable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A file (or a link to one) behind a folder the user may not enter was "[Errno 13]
+    Permission denied: '/data/secret/x.png'", the link's target alone: what was typed is said,
+    and the link."""
+    import errno
+    import os
+
+    (tmp_path / "secret").mkdir()
+    (tmp_path / "secret" / "x.png").write_bytes(b"png")
+    (tmp_path / "link.png").symlink_to(Path("secret") / "x.png")
+    stat = os.stat
+
+    def denied(p: Any, *args: Any, **kwargs: Any) -> Any:  # as for a user other than root
+        if "secret" in os.fspath(p) and kwargs.get("follow_symlinks", True):
+            raise PermissionError(errno.EACCES, "Permission denied", os.fspath(p))
+        return stat(p, *args, **kwargs)
+
+    monkeypatch.setattr(os, "stat", denied)
+    folders = AllowedFolders([tmp_path])
+    for name, said in (
+        ("link.png", "link.png (a link to secret/x.png)"),
+        ("secret/x.png", "secret/x.png"),
+    ):
+        with pytest.raises(PermissionError) as err:
+            folders.resolve(name)
+        assert str(err.value) == f"cannot read {said}: Permission denied"
+
+
 def test_a_data_folder_or_video_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     # --data data -> moved/data (a disk since unmounted), VideoPair("v.avi") -> moved/v.avi:
     # "not found" alone, of a name ls lists, where load_scene and StereoCamera name the target

@@ -239,6 +239,8 @@ class AllowedFolders:
             If the resolved path is outside every allowed folder (or empty).
         FileNotFoundError
             If it is inside but does not exist.
+        PermissionError
+            If it is inside, behind a folder this user may not enter.
         """
         text = os.fspath(path)
         if not text or "\x00" in text:
@@ -254,7 +256,14 @@ class AllowedFolders:
         real = real_path(p)
         if not any(real == r or real.is_relative_to(r) for r in self.roots):
             raise ValueError(f"path outside the allowed folders: {said}")
-        if not real.exists():
+        try:
+            there = real.exists()
+        except PermissionError as exc:
+            # behind a folder this user may not enter: Python's "[Errno 13] Permission denied:
+            # '/data/secret/x.png'" named neither what was typed nor that a link led there
+            to = f" (a link to {escaped(os.readlink(p))})" if os.path.islink(p) else ""
+            raise PermissionError(f"cannot read {said}{to}: {exc.strerror}") from None
+        if not there:
             raise FileNotFoundError(f"no such file: {said}{_loop_note(p)}")
         return real
 
