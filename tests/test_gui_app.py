@@ -3454,23 +3454,29 @@ def test_rectify_controller_without_a_calibration(data_dir):
 def test_rectify_with_a_calib_that_fits_no_camera_mode_says_it_does_not_fit():
     """Cameras in a mode --calib does not fit (another aspect ratio): "Rectify" said "this pair
     has a calibration: it is rectified with it", of a pair no computation could use it on."""
-    calib = syn.calibration()  # 160x120
-    frame = np.zeros((120, 320, 3), np.uint8)  # twice as wide
+    import asyncio
+    from types import SimpleNamespace
 
-    class Cameras:
-        def read(self):
-            return frame, frame
+    pytest.importorskip("trame")
+    from stereovision.gui.app import StereoApp
 
-        def close(self):
+    class State(SimpleNamespace):  # the page's state, as the button's handler uses it
+        def __enter__(self) -> None:
             pass
 
-    app = _scene_app("test-rectify-unfit", [], source=Cameras(), calib=calib)
-    app._grab()
-    _run(app, app.rectify_from_features)
+        def __exit__(self, *exc: object) -> None:
+            pass
+
+    app = StereoApp.__new__(StereoApp)  # the button's handler alone: a page takes 0.7 s
+    app.state = State(rows_label="")
+    app.calib = app.source_calib = syn.calibration()  # 160x120
+    frame = np.zeros((120, 320, 3), np.uint8)  # twice as wide
+    app.pair = (frame, frame)
+    asyncio.run(app.rectify_from_features())
     assert app.state.rows_label == (
         "the calibration does not fit this pair (calibration is for 160x120 images, the "
-        "frames are 320x120: another aspect ratio (a camera mode that crops), which needs its own "
-        "calibration): Rectify finds no homographies for a pair with one (start the page "
+        "frames are 320x120: another aspect ratio (a camera mode that crops), which needs its "
+        "own calibration): Rectify finds no homographies for a pair with one (start the page "
         "without --calib to rectify from features)"
     )
 
