@@ -2241,13 +2241,13 @@ def test_cli_float32_tiff_sequence_is_saved_with_format_tiff(
         for i, f in enumerate(frames):
             cv2.imwrite(str(tmp_path / f"{side}{i:02d}.tif"), f)
     src = ["--left", str(tmp_path / "left%02d.tif"), "--right", str(tmp_path / "right%02d.tif")]
-    out = tmp_path / "out"
+    out = tmp_path / "new" / "out"
     assert main(["capture", *src, "-o", str(out)]) == 2
     assert capsys.readouterr().err == (
         "stereovision: error: cannot save the left image (float32) as .png without loss: that "
         "format would write it as 8 bits; .tiff holds float32: give --format tiff\n"
     )
-    assert not out.exists()
+    assert not (tmp_path / "new").exists()
     assert main(["capture", *src, "-o", str(out), "--format", "tiff"]) == 0
     assert sorted(p.name for p in out.iterdir()) == [
         "left_0001.tiff", "left_0002.tiff", "right_0001.tiff", "right_0002.tiff"

@@ -3288,7 +3288,8 @@ def capture(
     # File exists" or "[Errno 2] No such file or directory")
     check_output_folder(out, "output folder")
     _refuse_own_output(getattr(camera, "sources", None), out, ext, "output folder")
-    made = not out.exists()
+    # the folders made here, deepest first (-o new/pairs makes two)
+    made = [f for f in (out, *out.parents) if not f.exists()]
     out.mkdir(parents=True, exist_ok=True)
     stale = remove_stale_temps(out)
     if stale and log is not None:
@@ -3442,9 +3443,10 @@ def capture(
         except ValueError:
             # a frame the format cannot hold (float32 as .png) fails the first pair: the folder
             # made for it was left behind, empty
-            if made and not saved:
+            if not saved:
                 with contextlib.suppress(OSError):
-                    out.rmdir()
+                    for folder in made:
+                        folder.rmdir()
             raise
         except OSError as exc:
             # a full disk, a card turned read-only: the pairs saved before are said, as for a
