@@ -1524,6 +1524,34 @@ def test_a_file_typed_on_the_page_out_of_reach_is_said_unreadable(
         assert str(err.value) == f"cannot read {said}: Permission denied"
 
 
+def test_a_data_folder_out_of_reach_is_said_unreadable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--data behind a folder the user may not enter, or a link to one: "[Errno 13] Permission
+    denied: '/mnt/secret/data'", a link's target alone, not the folder given."""
+    import errno
+    import os
+
+    (tmp_path / "secret" / "data").mkdir(parents=True)
+    (tmp_path / "data").symlink_to(Path("secret") / "data")
+    stat = os.stat
+
+    def denied(p: Any, *args: Any, **kwargs: Any) -> Any:  # as for a user other than root
+        if os.fspath(p) == str(tmp_path / "data") or "secret" in os.fspath(p):
+            if kwargs.get("follow_symlinks", True):
+                raise PermissionError(errno.EACCES, "Permission denied", os.fspath(p))
+        return stat(p, *args, **kwargs)
+
+    monkeypatch.setattr(os, "stat", denied)
+    for given, said in (
+        (tmp_path / "data", f"{tmp_path / 'data'} (a link to secret/data)"),
+        (tmp_path / "secret" / "data", str(tmp_path / "secret" / "data")),
+    ):
+        with pytest.raises(PermissionError) as err:
+            AllowedFolders([given])
+        assert str(err.value) == f"data folder cannot be read: {said}: Permission denied"
+
+
 def test_a_data_folder_or_video_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     # --data data -> moved/data (a disk since unmounted), VideoPair("v.avi") -> moved/v.avi:
     # "not found" alone, of a name ls lists, where load_scene and StereoCamera name the target

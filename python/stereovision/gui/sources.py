@@ -180,6 +180,8 @@ class AllowedFolders:
     ------
     FileNotFoundError
         If a root is not an existing folder.
+    PermissionError
+        If a root lies behind a folder this user may not enter.
     ValueError
         If a root is empty or blank (spaces naming no folder), or under the home folder of a
         user no one knows.
@@ -197,7 +199,16 @@ class AllowedFolders:
             # ~bob/x of an unknown user: said as the page says it (not "Could not determine
             # home directory.")
             p = expand_home(text)
-            if not p.is_dir():  # a file that is there was said only as "not found"
+            try:
+                folder = p.is_dir()
+            except PermissionError as exc:
+                # behind a folder this user may not enter: "[Errno 13] Permission denied:
+                # '/mnt/secret/data'" named a link's target alone, not the folder given
+                to = f" (a link to {escaped(os.readlink(p))})" if os.path.islink(p) else ""
+                raise PermissionError(
+                    f"data folder cannot be read: {r}{to}: {exc.strerror}"
+                ) from None
+            if not folder:  # a file that is there was said only as "not found"
                 there = " is a file, not a folder" if p.exists() else ""
                 if not there and p.is_symlink():
                     from stereovision.io import _broken_link
