@@ -343,6 +343,17 @@ def test_the_lists_read_an_unchanged_folder_once(
     assert sorted(read) == [str(tmp_path), str(tmp_path / "s")]
     (tmp_path / "s" / "d.ply").write_bytes(b"x")
     assert folders.files(sources.CLOUD_SUFFIXES) == [tmp_path / "s" / n for n in ("c.ply", "d.ply")]
+    # past MAX_KEPT_NAMES names a folder is read each time (not held in memory)
+    os.utime(tmp_path / "s", (old, old))
+    monkeypatch.setattr(sources, "MAX_KEPT_NAMES", 1)
+    read.clear()
+    few = AllowedFolders([tmp_path / "s"])
+    for _ in range(2):
+        assert few.files(sources.CLOUD_SUFFIXES) == [
+            tmp_path / "s" / "c.ply",
+            tmp_path / "s" / "d.ply",
+        ]
+    assert read == [str(tmp_path / "s")] * 2 and few._kept_names == 0
 
 
 def test_scenes_skip_hidden_links_out_and_stop_at_max_listed(

@@ -58,6 +58,10 @@ VIDEO_SUFFIXES = frozenset({".avi", ".mp4", ".mkv", ".mov", ".webm"})
 #: At most this many files / scenes are listed per kind (a huge folder must not stall the page).
 MAX_LISTED = 500
 
+#: At most this many names of the folders walked are kept between the lists' refreshes
+#: (:meth:`AllowedFolders._listed`): some 20 MB.
+MAX_KEPT_NAMES = 300_000
+
 #: A source's frame: BGR, ``uint16`` for a 16-bit image file or sequence (kept at its 16 bits,
 #: as ``batch`` and ``capture`` read it), else ``uint8``.
 Frame = npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
@@ -235,6 +239,7 @@ class AllowedFolders:
             self._names[r] = Path(*r.parts[-depth:]).as_posix()
         #: Each folder walked: its mtime, sub-folders to walk and file names (:meth:`_listed`).
         self._listing: dict[str, tuple[int, list[str], list[str]]] = {}
+        self._kept_names = 0  # names held in _listing
 
     def resolve(self, path: str | os.PathLike[str]) -> Path:
         """The real path of ``path`` if it lies inside an allowed folder.
@@ -370,8 +375,13 @@ class AllowedFolders:
         names.sort()
         # a folder changed within the last 2 s may change again within its mtime's tick
         # (1 s or 2 s on some file systems): read again next time
+        # (and at most MAX_KEPT_NAMES names in all: a --data of millions of files is read
+        # each time, as before, not held in memory)
+        kept_names = self._kept_names - (len(kept[1]) + len(kept[2]) if kept else 0)
         if time.time_ns() - mtime > 2_000_000_000:
-            self._listing[folder] = (mtime, subs, names)
+            if kept_names + len(subs) + len(names) <= MAX_KEPT_NAMES:
+                self._listing[folder] = (mtime, subs, names)
+                self._kept_names = kept_names + len(subs) + len(names)
         return subs, names
 
     def _tree(self, root: Path) -> Iterator[tuple[str, list[str]]]:
