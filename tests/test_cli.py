@@ -3521,6 +3521,55 @@ def test_every_way_of_typing_a_unit_after_a_metre_value_is_told_to_leave_it_out(
 
 
 @pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (
+            ["depth", "l.png", "r.png", "--grid", "50ft"],
+            "--grid: expected a number of metres "
+            "without a unit (50 ft is 15.24 m, outside 0.01 to 10 m), got '50ft'",
+        ),
+        (
+            ["depth", "l.png", "r.png", "--grid", "0.1in"],
+            "--grid: expected a number of metres "
+            "without a unit (0.1 in is 0.00254 m, outside 0.01 to 10 m), got '0.1in'",
+        ),
+        (
+            ["depth", "l.png", "r.png", "--grid", "2ft"],
+            "--grid: expected a number of metres "
+            "without a unit (2 ft is 0.6096 m: give 0.6096), got '2ft'",
+        ),
+        (
+            ["batch", "in", "out", "--grid", "50ft"],
+            "--grid: expected a number of metres "
+            "without a unit (50 ft is 15.24 m, outside 0.01 to 10 m), got '50ft'",
+        ),
+        (
+            ["info", "--baseline", "4e6ft"],
+            "--baseline: expected a number of metres without a "
+            "unit (4e+06 ft is 1.2192e+06 m, outside 0 to 1e+06 m), got '4e6ft'",
+        ),
+        (
+            ["view", "c.ply", "--up=-4e6ft", "-o", "s.png"],
+            "--up: expected metres from -1e+06 "
+            "to 1e+06 without a unit (-4e+06 ft is -1.2192e+06 m, outside -1e+06 to 1e+06 m), "
+            "got '-4e6ft'",
+        ),
+    ],
+)
+def test_a_length_typed_in_feet_is_never_said_as_a_value_the_option_refuses(
+    argv: list[str], said: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--grid 50ft`` was told "give 15.24", which --grid then refused (0.01 to 10 m): a length
+    outside the option's range is said with the range, not as a value to give."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert capsys.readouterr().err == (
+        f"stereovision {argv[0]}: error: argument {said} (see stereovision {argv[0]} --help)\n"
+    )
+
+
+@pytest.mark.parametrize(
     ("value", "hint"),
     [
         ("2ft", "2 ft is 0.6096 m: give 0.6096"),

@@ -2900,7 +2900,7 @@ def add_cli(subparsers: Any) -> None:
         _METHOD_HELP,
         CALIB_FILES_HELP,
         add_calib_unit,
-        metres,
+        cell_metres,
         positive_pixels,
     )
     from stereovision.depth import METHODS
@@ -2962,7 +2962,7 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--grid",
-        type=metres,
+        type=cell_metres,
         metavar="M",
         help="with --ground: an occupancy grid of M-metre cells",
     )

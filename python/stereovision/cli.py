@@ -406,8 +406,9 @@ def depth_outputs(
         raise CliError("--ground needs --calib (the floor is found in metres)")
     if grid is not None and not ground:
         raise CliError("--grid needs --ground (the grid lies on the floor)")
-    if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
-        raise CliError(f"--grid: expected a cell side from 0.01 to 10 m, got {grid}")
+    lo, hi = GRID_CELL_M
+    if grid is not None and not (math.isfinite(grid) and lo <= grid <= hi):
+        raise CliError(f"--grid: expected a cell side from {lo:g} to {hi:g} m, got {grid}")
     from stereovision._validate import positive_finite
 
     for value, flag in ((max_depth, "--max-depth"), (max_sigma, "--max-sigma"), (voxel, "--voxel")):
@@ -1573,6 +1574,12 @@ def _paper_baseline_words(text: str, baseline: float) -> str:
 MAX_PAPER_BASELINE_M = 1e6
 
 
+def paper_baseline(text: str) -> float:
+    """argparse type of ``info --baseline``: :func:`metres` (its range is checked with the other
+    options) whose unit hint keeps to :data:`MAX_PAPER_BASELINE_M`."""
+    return metres(text, within=(0.0, MAX_PAPER_BASELINE_M))
+
+
 def _given_size_note(calib: Any, beside: Path | None = None) -> str:
     """``info CALIB --size WxH``'s line for a calibration that holds no image size: the field
     of view is the size given's (the depths are not), and a principal point outside that size
@@ -2352,7 +2359,10 @@ def _with_unit_hint(message: str) -> str:
         return message
     unit = _OPTION_UNITS.get(m[1].split("/")[-1])
     if unit == "m":  # view's moves, either way: 2ft said in metres, as the metre options say it
-        return f"argument {m[1]}: {m[2]}{_metres_hint(typed, signed=True)}, got {m[3]}"
+        from stereovision.render import VIEW_MAX_MOVE_M
+
+        hint = _metres_hint(typed, signed=True, within=(-VIEW_MAX_MOVE_M, VIEW_MAX_MOVE_M))
+        return f"argument {m[1]}: {m[2]}{hint}, got {m[3]}"
     example = f" (5 for 5 {unit})" if unit else ""
     return f"argument {m[1]}: {m[2]} without a unit{example}, got {m[3]}"
 
@@ -2397,27 +2407,42 @@ def positive_metres(text: str) -> float:
     return value
 
 
-def metres(text: str) -> float:
-    """argparse type of ``--grid``: a number of metres, as a plain number (its range is checked
-    with the other options, in :func:`run_depth`); ``5m`` said only "expected a number"."""
+def metres(text: str, within: tuple[float, float] | None = None) -> float:
+    """argparse type of a length option: a number of metres, as a plain number (its range is
+    checked with the other options); ``5m`` said only "expected a number". ``within``: the
+    option's range, which the hint for a value typed with a unit keeps to (:func:`_metres_hint`).
+    """
     try:
         return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"expected a number of metres{_metres_hint(text)}, got {text!r}"
+            f"expected a number of metres{_metres_hint(text, within=within)}, got {text!r}"
         ) from None
+
+
+#: Smallest and largest ``depth --grid`` cell side, in metres.
+GRID_CELL_M = (0.01, 10.0)
+
+
+def cell_metres(text: str) -> float:
+    """argparse type of ``depth --grid``: :func:`metres` (its range is checked with the other
+    options, in :func:`run_depth`) whose unit hint keeps to :data:`GRID_CELL_M`: ``50ft`` was
+    told "give 15.24", which the option then refused."""
+    return metres(text, within=GRID_CELL_M)
 
 
 #: The length units typed as a mark: 5' is 5 ft, 5" 5 in.
 _UNIT_MARKS = {"'": "ft", '"': "in"}
 
 
-def _metres_hint(text: str, signed: bool = False) -> str:
+def _metres_hint(text: str, signed: bool = False, within: tuple[float, float] | None = None) -> str:
     """The hint of a metre option's refusal of ``text`` typed with a unit: a positive length
     (any nonzero one for a ``signed`` option: ``view --forward -2ft``) in another unit of
     :data:`~stereovision.calibration.UNIT_TO_METRES` said in metres (``5ft`` -> `` without a
     unit (5 ft is 1.524 m: give 1.524)``), since "5 for 5 m" sent the user to 5 m; any other
-    unit word ``(5 for 5 m)``; no unit, nothing."""
+    unit word ``(5 for 5 m)``; no unit, nothing. A length outside the option's range
+    ``within`` (metres, inclusive) is said with that range, not as a value to give (``--grid
+    50ft`` was told "give 15.24", past its 10 m)."""
     from stereovision.calibration import UNIT_TO_METRES
 
     typed = _UNIT_SUFFIXED.match(text)
@@ -2428,7 +2453,11 @@ def _metres_hint(text: str, signed: bool = False) -> str:
     length = math.isfinite(value) and (value != 0 if signed else value > 0)
     if unit == "m" or unit not in UNIT_TO_METRES or not length:
         return " without a unit (5 for 5 m)"
-    shown = f"{value * UNIT_TO_METRES[unit]:g}"
+    in_metres = value * UNIT_TO_METRES[unit]
+    shown = f"{in_metres:g}"
+    if within is not None and not within[0] <= in_metres <= within[1]:
+        lo, hi = within
+        return f" without a unit ({value:g} {unit} is {shown} m, outside {lo:g} to {hi:g} m)"
     return f" without a unit ({value:g} {unit} is {shown} m: give {shown})"
 
 
@@ -2805,7 +2834,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--grid",
-        type=metres,
+        type=cell_metres,
         metavar="M",
         help="with --ground: a bird's-eye occupancy grid of M-metre cells, 20 m ahead and 10 m "
         "to each side, as ROS map_server's map.png and map.yaml",
@@ -2913,7 +2942,9 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"a rig on paper: horizontal FOV, {HFOV_RANGE_DEG[0]:g} to under "
         f"{HFOV_RANGE_DEG[1]:g} degrees",
     )
-    d.add_argument("--baseline", type=metres, metavar="M", help="a rig on paper: baseline (m)")
+    d.add_argument(
+        "--baseline", type=paper_baseline, metavar="M", help="a rig on paper: baseline (m)"
+    )
     d.add_argument("--left-topic", help="a bag: its left image topic (default: found)")
     d.add_argument("--right-topic", help="a bag: its right image topic (default: found)")
     d.set_defaults(func=cmd_info)
