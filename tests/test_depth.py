@@ -1363,6 +1363,34 @@ def test_a_min_depth_of_0_is_a_limit_and_the_filled_guess_obeys_max_depth() -> N
         assert _kept(r.filtered(max_depth=2.5).point_image(filled=True)[..., 2]) == [1, 2, 2.5]
 
 
+@pytest.mark.parametrize(
+    ("first", "then", "said"),
+    [
+        ({"max_depth": 2.5}, {"min_depth": 3}, "3 > 2.5 m (max_depth from an earlier filtered())"),
+        (
+            {"max_depth": 2.5},
+            {"min_depth": 3, "max_depth": 10},
+            "3 > 2.5 m (max_depth from an earlier filtered())",
+        ),
+        ({"min_depth": 3}, {"max_depth": 2}, "3 > 2 m (min_depth from an earlier filtered())"),
+        ({"max_depth": 5}, {"min_depth": 3, "max_depth": 2}, "3 > 2 m"),
+    ],
+)
+def test_chained_filtered_calls_refuse_an_empty_range_as_one_call_does(
+    first: dict[str, float], then: dict[str, float], said: str
+) -> None:
+    """``filtered(max_depth=2.5).filtered(min_depth=3)`` was silently empty (limits min 3, max
+    2.5) where ``filtered(min_depth=3, max_depth=2.5)`` is refused: the chain is refused too,
+    naming the limit of the earlier call; a range of one depth is still a range."""
+    r = _hand_result()
+    with pytest.raises(ValueError) as err:
+        r.filtered(**first).filtered(**then)
+    assert str(err.value) == f"min_depth, max_depth: an empty range, {said}"
+    one = r.filtered(max_depth=2).filtered(min_depth=2)
+    assert one.limits == {"max_depth": 2.0, "min_depth": 2.0}
+    assert _kept(one.require_depth()) == [2]
+
+
 def test_a_hand_made_result_prints_its_depth_range_and_counts_a_zero_confidence_depth() -> None:
     """The summary gives the depth range lowest first (1-5 m, median 2 m, on 3 of 6 pixels);
     a measured pixel with confidence 0 that has a depth is not "filled": the counts still add

@@ -927,13 +927,16 @@ class DepthResult:
         Returns
         -------
         DepthResult
-            The filtered copy (this result is unchanged).
+            The filtered copy (this result is unchanged). Filtering a filtered result keeps
+            the tighter of each limit (:attr:`limits`).
 
         Raises
         ------
         ValueError
-            A result without depth (no calibration), or a limit that is not a positive
-            number (``min_depth`` may be 0).
+            A result without depth (no calibration), a limit that is not a positive
+            number (``min_depth`` may be 0), or a ``min_depth`` above ``max_depth``, one of
+            them given to an earlier call (``filtered(max_depth=2.5).filtered(min_depth=3)``
+            is refused as ``filtered(min_depth=3, max_depth=2.5)`` is).
         """
         if self.depth is None:
             raise ValueError(NO_DEPTH.format(what="depth to filter"))
@@ -949,9 +952,21 @@ class DepthResult:
                 ok_number and _finite(v) and (v > 0 or (name == "min_depth" and v == 0))
             ):
                 raise ValueError(f"{name}: expected a positive number, got {number_shown(v)}")
-        if min_depth is not None and max_depth is not None and min_depth > max_depth:
+        tighter = {"min_depth": max}  # the other limits: the smaller of two
+        merged = dict(self.limits)
+        for name, v in limits.items():
+            if v is not None:
+                merged[name] = float(tighter.get(name, min)(merged.get(name, v), v))
+        lo, hi = merged.get("min_depth"), merged.get("max_depth")
+        if lo is not None and hi is not None and lo > hi:
+            # a chained call's empty range was a silently empty result
+            now = {k: limits[k] for k in ("min_depth", "max_depth") if limits[k] == merged[k]}
+            earlier = [k for k in ("min_depth", "max_depth") if k not in now]
+            said = f" ({' and '.join(earlier)} from an earlier filtered())" if earlier else ""
+            lo = now.get("min_depth", _whole_or_float(lo))  # 3 as given, not 3.0
+            hi = now.get("max_depth", _whole_or_float(hi))
             raise ValueError(
-                f"min_depth, max_depth: an empty range, {_shown(min_depth)} > {_shown(max_depth)} m"
+                f"min_depth, max_depth: an empty range, {_shown(lo)} > {_shown(hi)} m{said}"
             )
         z = self.depth
         keep = np.isfinite(z)
@@ -978,11 +993,6 @@ class DepthResult:
             points, colors, pixels = self.points[on], self.colors[on], self.pixels[on]
         else:
             points, colors, pixels = self.points, self.colors, self.pixels
-        tighter = {"min_depth": max}  # the other limits: the smaller of two
-        merged = dict(self.limits)
-        for name, v in limits.items():
-            if v is not None:
-                merged[name] = float(tighter.get(name, min)(merged.get(name, v), v))
         return dataclasses.replace(
             self,
             limits=merged,
