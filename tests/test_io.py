@@ -632,6 +632,27 @@ def test_load_scene_of_middleburys_names_says_the_names_a_scene_takes(tmp_path: 
     assert str(err.value) == f"image file not found: {tmp_path / 'right.png'}"
 
 
+def test_a_missing_image_names_the_one_file_of_its_stem_beside_it(tmp_path: Path) -> None:
+    """``image file not found: left.png`` beside a ``left.jpg`` said nothing of it: the one
+    image of the same stem and another suffix is offered; none for two such files or for a
+    file that is no image."""
+    (tmp_path / "left.txt").write_bytes(b"")
+    with pytest.raises(FileNotFoundError) as err:
+        read_image(tmp_path / "left.png")
+    assert str(err.value) == f"image file not found: {tmp_path / 'left.png'}"
+    (tmp_path / "left.JPG").write_bytes(b"")
+    for typed in ("left.png", "left"):
+        with pytest.raises(FileNotFoundError) as err:
+            read_image(tmp_path / typed)
+        assert str(err.value) == (
+            f"image file not found: {tmp_path / typed} (did you mean {tmp_path / 'left.JPG'}?)"
+        )
+    (tmp_path / "left.tif").write_bytes(b"")
+    with pytest.raises(FileNotFoundError) as err:
+        read_image(tmp_path / "left.png")
+    assert str(err.value) == f"image file not found: {tmp_path / 'left.png'}"
+
+
 def test_load_scene_and_view_of_a_pair_named_in_another_case_say_the_names(
     tmp_path: Path,
 ) -> None:

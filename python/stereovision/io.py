@@ -937,11 +937,34 @@ def _broken_link(link: Path) -> str:
     return ", ".join(f"a link to {t}" for t in hops) + ", which does not exist"
 
 
+def _other_suffix(path: Path) -> str:
+    """`` (did you mean left.jpg?)`` for a missing image ``left.png`` beside which exactly one
+    image of the same stem and another image suffix lies (``--left left.png`` of a folder of
+    JPEGs was "not found" alone), else ""."""
+    from stereovision.batch import IMAGE_EXTS
+
+    try:
+        names = [
+            e.name
+            for e in os.scandir(path.parent)
+            if Path(e.name).stem == path.stem
+            and e.name != path.name
+            and Path(e.name).suffix.lower() in IMAGE_EXTS
+        ]
+    except OSError:  # no such folder, or one not readable: nothing to suggest
+        return ""
+    if len(names) != 1:
+        return ""
+    return f" (did you mean {escaped(str(path.with_name(names[0])))}?)"
+
+
 def _existing_file(path: PathLike, what: str) -> Path:
     p = as_path(path, file=True)
     if not p.exists():
         # a link whose target moved reads as no file at all: which one is missing is said
         gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+        if not gone and what == "image file":
+            gone = _other_suffix(p)
         raise FileNotFoundError(f"{what} not found: {p}{gone}")
     if not p.is_file():
         hint = _pair_in_folder(p) if what == "image file" else ""
