@@ -2469,7 +2469,9 @@ def test_depth_says_its_depths_in_metres_unless_unit_is_given(
     """The summary's depths are in metres by default and in --unit's unit when given (a wall
     about 8 px apart, 150 px focal, 0.1 m baseline: near 1.9 m); depth.npy stays in metres.
     A depth of 1000 or more in the unit was said in exponent form (``--unit mm``: "depth
-    1.87e+03-1.93e+03 mm"); now in whole units."""
+    1.87e+03-1.93e+03 mm"); now in whole units. ``--unit mm --max-depth 1000`` kept every
+    depth without a word (1000 m, the limits stay in metres): it is warned of, naming the
+    --max-depth that 1000 mm is; with --unit m (or ft, where it cuts nothing either way) not."""
     from tests import synthetic_scene as syn
 
     rng = np.random.default_rng(0)
@@ -2484,8 +2486,17 @@ def test_depth_says_its_depths_in_metres_unless_unit_is_given(
     medians = {}
     for unit in ("m", "ft", "mm"):
         extra = [] if unit == "m" else ["--unit", unit]
-        assert main([*argv, *extra, "-o", str(tmp_path / unit)]) == 0
-        line = capsys.readouterr().out.splitlines()[0]
+        assert main([*argv, *extra, "--max-depth", "1000", "-o", str(tmp_path / unit)]) == 0
+        out, err = capsys.readouterr()
+        line = out.splitlines()[0]
+        if unit == "mm":
+            assert re.fullmatch(
+                r"stereovision: warning: --max-depth 1000 is in metres, whatever --unit: 1000 m "
+                r"keeps every depth \(the largest [\d.]+ m\); for 1000 mm give --max-depth 1\n",
+                err,
+            ), err
+        else:
+            assert err == ""
         found = re.search(rf"depth [\d.]+-[\d.]+ {unit} \(median ([\d.]+) {unit}\)", line)
         assert found, line
         medians[unit] = float(found.group(1))

@@ -874,6 +874,15 @@ def cmd_depth(args: argparse.Namespace) -> int:
         tight = _below_max_sigma(res.depth, unfiltered[0], args.max_sigma, args.max_depth)
         if tight is not None:
             warnings.warn(tight, stacklevel=1)
+    for flag, value, of in (
+        ("--max-depth", args.max_depth, "depth"),
+        ("--max-sigma", args.max_sigma, "depth_sigma"),
+    ):
+        if value is not None and unfiltered:
+            # --unit mm --max-depth 3000 kept every depth (3000 m): the limits stay in metres
+            odd = _limit_not_in_unit(flag, value, unit, getattr(unfiltered[0], of))
+            if odd is not None:
+                warnings.warn(odd, stacklevel=1)
     if args.voxel is not None and "cloud.ply" in written:
         # the cloud.ply of --voxel holds fewer points than the result: "N points" read as its
         # (the count comes from the writer: the file was read back whole to count its points)
@@ -942,6 +951,44 @@ def _beyond_max_depth(depth: np.ndarray, before: np.ndarray, max_depth: float) -
     if float(shown) <= max_depth:  # 2.0004 shown as "2" read as within --max-depth 2
         shown = f"{nearest:.7g}"
     return f"no depth within --max-depth {max_depth:g} m (the nearest is {shown} m)"
+
+
+def _limit_not_in_unit(flag: str, value: float, unit: str, values: np.ndarray | None) -> str | None:
+    """The warning of a ``--max-depth`` or ``--max-sigma`` (metres, whatever ``--unit``) that
+    looks given in ``--unit``: in metres it keeps every one of ``values`` (the frame's depths
+    or depth sigmas, metres), in ``unit`` it would have kept fewer (``--unit mm --max-depth
+    3000`` kept all, 3000 m); None otherwise, and for ``--unit m``.
+
+    Parameters
+    ----------
+    flag : str
+        ``--max-depth`` or ``--max-sigma``.
+    value : float
+        The option's value, metres.
+    unit : str
+        ``--unit``, a key of :data:`~stereovision.calibration.UNIT_TO_METRES`.
+    values : ndarray or None
+        The frame's depths or depth sigmas before the limit, metres, NaN where none.
+
+    Returns
+    -------
+    str or None
+        ``--max-depth 3000 is in metres, whatever --unit: 3000 m keeps every depth (the
+        largest 6.34 m); for 3000 mm give --max-depth 3``, or None.
+    """
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if unit == "m" or values is None or not np.isfinite(values).any():
+        return None
+    top = float(np.nanmax(values))
+    meant = value * UNIT_TO_METRES[unit]
+    if value < top or meant >= top:  # the limit takes some in metres, or none either way
+        return None
+    what = "depth" if flag == "--max-depth" else "depth sigma"
+    return (
+        f"{flag} {value:g} is in metres, whatever --unit: {value:g} m keeps every {what} (the "
+        f"largest {figure_shown(top)} m); for {value:g} {unit} give {flag} {meant:g}"
+    )
 
 
 def _below_max_sigma(
