@@ -635,8 +635,9 @@ def test_load_scene_of_middleburys_names_says_the_names_a_scene_takes(tmp_path: 
 def test_a_missing_image_names_the_one_file_of_its_stem_beside_it(tmp_path: Path) -> None:
     """``image file not found: left.png`` beside a ``left.jpg`` said nothing of it: the one
     image of the same stem and another suffix is offered; none for two such files or for a
-    file that is no image."""
+    file that is no image (nor for a folder named as an image)."""
     (tmp_path / "left.txt").write_bytes(b"")
+    (tmp_path / "left.webp").mkdir()  # a folder of an image's name is no image to offer
     with pytest.raises(FileNotFoundError) as err:
         read_image(tmp_path / "left.png")
     assert str(err.value) == f"image file not found: {tmp_path / 'left.png'}"

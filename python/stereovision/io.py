@@ -939,7 +939,7 @@ def _broken_link(link: Path) -> str:
 
 def _other_suffix(path: Path) -> str:
     """`` (did you mean left.jpg?)`` for a missing image ``left.png`` beside which exactly one
-    image of the same stem and another image suffix lies (``--left left.png`` of a folder of
+    image file of the same stem and another image suffix lies (``--left left.png`` of a folder of
     JPEGs was "not found" alone), else ""."""
     from stereovision.batch import IMAGE_EXTS
 
@@ -950,6 +950,7 @@ def _other_suffix(path: Path) -> str:
             if Path(e.name).stem == path.stem
             and e.name != path.name
             and Path(e.name).suffix.lower() in IMAGE_EXTS
+            and e.is_file()  # a folder named left.jpg is no image to offer
         ]
     except OSError:  # no such folder, or one not readable: nothing to suggest
         return ""
