@@ -3679,6 +3679,39 @@ def test_a_value_starting_with_a_dash_is_told_in_the_options_long_form(
     )
 
 
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (
+            ["info", "--size", "64x48", "--hfov", "60", "--baseline", "0.1",
+             "--max-disparity=64"],
+            "stereovision info: error: unrecognized arguments: --max-disparity=64 (see "
+            "stereovision info --help)",
+        ),
+        (
+            ["depth", "l.png", "r.png", "--maxdisparity=64", "-o", "out"],
+            "stereovision depth: error: unrecognized arguments: --maxdisparity=64; did you mean "
+            "--max-disparity? (see stereovision depth --help)",
+        ),
+        (
+            ["depth", "l.png", "r.png", "extra.png", "-o", "out"],
+            "stereovision depth: error: unrecognized arguments: extra.png (see stereovision "
+            "depth --help)",
+        ),
+    ],
+)  # fmt: skip
+def test_a_word_no_option_took_is_refused_by_its_command_with_the_option_meant(
+    capsys: pytest.CaptureFixture[str], argv: list[str], said: str
+) -> None:
+    """An option a command has not was "stereovision: error: unrecognized arguments: ... (see
+    stereovision --help)", the command list's help, and a mistyped one was not named: the
+    command refuses it, with the option that is close to it."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert capsys.readouterr().err == said + "\n"
+
+
 def test_an_option_given_twice_the_last_without_its_value_says_expected_one_argument(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import difflib
 import functools
 import json
 import math
@@ -2657,6 +2658,25 @@ class _Parser(argparse.ArgumentParser):
         namespace, extras = super().parse_known_args(args, namespace)
         self._refuse_empty_values(namespace)
         return namespace, extras
+
+    def parse_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: Any = None
+    ) -> Any:
+        """argparse's, but words no option took are refused by the command they were typed
+        to: ``stereovision info ... --max-disparity 64`` said "stereovision: error:
+        unrecognized arguments: --max-disparity (see stereovision --help)", the help of the
+        command list, and a mistyped option (``--maxdisparity``) was not named."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            subs = [a for a in self._actions if isinstance(a, argparse._SubParsersAction)]
+            command = getattr(parsed, subs[0].dest, None) if subs else None
+            by = subs[0].choices.get(command, self) if isinstance(command, str) else self
+            known = [o for a in by._actions for o in a.option_strings if o.startswith("--")]
+            typed = [w.split("=")[0] for w in extras if w.startswith("--")]
+            near = [m for w in typed for m in difflib.get_close_matches(w, known, n=1)]
+            hint = f"; did you mean {', '.join(dict.fromkeys(near))}?" if near else ""
+            by.error(f"unrecognized arguments: {' '.join(extras)}{hint}")
+        return parsed
 
     def _refuse_empty_values(self, namespace: Any) -> None:
         """An empty value typed for a path, source, topic or pattern (``-o "$OUT"``, ``batch
