@@ -2403,6 +2403,38 @@ def test_check_output_folder_error_classes(tmp_path: Path, monkeypatch: pytest.M
     )
 
 
+def test_a_tilde_the_shell_left_as_typed_is_not_made_a_folder_named_tilde(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--output=~/out`` (bash expands no ~ after '=') made a folder named "~" in the current
+    one and wrote there; an image typed ``"~/l.png"`` was "not found" alone. The folder is
+    refused, the image's message offers the home's file; ./~/out, or a ~ folder that is
+    there, is taken as typed."""
+    from stereovision.io import check_output_folder
+
+    home, cwd = tmp_path / "home", tmp_path / "cwd"
+    home.mkdir()
+    cwd.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir(cwd)
+    with pytest.raises(ValueError) as err:
+        check_output_folder("~/out", "-o")
+    assert str(err.value) == (
+        "-o ~/out: ~ is not expanded here (the shell leaves it as typed after '=' or in "
+        f"quotes): give {home / 'out'}, or ./~/out for a folder named ~"
+    )
+    check_output_folder("./~/out", "-o")
+    cv2.imwrite(str(home / "l.png"), np.zeros((2, 2), np.uint8))
+    with pytest.raises(FileNotFoundError) as missing:
+        read_image("~/l.png")
+    assert str(missing.value) == (
+        f"image file not found: ~/l.png (~ is not expanded here: did you mean {home / 'l.png'}?)"
+    )
+    (cwd / "~").mkdir()  # a folder of that name, made on purpose: taken
+    check_output_folder("~/out", "-o")
+    assert not (cwd / "~" / "out").exists()
+
+
 def test_check_destinations_a_loop_and_a_hard_link(tmp_path: Path) -> None:
     """A looping link is said as a loop alone (not 'is a link to itself; ...'), its errno
     kept (ELOOP); right.yaml a hard link of left.yaml is one file, as a symbolic one is."""

@@ -263,6 +263,14 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
             f"{flag} -: the outputs are files in a folder, not a stream for standard output: "
             "name a folder"
         )
+    home = _unexpanded_home(folder)
+    if home is not None:
+        # `--output=~/out` (bash expands no ~ after "=", nor in quotes) made a folder named "~"
+        # in the current one; ./~/out still names such a folder
+        raise ValueError(
+            f"{flag} {folder}: ~ is not expanded here (the shell leaves it as typed after '=' "
+            f"or in quotes): give {escaped(home)}, or ./{folder} for a folder named ~"
+        )
     path = Path(folder)
     if path.exists() and not path.is_dir():
         # a FIFO is no file either: "not a folder", as make_folder says it
@@ -278,6 +286,19 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
     why = cannot_write_in(above) if above.exists() else None
     if why:
         raise PermissionError(f"{flag} {path}: cannot write in {above} ({why})")
+
+
+def _unexpanded_home(path: PathLike) -> str | None:
+    """``path`` with its leading ``~`` (or ``~user``) expanded, when it is text that starts
+    with one the shell left as typed and no such file or folder is in the current folder
+    (``~/out`` with no ``./~``); else None."""
+    if not isinstance(path, str) or not path.startswith("~"):
+        return None
+    first = path.split("/", 1)[0]
+    home = os.path.expanduser(first)
+    if home == first or os.path.lexists(first):
+        return None
+    return os.path.expanduser(path)
 
 
 def cannot_write_in(folder: PathLike) -> str | None:
@@ -964,6 +985,9 @@ def _existing_file(path: PathLike, what: str) -> Path:
     if not p.exists():
         # a link whose target moved reads as no file at all: which one is missing is said
         gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
+        home = _unexpanded_home(path)
+        if not gone and home is not None and os.path.exists(home):
+            gone = f" (~ is not expanded here: did you mean {escaped(home)}?)"
         if not gone and what == "image file":
             gone = _other_suffix(p)
         raise FileNotFoundError(f"{what} not found: {p}{gone}")
