@@ -327,6 +327,54 @@ def test_report_files(chessboard: tuple[Calibration, CalibrationReport], tmp_pat
         assert img is not None and img.shape[1] > 100
     with pytest.raises(ValueError, match=r"\.txt"):
         rep.save(tmp_path / "report.txt")
+    for fmt in ("yaml", "json"):  # read back: the same figures and calibration
+        back = CalibrationReport.load(paths[fmt])
+        assert back.as_dict() == rep.as_dict() and back.pattern == (9, 6)
+        assert back._calibration == rep._calibration
+
+
+def _figures_report(**changes: Any) -> CalibrationReport:
+    """A report of made-up figures (no solve), ``changes`` replacing some."""
+    figures: dict[str, Any] = dict(
+        rms=0.2, rms_left=0.1, rms_right=0.1, per_pair_errors={"a": 0.2},
+        per_pair_errors_left={"a": 0.1}, per_pair_errors_right={"a": 0.1}, used_pairs=["a"],
+        rejected_pairs={}, outlier_pairs=[], epipolar_mean_dy=0.1, epipolar_max_dy=0.2,
+        square_size=1.0, square_size_measured=1.0, square_size_std=0.01, coverage_left=0.5,
+        coverage_right=0.5, distortion_model="k1k2p1p2", model_selection={}, refined=False,
+        pattern=(9, 6), image_size=(640, 480), unit="m", baseline=0.06, focal_left=700.0,
+        focal_right=700.0,
+    )  # fmt: skip
+    return CalibrationReport(**{**figures, **changes})
+
+
+def test_a_report_with_nan_or_inf_figures_is_strict_json_read_back_alike(tmp_path: Path) -> None:
+    """A square never measured (NaN) and a model whose leave-one-out failed (inf) were written
+    as the bare NaN / Infinity of json.dumps, which JSON.parse, jq and a strict json.loads
+    refuse; they are null, and CalibrationReport.load reads them back as NaN and inf."""
+    rep = _figures_report(
+        square_size_measured=math.nan,
+        square_size_std=math.nan,
+        model_selection={"k1k2p1p2": 0.3, "k1k2k3p1p2": math.inf},
+    )
+
+    def refuse(constant: str) -> None:
+        raise ValueError(f"not strict JSON: {constant}")
+
+    rep.save(tmp_path / "r.json")
+    data = json.loads((tmp_path / "r.json").read_text(), parse_constant=refuse)
+    assert data["square_size_measured"] is None and data["square_size_error"] is None
+    assert data["model_selection"] == {"k1k2p1p2": 0.3, "k1k2k3p1p2": None}
+    rep.save(tmp_path / "r.yaml")
+    for name in ("r.json", "r.yaml"):
+        back = CalibrationReport.load(tmp_path / name)
+        assert repr(back.as_dict()) == repr(rep.as_dict())
+        assert math.isnan(back.square_size_std) and back.model_selection["k1k2k3p1p2"] == math.inf
+    (tmp_path / "bad.yaml").write_text("rms: [1,\n")
+    with pytest.raises(ValueError, match=r"^\S+bad\.yaml is not a calibration report: not YAML "):
+        CalibrationReport.load(tmp_path / "bad.yaml")
+    (tmp_path / "cal.json").write_text('{"rms": 0.2}')
+    with pytest.raises(ValueError, match=r"cal\.json is not a calibration report: no field 'rms_"):
+        CalibrationReport.load(tmp_path / "cal.json")
 
 
 # --------------------------------------------------------------------------- synthetic rig

@@ -51,7 +51,7 @@ import re
 import sys
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import MISSING, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, cast
 
@@ -776,6 +776,11 @@ class CalibrationReport:
     def save(self, path: PathLike) -> None:
         """Write the figures as ``.json`` or ``.yaml``/``.yml`` (atomically).
 
+        A figure with nothing to measure (NaN: the triangulated square of a board whose
+        corners were never seen beside each other) or an infinite one (a model's leave-one-out
+        RMS in ``model_selection`` when a view's pose was not found) is ``null`` in JSON, which
+        has no such numbers, and ``.nan`` / ``.inf`` in YAML; :meth:`load` reads both back.
+
         Raises
         ------
         ValueError
@@ -789,7 +794,11 @@ class CalibrationReport:
         suffix = p.suffix.lower()
         data = self.as_dict()
         if suffix == ".json":
-            text = json.dumps(data, indent=2)
+            from stereovision._jsonout import json_ready
+
+            # strict JSON: the bare NaN / Infinity json.dumps wrote are refused by JSON.parse,
+            # jq and json.loads(..., parse_constant=...)
+            text = json.dumps(json_ready(data), indent=2, allow_nan=False)
         elif suffix in (".yaml", ".yml"):
             import yaml
 
@@ -798,6 +807,79 @@ class CalibrationReport:
             raise ValueError(f"cannot save a report as {p.name!r}: use .json, .yaml or .yml")
         with atomic_write(p, "w") as fh:
             fh.write(text)
+
+    @classmethod
+    def load(cls, path: PathLike) -> CalibrationReport:
+        """Read a report :meth:`save` (or :meth:`write`) wrote, ``.json``, ``.yaml`` or ``.yml``.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The report file.
+
+        Returns
+        -------
+        CalibrationReport
+            Its figures, equal to those saved: a JSON ``null`` is read as NaN, in
+            ``model_selection`` as infinity (see :meth:`save`); with the calibration, but
+            without the corners and images the pictures of :meth:`write` are drawn from.
+
+        Raises
+        ------
+        FileNotFoundError
+            If the file does not exist.
+        ValueError
+            For another file extension, or a file that is not such a report (a missing or
+            malformed field named).
+        """
+        from stereovision.io import _existing_file
+
+        p = _existing_file(path, "report file")
+        suffix = p.suffix.lower()
+        if suffix not in (".json", ".yaml", ".yml"):
+            raise ValueError(f"cannot load a report from {p.name!r}: use .json, .yaml or .yml")
+        import yaml
+
+        try:
+            text = p.read_text(encoding="utf-8-sig")
+            data = json.loads(text) if suffix == ".json" else yaml.safe_load(text)
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"{p} is not a calibration report: {exc}") from None
+        except yaml.YAMLError as exc:  # its text spans several lines
+            mark = getattr(exc, "problem_mark", None)
+            where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
+            raise ValueError(f"{p} is not a calibration report: not YAML{where}") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"{p} is not a calibration report: not a mapping of figures")
+        # JSON's null back to what save wrote it for (model_selection's: a failed fit, inf)
+        none_is = {"model_selection": math.inf}
+        figures: dict[str, Any] = {}
+        try:
+            for f in fields(cls):
+                optional = f.default is not MISSING or f.default_factory is not MISSING
+                if f.name.startswith("_") or (f.name not in data and optional):
+                    continue
+                v = data[f.name]
+                if f.type == "float" and v is None:
+                    v = math.nan
+                elif f.type == "dict[str, float]":
+                    gone = none_is.get(f.name, math.nan)
+                    v = {k: gone if x is None else x for k, x in v.items()}
+                elif f.type == "tuple[int, int]":
+                    v = (v[0], v[1])
+                figures[f.name] = v
+            cal = data.get("calibration")
+            if cal is not None:
+                model = "fisheye" if figures["distortion_model"] == "fisheye" else "pinhole"
+                matrices = {k: cal[k] for k in ("K1", "D1", "K2", "D2", "R", "T")}
+                figures["_calibration"] = Calibration(
+                    **matrices, image_size=figures["image_size"], unit=figures["unit"], model=model
+                )
+        except KeyError as exc:
+            raise ValueError(f"{p} is not a calibration report: no field {exc}") from None
+        except (TypeError, AttributeError, IndexError, ValueError) as exc:
+            raise ValueError(f"{p} is not a calibration report: {exc}") from None
+        return cls(**figures)
 
     def write(self, directory: PathLike) -> dict[str, Path]:
         """Write ``report.html`` (self-contained), ``report.yaml`` and ``report.json``.
