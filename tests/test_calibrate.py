@@ -2092,6 +2092,31 @@ def test_names_of_another_count_are_refused_before_the_boards_are_looked_for(
         calibrate(np.stack([blank] * 3), [blank] * 3, square_size=1.0, names=["a"])
 
 
+def test_an_image_of_another_size_is_refused_before_any_board_search(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An image of another size was refused only when the loop reached it, after the board
+    searches of every pair before it (0.6 s each on OpenCV's pairs); all sizes are read first,
+    the file named with both sizes, no board looked for."""
+    searched: list[int] = []
+    monkeypatch.setattr(calmod, "find_corners", lambda gray, pat: searched.append(1))
+    small, wide = np.full((48, 64), 128, np.uint8), np.full((48, 80), 128, np.uint8)
+    with pytest.raises(
+        ValueError, match=r"^right_images\[3\]: image is 80x48, but left_images\[0\] is 64x48$"
+    ):
+        calibrate([small] * 4, [small] * 3 + [wide], square_size=1.0)
+    names = ["l0.png", "r0.png", "l1.png", "r1.png"]
+    for name, img in zip(names, (small, small, small, wide), strict=True):
+        cv2.imwrite(str(tmp_path / name), img)
+    with pytest.raises(ValueError, match=r"^r1\.png: image is 80x48, but l0\.png is 64x48$"):
+        calibrate(
+            [tmp_path / "l0.png", tmp_path / "l1.png"] * 2,
+            [tmp_path / "r0.png", tmp_path / "r1.png"] * 2,
+            square_size=1.0,
+        )
+    assert searched == []
+
+
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:
     """A third mutation audit found unasserted: "9*6" read as 9x6, a square of exactly 100 m and
     1 nm taken (the refusal is outside them), names= of another length than the pairs refused by

@@ -1368,6 +1368,20 @@ def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
     return _board_gray(item, what), name
 
 
+def _image_size(item: object, what: str) -> tuple[tuple[int, int], str]:
+    """``(w, h)`` of an image as :func:`_load_gray` reads it, and its name in messages (the
+    file's name, else ``what``), without the grey conversion."""
+    if isinstance(item, (str, os.PathLike)):
+        from stereovision.io import read_image
+
+        h, w = read_image(item).shape[:2]
+        return (w, h), Path(item).name
+    from stereovision._validate import as_image_array
+
+    h, w = as_image_array(item, what).shape[:2]
+    return (w, h), what
+
+
 def _board_gray(image: object, what: str) -> npt.NDArray[np.uint8]:
     """Grey uint8 image of a board for OpenCV's detectors.
 
@@ -1711,6 +1725,17 @@ def calibrate(
             from stereovision.io import _existing_file
 
             _existing_file(item, "image file")
+    # every image's size before any board search: an image of another size late in the list
+    # was refused after the searches of all pairs before it (0.6 s each, 30 ms for a read)
+    for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
+        for item, what in ((li, f"left_images[{i}]"), (ri, f"right_images[{i}]")):
+            s, label = _image_size(item, what)
+            if size is None:
+                size, first_name = s, label
+            elif s != size:
+                raise ValueError(
+                    f"{label}: image is {s[0]}x{s[1]}, but {first_name} is {size[0]}x{size[1]}"
+                )
 
     first_gray: np.ndarray | None = None
     for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
@@ -1720,14 +1745,6 @@ def calibrate(
         gr, nr = _load_gray(ri, f"right_images[{i}]")
         left_names.append(nl)
         right_names.append(nr)
-        for img, label in ((gl, nl or f"left_images[{i}]"), (gr, nr or f"right_images[{i}]")):
-            s = (img.shape[1], img.shape[0])
-            if size is None:
-                size, first_name = s, label
-            elif s != size:
-                raise ValueError(
-                    f"{label}: image is {s[0]}x{s[1]}, but {first_name} is {size[0]}x{size[1]}"
-                )
         ids: npt.NDArray[np.int64] | None = full_ids
         if board is not None:
             if not board.resolved:  # settle dictionary="auto" on the first image showing it
