@@ -2467,6 +2467,11 @@ def test_calibration_from_a_camera_checks_min_distance_before_opening_it(
             TypeError,
             "{}() got an unexpected keyword argument 'names'",
         ),
+        (
+            {"square_size": 1.0, "progress": 5},
+            TypeError,
+            "progress: expected a callable progress(stage, done, total), or None, got 5",
+        ),
     ],
 )
 def test_calibration_from_a_camera_checks_calibrates_arguments_before_opening_it(
@@ -2495,6 +2500,22 @@ def test_calibration_from_a_camera_checks_calibrates_arguments_before_opening_it
             call()
         assert str(err.value) == words.format(name)
     assert opened == []
+
+
+def test_a_progress_that_cannot_be_called_is_refused_before_the_boards_are_looked_for(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """calibrate(..., progress="yes") said "'str' object is not callable", naming no
+    parameter, after the first pair's board search; it is refused first, by name."""
+    searched: list[int] = []
+    monkeypatch.setattr(calmod, "find_corners", lambda gray, pat: searched.append(1))
+    blank = np.full((48, 64), 128, np.uint8)
+    with pytest.raises(TypeError) as err:
+        calibrate([blank] * 3, [blank] * 3, square_size=1.0, progress="yes")  # type: ignore[arg-type]
+    assert str(err.value) == (
+        "progress: expected a callable progress(stage, done, total), or None, got 'yes'"
+    )
+    assert searched == []
 
 
 class _HungDevice:

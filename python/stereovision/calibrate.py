@@ -1640,8 +1640,9 @@ def calibrate(
         If an image file does not exist (the message names it).
     TypeError
         If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard` (a
-        chessboard's ``"9x6"`` goes in ``pattern``), or ``left_images``, ``right_images`` or
-        ``names`` is no sequence (one path, one string, one image array, None, a number).
+        chessboard's ``"9x6"`` goes in ``pattern``), ``left_images``, ``right_images`` or
+        ``names`` is no sequence (one path, one string, one image array, None, a number), or
+        ``progress`` is given and cannot be called.
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
@@ -1674,6 +1675,7 @@ def calibrate(
     from stereovision.charuco import corners_span_plane, find_charuco_corners
 
     pat, square, unit = _board_setup(pattern, square_size, board, unit, distortion)
+    _check_progress(progress)
     for name, given in (("left_images", left_images), ("right_images", right_images)):
         if isinstance(given, (str, bytes, os.PathLike)):  # one path: list() would split it
             raise TypeError(
@@ -2212,6 +2214,19 @@ def _check_calibrate_args(
             raise TypeError(f"{caller}() got an unexpected keyword argument {key!r}")
     unit, distortion = (kwargs.get(k, params[k].default) for k in ("unit", "distortion"))
     _board_setup(pattern, square_size, board, unit, distortion)
+    _check_progress(kwargs.get("progress"))
+
+
+def _check_progress(progress: object) -> None:
+    """Refuse a ``progress`` that cannot be called: it was "'int' object is not callable",
+    naming no parameter, after the first pair's board search (a recording's first frame)."""
+    if progress is not None and not callable(progress):
+        from stereovision._validate import _shown
+
+        raise TypeError(
+            "progress: expected a callable progress(stage, done, total), or None, got "
+            f"{_shown(progress)}"
+        )
 
 
 def _weighted_rms(per_view: npt.ArrayLike, counts: Sequence[int]) -> float:
@@ -2290,9 +2305,9 @@ def calibrate_from_video(
         If a source cannot be opened, or does not open or deliver a pair within
         ``read_timeout`` s (:class:`stereovision.capture.SourceError`, an OSError).
     TypeError
-        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, or a
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, a
         keyword is not one of :func:`calibrate`'s (``names`` included: the frames name the
-        pairs), before a camera is opened.
+        pairs), or ``progress`` cannot be called, before a camera is opened.
     ValueError
         As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
         a ``max_pairs`` below :data:`MIN_PAIRS`, a ``min_distance`` that is not a finite number
@@ -2365,8 +2380,9 @@ def calibrate_from_bag(
     FileNotFoundError
         If the bag does not exist.
     TypeError
-        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, or a
-        keyword is not one of :func:`calibrate`'s, before the bag is opened.
+        If ``board`` is given and is not a :class:`~stereovision.charuco.CharucoBoard`, a
+        keyword is not one of :func:`calibrate`'s, or ``progress`` cannot be called, before
+        the bag is opened.
     ValueError
         As :class:`~stereovision.rosbag.BagCamera` and :func:`calibrate` (its checks of
         ``pattern``, ``square_size``, ``unit`` and ``distortion`` before the bag is opened).
