@@ -704,6 +704,27 @@ def test_kalibr_unreadable_documents_are_named(tmp_path: Path) -> None:
         Calibration.from_kalibr(path, cameras=("cam0", "cam2"))
 
 
+def test_kalibr_yaml_errors_are_one_line_naming_the_line_and_column(tmp_path: Path) -> None:
+    """PyYAML's error was passed on whole: five lines ("in "<unicode string>"", carets), of which
+    the CLI showed the first, "cannot parse ... as Kalibr YAML: while parsing a flow sequence",
+    without the line or the problem. One line now, the file, line and column named."""
+    path = tmp_path / "camchain.yaml"
+    path.write_text("cam0:\n  intrinsics: [1, 2, 3\n  resolution: [640, 480]\n")
+    with pytest.raises(ValueError) as err:
+        Calibration.from_file(path)
+    assert str(err.value) == (
+        f"cannot parse {path} as Kalibr YAML: line 3, column 13: expected ',' or ']', but got "
+        "':' (while parsing a flow sequence at line 2, column 15)"
+    )
+    path.write_text('cam0:\n  intrinsics: "1\x01"\n')  # a control character: PyYAML's reader
+    with pytest.raises(ValueError) as err:
+        Calibration.from_kalibr(path)
+    assert str(err.value) == (
+        f"cannot parse {path} as Kalibr YAML: line 2, column 17: character #x0001: special "
+        "characters are not allowed"
+    )
+
+
 def test_from_file_sends_each_format_to_its_reader(tmp_path: Path) -> None:
     """Format detection, from a mutation audit: a ROS pair named "intrinsics" is not Kalibr, a
     YAML of camN device names is no calibration, a .yml ROS pair is a ROS folder, a Q.dat

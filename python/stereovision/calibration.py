@@ -2460,7 +2460,7 @@ class Calibration:
         except (yaml.YAMLError, ValueError, RecursionError, LookupError, AttributeError) as exc:
             # not YAMLError alone: "2024-13-01" was a bare "month must be in 1..12", "!!bool x"
             # a KeyError (as _from_plain_yaml catches)
-            raise ValueError(f"cannot parse {p} as Kalibr YAML: {exc}") from None
+            raise ValueError(f"cannot parse {p} as Kalibr YAML: {_yaml_error(exc, text)}") from None
         if not isinstance(doc, dict):
             raise ValueError(f"{p}: expected Kalibr's camchain mapping (cam0, cam1, ...)")
         chain = sorted(
@@ -3101,6 +3101,29 @@ def _holds_itself(obj: object) -> bool:
         stack.append((node, True))
         stack.extend((v, False) for v in (node.values() if isinstance(node, dict) else node))
     return False
+
+
+def _yaml_error(exc: BaseException, text: str) -> str:
+    """PyYAML's error (parsing ``text``) in one line: ``line L, column C: PROBLEM``, and where
+    the construct it was in began. Its own text spans five lines (each mark's line quoted, a
+    caret under it, ``in "<unicode string>"`` for the file), and the CLI shows a message's
+    first line only: "while parsing a flow sequence", without the line or what was wrong."""
+    mark = getattr(exc, "problem_mark", None)
+    problem = getattr(exc, "problem", None)
+    reason, at = getattr(exc, "reason", None), getattr(exc, "position", None)
+    if isinstance(at, int) and reason:  # a ReaderError (a control character): at an offset
+        line = text.count("\n", 0, at) + 1
+        column = at - text.rfind("\n", 0, at)
+        code = getattr(exc, "character", None)
+        what = f"character #x{code:04x}: " if isinstance(code, int) else ""
+        return f"line {line}, column {column}: {what}{reason}"
+    if mark is None or not problem:
+        return " ".join(str(exc).split())  # a ValueError, a KeyError: as given
+    text = f"line {mark.line + 1}, column {mark.column + 1}: {problem}"
+    context, start = getattr(exc, "context", None), getattr(exc, "context_mark", None)
+    if context and start is not None:
+        text += f" ({context} at line {start.line + 1}, column {start.column + 1})"
+    return text
 
 
 def _yaml_loader() -> Any:
