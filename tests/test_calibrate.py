@@ -74,11 +74,22 @@ def _chessboard_paths() -> tuple[list[Path], list[Path]]:
     )
 
 
+#: cv2.calibrateCamera's calls in the ``chessboard`` fixture's calibration.
+_CHESSBOARD_MONO_FITS: list[int] = []
+
+
 @pytest.fixture(scope="module")
 def chessboard() -> tuple[Calibration, CalibrationReport]:
     left, right = _chessboard_paths()
+    real = cv2.calibrateCamera
+
+    def counted(*a: Any, **kw: Any) -> Any:
+        _CHESSBOARD_MONO_FITS.append(1)
+        return real(*a, **kw)
+
     with pytest.MonkeyPatch.context() as mp:  # fills the corner cache the later tests read
         mp.setattr(calmod, "find_corners", _cached_find_corners)
+        mp.setattr(cv2, "calibrateCamera", counted)
         return calibrate(left, right, pattern=(9, 6), square_size=1.0)
 
 
@@ -199,6 +210,9 @@ def test_chessboard_all_pairs_used_and_rms(
     assert cal.T[0] == pytest.approx(-3.33, abs=0.05)
     assert cal.K1[0, 0] == pytest.approx(535, abs=10)
     assert cal.image_size == (640, 480)
+    # each camera's fit on all 13 views per candidate model, and 13 fits each leaving one out:
+    # the chosen model's fits on all views were made again for the mono solution (58 calls)
+    assert len(_CHESSBOARD_MONO_FITS) == 2 * 2 * (13 + 1)
 
 
 def test_the_per_camera_rms_printed_beside_the_stereo_rms_is_said_to_be_each_camera_alone(

@@ -956,12 +956,13 @@ def _loo_rms(
     flags: int,
     *,
     step: Callable[[], None] | None = None,
+    fit: Any = None,
 ) -> tuple[float, F64, F64]:
     """Leave-one-view-out RMS of a camera model; also the fit on all views (K, D). ``step`` is
-    called after each view left out (a progress bar's tick)."""
-    fit: Any = cv2.calibrateCamera(
-        obj, pts, size, None, None, flags=flags, criteria=SOLVER_CRITERIA
-    )
+    called after each view left out (a progress bar's tick); ``fit`` is ``cv2.calibrateCamera``'s
+    fit on all views when already made (:func:`_solve` keeps the chosen model's)."""
+    if fit is None:
+        fit = _fit_all(obj, pts, size, flags)
     K, D = np.asarray(fit[1], np.float64), np.asarray(fit[2], np.float64)
     sq = 0.0
     n = 0
@@ -986,6 +987,13 @@ def _loo_rms(
         sq += float(np.sum((proj.reshape(-1, 2) - pts[i].reshape(-1, 2)) ** 2))
         n += len(obj[i])
     return math.sqrt(sq / n), K, D
+
+
+def _fit_all(
+    obj: Sequence[np.ndarray], pts: Sequence[np.ndarray], size: tuple[int, int], flags: int
+) -> Any:
+    """``cv2.calibrateCamera`` of one camera on all views, from no initial guess."""
+    return cv2.calibrateCamera(obj, pts, size, None, None, flags=flags, criteria=SOLVER_CRITERIA)
 
 
 def _radial_is_monotonic(K: F64, D: F64, size: tuple[int, int]) -> bool:
@@ -1177,6 +1185,9 @@ def _solve(
     if distortion == "fisheye":
         return _solve_fisheye(obj, left, right, size, refine)
     selection: dict[str, float] = {}
+    # each camera's fit on all views, by model: the leave-one-out's start and, for the model
+    # chosen, the mono solution (made twice, it was 2 of 4n + 6 calibrateCamera calls)
+    full: dict[tuple[str, int], Any] = {}
     if distortion == "auto":
         candidates = AUTO_CANDIDATES
         if len(obj) < MODEL_SELECTION_MIN_VIEWS:
@@ -1206,9 +1217,11 @@ def _solve(
 
         for k, name in enumerate(candidates):
             flags = DISTORTION_MODELS[name]
-            loo_l, K1, D1 = _loo_rms(obj, left, size, flags, step=step)
+            full[name, 0] = _fit_all(obj, left, size, flags)
+            loo_l, K1, D1 = _loo_rms(obj, left, size, flags, step=step, fit=full[name, 0])
             reach((2 * k + 1) * len(obj))
-            loo_r, K2, D2 = _loo_rms(obj, right, size, flags, step=step)
+            full[name, 1] = _fit_all(obj, right, size, flags)
+            loo_r, K2, D2 = _loo_rms(obj, right, size, flags, step=step, fit=full[name, 1])
             reach((2 * k + 2) * len(obj))
             loo = math.sqrt((loo_l**2 + loo_r**2) / 2)
             selection[name] = loo
@@ -1218,8 +1231,8 @@ def _solve(
         model = best_model or candidates[0]
     flags = DISTORTION_MODELS[model]
     mono: Any = [
-        cv2.calibrateCamera(obj, pts, size, None, None, flags=flags, criteria=SOLVER_CRITERIA)
-        for pts in (left, right)
+        full[model, side] if (model, side) in full else _fit_all(obj, pts, size, flags)
+        for side, pts in enumerate((left, right))
     ]
     rms_l, K1, D1 = mono[0][:3]
     rms_r, K2, D2 = mono[1][:3]
