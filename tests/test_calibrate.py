@@ -2122,13 +2122,18 @@ def test_an_image_of_another_size_is_refused_before_any_board_search(
     names = ["l0.png", "r0.png", "l1.png", "r1.png"]
     for name, img in zip(names, (small, small, small, wide), strict=True):
         cv2.imwrite(str(tmp_path / name), img)
+    import stereovision.io as iomod
+
+    real_read = iomod.read_image
+    read: list[object] = []  # the sizes come from one grey decode, not read_image's two
+    monkeypatch.setattr(iomod, "read_image", lambda p: read.append(p) or real_read(p))
     with pytest.raises(ValueError, match=r"^r1\.png: image is 80x48, but l0\.png is 64x48$"):
         calibrate(
             [tmp_path / "l0.png", tmp_path / "l1.png"] * 2,
             [tmp_path / "r0.png", tmp_path / "r1.png"] * 2,
             square_size=1.0,
         )
-    assert searched == []
+    assert searched == [] and read == []
 
 
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:
