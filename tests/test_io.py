@@ -99,6 +99,41 @@ def test_read_image_keeps_16_bits(tmp_path: Path) -> None:
         read_image(tmp_path / "bad.png")
 
 
+def test_read_image_decodes_an_8_bit_file_once(tmp_path: Path, monkeypatch) -> None:
+    """An 8-bit JPEG (EXIF-turned) and PNG read by one decode, imread's very pixels: the
+    16-bit try and then imread decoded every 8-bit file twice (a board search reads each)."""
+    import struct
+
+    from stereovision import io as svio
+
+    rng = np.random.default_rng(3)
+    img = rng.integers(0, 256, (40, 30, 3), np.uint8)
+    jpg = cv2.imencode(".jpg", img)[1].tobytes()
+    # an APP1 Exif block with Orientation 6 (turn 90 degrees clockwise)
+    tiff = b"MM\x00\x2a\x00\x00\x00\x08" + struct.pack(">HHHII", 1, 0x0112, 3, 1, 6 << 16)
+    app1 = b"Exif\x00\x00" + tiff + b"\x00" * 4
+    (tmp_path / "t.jpg").write_bytes(
+        jpg[:2] + b"\xff\xe1" + struct.pack(">H", len(app1) + 2) + app1 + jpg[2:]
+    )
+    assert cv2.imwrite(str(tmp_path / "c.png"), img)
+    calls: list[int] = []
+    decode = svio._imdecode
+
+    def counted(buf: np.ndarray, flags: int) -> np.ndarray | None:
+        calls.append(flags)
+        return decode(buf, flags)
+
+    for name, shape in (("t.jpg", (30, 40, 3)), ("c.png", (40, 30, 3))):
+        want = imread(tmp_path / name)
+        calls.clear()
+        monkeypatch.setattr(svio, "_imdecode", counted)
+        got = read_image(tmp_path / name)
+        monkeypatch.setattr(svio, "_imdecode", decode)
+        assert len(calls) == 1, name
+        assert got.dtype == np.uint8 and got.shape == shape
+        np.testing.assert_array_equal(got, want)
+
+
 def test_imread_missing(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError, match=r"nope\.png"):
         imread(tmp_path / "nope.png")

@@ -939,10 +939,10 @@ def _without_side(sub: str) -> str:
 def _decode(name: str, data: bytes) -> Any:
     import numpy as np
 
-    from stereovision.io import _decode_16bit, _not_an_image_hint, decode_image
+    from stereovision.io import _decode_8_or_16bit, _not_an_image_hint, decode_image
 
     # 16-bit files keep their 16 bits, as `stereovision depth` reads them (read_image)
-    img: Any = _decode_16bit(data)
+    img: Any = _decode_8_or_16bit(data)
     if img is None:
         img = decode_image(data)
     if img is None:

@@ -1320,20 +1320,27 @@ def read_image(path: PathLike) -> npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
         If the file cannot be decoded as an image.
     """
     p = _existing_file(path, "image file")
-    deep = _decode_16bit(np.fromfile(p, dtype=np.uint8))
-    return deep if deep is not None else imread(p)
+    img = _decode_8_or_16bit(np.fromfile(p, dtype=np.uint8))
+    return img if img is not None else imread(p)  # imread's message for the rest
 
 
-def _decode_16bit(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint16] | None:
-    """A 16-bit image file's bytes as ``uint16`` BGR (:func:`read_image`'s, and ``batch``'s,
-    as ``stereovision depth`` reads them); None for any other file."""
+def _decode_8_or_16bit(
+    data: npt.NDArray[np.uint8] | bytes,
+) -> npt.NDArray[np.uint8] | npt.NDArray[np.uint16] | None:
+    """An image file's bytes as BGR, ``uint16`` for a 16-bit file, else ``uint8``
+    (:func:`read_image`'s, and ``batch``'s, as ``stereovision depth`` reads them); None for an
+    empty, unreadable, PFM or floating-point file.
+
+    One decode: ``IMREAD_ANYDEPTH`` gives an 8-bit file ``IMREAD_COLOR``'s very pixels (the
+    EXIF turn included); a 16-bit try and then :func:`imread` decoded every 8-bit file twice.
+    """
     buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
-    if buf.size == 0:
+    if buf.size == 0 or _is_pfm(buf):
         return None
-    deep = _imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
-    if deep is not None and deep.dtype == np.uint16:
-        return np.asarray(deep, dtype=np.uint16)
-    return None
+    img = _imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    if img is None or img.dtype not in (np.uint8, np.uint16):
+        return None
+    return np.asarray(img)
 
 
 # ------------------------------------------------------------------------------------------ PFM
