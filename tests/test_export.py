@@ -1409,6 +1409,19 @@ def test_depths_too_far_for_the_png_are_not_said_to_be_millimetres(tmp_path):
     )
 
 
+def test_a_depth_past_a_float_once_scaled_is_dropped_without_numpy_warning():
+    """A float64 depth of 1e308 m (a disparity of 1e-306 px) times 1000 overflowed: NumPy's
+    bare 'overflow encountered in multiply' came with the PNG; it is dropped (0) as any depth
+    too far for 16 bits, the others written."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        data = export.encode_depth_png(np.array([[1e308, 2.0]]))
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+    assert img.tolist() == [[0, 2000]]
+
+
 def test_pcd_header_incomplete_or_not_terminated(tmp_path):
     path = _xyz_pcd(tmp_path / "h.pcd")
     path.write_text(path.read_text().replace("WIDTH 2\n", ""))

@@ -1039,7 +1039,10 @@ def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.f
     a = np.asarray(arr, dtype=np.float64)
     if a.ndim != 2 or a.size == 0:
         raise ValueError(f"{name}: expected a non-empty (H, W) array, got shape {a.shape}")
-    s = np.rint(np.where(np.isfinite(a), a, 0.0) * scale)
+    # over: a depth past a float's range once scaled (1e308 m) is inf, dropped below as too
+    # far; NumPy's bare "overflow encountered in multiply" named neither map nor pixel
+    with np.errstate(over="ignore"):
+        s = np.rint(np.where(np.isfinite(a), a, 0.0) * scale)
     # 0 means "none": values that round to 0 or do not fit 16 bits are dropped, not clipped, so
     # no pixel is written at a wrong distance.
     kept = (s >= 1) & (s <= 65535)
