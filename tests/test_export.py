@@ -1682,6 +1682,11 @@ def test_mutation_audit_3_export_survivors_bis(result, tmp_path):
         ValueError, match=re.escape("voxel: 1.0 is too small for points reaching 5e+18")
     ):
         export.voxel_downsample(np.array([[-5e18, 0.0, 0.0], [5e18, 0.0, 0.0]]), voxel=1.0)
+    # points / side past a float's range: the farthest point named, not 'reaching inf'
+    with pytest.raises(
+        ValueError, match=re.escape("voxel: 1e-300 is too small for points reaching 1e+300")
+    ):
+        export.voxel_downsample(np.array([[1e300, 0.0, 0.0], [0.0, 0.0, 0.0]]), voxel=1e-300)
     pk = tmp_path / "cloud.bin"
     pk.write_bytes(b"PKnot a zip at all")
     with pytest.raises(ValueError, match=re.escape("not a point cloud file (PLY, PCD or NPZ)")):

@@ -888,9 +888,12 @@ def voxel_downsample(
     if len(pts) == 0:
         empty_c = None if cols is None else np.zeros((0, 3), np.uint8)
         return np.zeros((0, 3), np.float32), empty_c
-    reach = float(np.abs(pts).max()) / voxel
+    farthest = float(np.abs(pts).max())
+    reach = farthest / voxel
     if not reach < 2.0**62:  # cube indices must fit an int64
-        raise ValueError(f"voxel: {voxel!r} is too small for points reaching {reach * voxel:.3g}")
+        # the farthest coordinate itself: reach * voxel was inf once reach overflowed (points
+        # at 1e300 with a side of 1e-300 were said to reach inf)
+        raise ValueError(f"voxel: {voxel!r} is too small for points reaching {farthest:.3g}")
     cells = np.floor(pts / voxel).astype(np.int64)
     cells -= cells.min(axis=0)
     ext = cells.max(axis=0) + 1
