@@ -334,6 +334,44 @@ def test_surface_mesh_errors(result):
         render.surface_mesh(replace(result, depth=None, calibration=None))
 
 
+def test_a_sparse_result_off_the_mesh_grid_is_named_and_still_rendered(result, monkeypatch):
+    """A result whose pixels with a depth all miss the grid of step: pyvista's "Invalid array
+    shape ... Array 'RGB' cannot have shape (0, 3)" from surface_mesh, and render_result (step
+    longest // max_side) failed with it, `depth -o`'s outputs with it. Named now; render_result
+    meshes such a result at step 1."""
+    from dataclasses import replace
+
+    z = np.full_like(result.depth, np.nan)
+    z[61, 81] = 2.0
+    one = replace(
+        result,
+        depth=z,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+    )
+    with pytest.raises(ValueError) as err:
+        render.surface_mesh(one, step=10)
+    assert str(err.value) == (
+        "empty point cloud: none of the 1 pixels with a depth lies on the mesh's grid (every "
+        "10th row and column); a smaller step keeps them"
+    )
+    assert render.surface_mesh(one).n_points == 1
+    # the mesh render_result renders (the render itself, 0.25 s, is not what is tested)
+    shown = []
+    monkeypatch.setattr(render, "render_view", lambda mesh, *a, **k: shown.append(mesh))
+    render.render_result(one, max_side=16)  # step 10 on 160 px
+    # and of a result with its cloud (cloud=True): the same pixel
+    with_cloud = replace(
+        one,
+        points=np.array([[0.02, 0.02, 2.0]], np.float32),
+        colors=np.array([[9, 9, 9]], np.uint8),
+        pixels=np.array([[81, 61]], np.int32),
+    )
+    render.render_result(with_cloud, max_side=16)
+    assert [m.n_points for m in shown] == [1, 1]
+
+
 def test_surface_mesh_texture_of_a_grey_or_bgra_left_image(result):
     """The texture is the left image in RGB: a grey (H, W) one repeated in the three channels
     (``[..., ::-1]`` mirrored its columns, and its reshape to RGB rows failed or scrambled

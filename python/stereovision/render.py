@@ -827,7 +827,8 @@ def surface_mesh(
     Raises
     ------
     ValueError
-        Without calibration, with no points, or with a bad ``step`` / ``max_jump``.
+        Without calibration, with no points (none on the grid of ``step``), or with a bad
+        ``step`` / ``max_jump``.
     """
     pv = _pv()
     _check_result(result)
@@ -852,6 +853,13 @@ def surface_mesh(
     xs, ys = pixels[:, 0], pixels[:, 1]
     on_grid = (xs % step == 0) & (ys % step == 0)
     sel = np.nonzero(on_grid)[0]
+    if len(sel) == 0:
+        # a sparse result's pixels all off the grid: pyvista's "Invalid array shape. Empty
+        # arrays are not allowed. Array 'RGB' cannot have shape (0, 3)" named no cause
+        raise ValueError(
+            f"empty point cloud: none of the {len(pixels)} pixels with a depth lies on the "
+            f"mesh's grid (every {step}th row and column); a smaller step keeps them"
+        )
     gh, gw = (h + step - 1) // step, (w + step - 1) // step
     index = np.full((gh, gw), -1, dtype=np.int64)
     index[ys[sel] // step, xs[sel] // step] = np.arange(len(sel))
@@ -1354,7 +1362,18 @@ def render_result(
     # about one vertex per picture pixel is all the picture shows (the texture keeps every
     # pixel of the image): a 3000 x 2000 result's full mesh took 52-70 s and 2.1 GB over the
     # data for a 1024 px render.png. Images under twice max_side keep every vertex.
-    mesh = surface_mesh(result, step=max(1, longest // int(max_side)))
+    step = max(1, longest // int(max_side))
+    if step > 1:
+        # a sparse result (a few pixels with a depth) may have none on the sub-sampled grid: its
+        # every vertex then (few of them), not the error that failed `depth -o` whole
+        if len(result.points):
+            on_grid = bool((result.pixels % step == 0).all(axis=1).any())
+        else:  # depth_map(cloud=False): its depth map's pixels (the cloud is not rebuilt twice)
+            assert result.depth is not None  # _check_result
+            on_grid = bool(np.isfinite(result.depth[::step, ::step]).any())
+        if not on_grid:
+            step = 1
+    mesh = surface_mesh(result, step=step)
     if controls is None:
         controls = orbit_controls(RENDER_YAW_DEG, RENDER_PITCH_DEG, median_depth(mesh))
     return render_view(mesh, controls, intrinsics=intr.scaled(scale))
