@@ -518,6 +518,26 @@ def test_a_k_past_float32_averages_as_a_large_one(data_dir: Path, k: float) -> N
     assert big.mean_frames() == ref.mean_frames() == 4.0
 
 
+def test_a_k_too_small_for_float32_restarts_every_changed_pixel() -> None:
+    """A k the constructor accepts (1e-300) times the noise is 0 in the kernel's float32: the
+    second pair raised "invalid parameter `ks`: ... is 0 in float32", a name the caller never
+    gave. It is a threshold of 0 now: a pixel that did not change averages, any other starts
+    again."""
+    rng = np.random.default_rng(0)
+    img = rng.integers(0, 256, (20, 30), np.uint8)
+    tf = TemporalFilter(k=1e-300)
+    tf(img, img)
+    left, right = tf(img, img)
+    assert np.array_equal(left, img) and np.array_equal(right, img)
+    assert tf.sigma > 1.0 and tf.mean_frames() == 2.0
+    moved = img.copy()
+    moved[5:8, 5:8] ^= 1  # 9 pixels one grey level off: k = 3 would average them
+    left, _ = tf(moved, img)
+    assert np.array_equal(left, moved) and tf.restarts == 0
+    counts = tf._means[0].count
+    assert np.count_nonzero(counts == 1) == 9 and counts[5:8, 5:8].tolist() == [[1] * 3] * 3
+
+
 @pytest.mark.parametrize("k", [np.float32(3e38), np.float16(60000.0)])
 def test_a_numpy_k_past_its_type_averages_without_an_overflow_warning(
     data_dir: Path, k: np.floating

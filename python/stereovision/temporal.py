@@ -453,7 +453,9 @@ class TemporalFilter:
         # over a grey difference's largest (255) restarts no pixel, so it is capped.
         # float(): a NumPy k (np.float32(3e38), np.float16(6e4)) multiplied in its own type,
         # overflowing with NumPy's RuntimeWarning on every pair
-        ks = min(float(self.k) * self.sigma, _KS_MAX)
+        # As the float32 it is there: a tiny k (1e-300) made a threshold that is 0 in float32,
+        # refused as "invalid parameter `ks`"; 0 keeps the same pixels (a difference of 0 only)
+        ks = float(np.float32(min(float(self.k) * self.sigma, _KS_MAX)))
         out = []
         for img, d, m in zip(imgs, diffs, self._means, strict=True):
             # In place: m.mean and m.count are updated.
