@@ -2044,6 +2044,10 @@ def test_mutation_audit_grid_sides_past_a_float_and_at_4096_cells() -> None:
     assert grid.data.shape == (4096, 4096)
     with pytest.raises(ValueError, match=r"^resolution: a 4097 x 1 grid is over 4096 cells"):
         occupancy_grid(box, plane, resolution=0.1, forward=(0, 409.7), lateral=(-0.1, 0))
+    # a count past 1e9 is shown in 3 digits (1e-300 m cells: their count's 302 digits were)
+    with pytest.raises(ValueError) as err:
+        occupancy_grid(box, plane, resolution=1e-300, forward=(0, 20), lateral=(-1, 1))
+    assert str(err.value) == "resolution: a 2e+301 x 2e+300 grid is over 4096 cells a side"
 
 
 def test_laser_scan_names_a_calib_that_is_no_calibration(tmp_path: Path) -> None:

@@ -1239,7 +1239,9 @@ def occupancy_grid(
         )
     cols, rows = _cells(x1 - x0, res), _cells(y1 - y0, res)
     if cols > 4096 or rows > 4096:
-        raise ValueError(f"resolution: a {cols} x {rows} grid is over 4096 cells a side")
+        # a count of a 1e-300 m cell was shown in its 300 digits
+        shown = [str(n) if n < 10**9 else f"{n:.3g}" for n in (cols, rows)]
+        raise ValueError(f"resolution: a {shown[0]} x {shown[1]} grid is over 4096 cells a side")
     lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
     if not (math.isfinite(lo) and lo >= 0 and hi > lo):
         raise ValueError(
