@@ -352,6 +352,36 @@ def test_no_calibration_no_cloud(result, tmp_path):
     assert np.isnan(data["depth_sigma"]).all()
 
 
+def test_a_left_image_of_another_size_is_named_before_anything_is_written(result, tmp_path):
+    """A result whose left_rectified is not the disparity map's size (made by hand: the raw
+    left image, a scaled one) failed in NumPy's words where its pixels colour the cloud:
+    write_pcd "could not broadcast input array from shape (4800,) into shape (19200,)" (after
+    export_result had replaced cloud.ply), a cloud=False result's PLY "index 4800 is out of
+    bounds". Named now, nothing written; a result with its own cloud writes its PLY as before."""
+    small = replace(result, left_rectified=result.left_rectified[::2, ::2].copy())
+    said = (
+        "result.left_rectified: 80x60 px, expected the disparity map's 160x120 (the rectified "
+        "left image colours the cloud)"
+    )
+    no_cloud = replace(
+        small,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+    )
+    for call in (
+        lambda: export.write_pcd(tmp_path / "c.pcd", small),
+        lambda: export.write_cloud_ply(tmp_path / "c.ply", no_cloud),
+        lambda: export.export_result(small, tmp_path / "out"),
+    ):
+        with pytest.raises(ValueError) as err:
+            call()
+        assert str(err.value) == said
+    assert sorted(p.name for p in tmp_path.rglob("*")) == []
+    export.write_cloud_ply(tmp_path / "c.ply", small)
+    assert len(export.load_cloud(tmp_path / "c.ply")[0]) == len(result.points)
+
+
 def test_every_writer_needing_a_calibration_says_to_pass_calib(result, tmp_path):
     """to_ply, points, filtered and export's writers said the result had no calibration but
     not what to do, where require_depth() says to pass calib=: all now give its hint."""

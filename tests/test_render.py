@@ -332,6 +332,11 @@ def test_surface_mesh_errors(result):
         render.surface_mesh(empty)
     with pytest.raises(ValueError, match="calibration"):
         render.surface_mesh(replace(result, depth=None, calibration=None))
+    # a cloud=False result colours its points from a left image of another size: named (it
+    # was NumPy's "index 4800 is out of bounds for axis 0 with size 4800")
+    small_left = replace(empty, depth=result.depth, left_rectified=result.left_rectified[::2, ::2])
+    with pytest.raises(ValueError, match=r"^result\.left_rectified: 80x60 px, expected the disp"):
+        render.surface_mesh(small_left)
 
 
 def test_a_sparse_result_off_the_mesh_grid_is_named_and_still_rendered(result, monkeypatch):

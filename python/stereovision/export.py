@@ -129,6 +129,21 @@ def _require_metric(result: DepthResult) -> None:
         raise ValueError(NO_DEPTH.format(what="point cloud"))
 
 
+def _check_left_size(result: DepthResult) -> None:
+    """Refuse a ``left_rectified`` of another size than the disparity map's, where its pixels
+    colour the cloud: a hand-made result (``dataclasses.replace`` with the raw left image, a
+    scaled one) failed in NumPy's words, "could not broadcast input array from shape (4800,)
+    into shape (19200,)" (write_pcd) or "index 4800 is out of bounds" (a cloud=False result's
+    PLY)."""
+    left = result.left_rectified
+    h, w = result.disparity.shape[:2]
+    if left is not None and left.ndim == 3 and left.shape[:2] != (h, w):
+        raise ValueError(
+            f"result.left_rectified: {left.shape[1]}x{left.shape[0]} px, expected the disparity "
+            f"map's {w}x{h} (the rectified left image colours the cloud)"
+        )
+
+
 def organised_points(
     result: DepthResult,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8]]:
@@ -146,9 +161,16 @@ def organised_points(
     colors : ndarray, uint8 (H, W, 3)
         RGB of the left rectified image (BGR or BGRA); without a colour one (none, or grey),
         the cloud's colours at their pixels, zeros elsewhere.
+
+    Raises
+    ------
+    ValueError
+        If the result has no calibration, or its colour ``left_rectified`` is not the
+        disparity map's size.
     """
     _require_type(result, "DepthResult", "result")
     _require_metric(result)
+    _check_left_size(result)
     h, w = result.disparity.shape[:2]
     if len(result.points) == 0:  # computed with cloud=False: from the depth map
         pts = result.point_image()
@@ -190,11 +212,14 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     Raises
     ------
     ValueError
-        If the result has no calibration (no metric points).
+        If the result has no calibration (no metric points), or has no cloud of its own and a
+        colour ``left_rectified`` of another size than its disparity map.
     """
     dest = as_path(path, file=True)
     _require_type(result, "DepthResult", "result")
     _require_metric(result)
+    if len(result.points) == 0:  # its colours are then the left image's, pixel for pixel
+        _check_left_size(result)
     # A cloud=False result (stream's) has no points of its own: the cloud from its depth map.
     points, colors = result._cloud_points()
     write_ply(dest, points, colors)
@@ -362,7 +387,8 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
     Raises
     ------
     ValueError
-        If the result has no calibration.
+        If the result has no calibration, or a colour ``left_rectified`` of another size than
+        its disparity map.
     """
     dest = as_path(path, file=True)
     _require_type(result, "DepthResult", "result")
@@ -1299,6 +1325,8 @@ def export_result(
             NO_DEPTH.format(what="depth") + f"; formats {metric} need one (npz and disp16 "
             "do not); nothing was written"
         )
+    if "pcd" in formats or ("ply" in formats and len(result.points) == 0):
+        _check_left_size(result)  # found at the PCD's turn, after cloud.ply was replaced
     out = as_path(directory, "directory")
     for fmt in formats:  # a folder in the way, refused before the formats before it are written
         target = out / EXPORT_FORMATS[fmt]

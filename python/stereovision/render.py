@@ -778,7 +778,9 @@ def _cloud_of(
     calib, depth = result.calibration, result.depth
     if len(points) == 0 and calib is not None and depth is not None:
         from stereovision.depth import _cloud
+        from stereovision.export import _check_left_size
 
+        _check_left_size(result)  # its pixels colour the points: NumPy's IndexError, unnamed
         left = result.left_rectified
         if left is None or left.ndim != 3:  # black, as DepthResult._cloud_points colours it
             left = np.zeros((*depth.shape, 3), np.uint8)
