@@ -1412,6 +1412,19 @@ def test_depth_png_scale_and_its_smallest_value(result, tmp_path):
     assert raw[60, 80] == round(syn.BOX_Z * 5000) and raw[5, 150] == round(syn.WALL_Z * 5000)
 
 
+@pytest.mark.parametrize(("scale", "metres"), [(1e-50, "1e+50 to 3e+50"), (1e39, "1e-39 to 3e-39")])
+def test_a_depth_png_scale_past_float32_is_refused(tmp_path, scale, metres):
+    """read_depth_png divides in float32: a scale of 1e-50 read every depth as inf, 1e39 as 0
+    (on the camera), with NumPy's "divide by zero encountered" alone. Refused by name."""
+    path = export.write_depth_png(tmp_path / "z.png", np.array([[0.001, 0.003], [np.nan, 0.002]]))
+    with pytest.raises(ValueError) as err:
+        export.read_depth_png(path, scale=scale)
+    assert str(err.value) == (
+        f"scale: {scale:g} units per metre makes the values 1 to 3 of {path} {metres} m, past "
+        "a float32's range"
+    )
+
+
 def test_disparity_png_warning_does_not_speak_of_millimetres(tmp_path):
     with pytest.warns(UserWarning) as rec:
         export.write_disparity_png(tmp_path / "d.png", np.full((2, 2), 300.0))

@@ -1187,7 +1187,17 @@ def _read_png16(path: PathLike, scale: float, what: str) -> npt.NDArray[np.float
     if img is None or img.ndim != 2 or img.dtype != np.uint16:
         got = "not a PNG" if img is None else f"{img.dtype} with shape {img.shape}"
         raise ValueError(f"{p}: expected a single-channel 16-bit PNG, got {got}")
-    out = img.astype(np.float32) / np.float32(scale)
+    # a scale whose depths a float32 cannot hold: 1e-50 units per metre read every depth as
+    # inf (1e39: as 0, on the camera), with NumPy's "divide by zero" warnings alone
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        out = img.astype(np.float32) / np.float32(scale)
+    known = img > 0
+    if known.any() and not (np.isfinite(out[known]).all() and (out[known] > 0).all()):
+        lo, hi = int(img[known].min()), int(img.max())
+        raise ValueError(
+            f"scale: {number_shown(scale)} units per metre makes the values {lo} to {hi} of "
+            f"{p} {lo / scale:.3g} to {hi / scale:.3g} m, past a float32's range"
+        )
     out[img == 0] = np.nan
     return out
 
@@ -1214,7 +1224,8 @@ def read_depth_png(path: PathLike, scale: float = DEPTH_PNG_SCALE) -> npt.NDArra
     TypeError
         If ``scale`` is not a number.
     ValueError
-        If it is not a single-channel 16-bit PNG, or ``scale`` is not positive and finite.
+        If it is not a single-channel 16-bit PNG, or ``scale`` is not positive and finite or
+        makes the file's depths past a float32's range (1e-50 units per metre).
     """
     return _read_png16(path, _check_scale(scale), "depth PNG")
 
