@@ -1727,9 +1727,16 @@ def test_mutation_audit_3_export_survivors_bis(result, tmp_path):
         export.voxel_downsample(np.array([[-5e18, 0.0, 0.0], [5e18, 0.0, 0.0]]), voxel=1.0)
     # points / side past a float's range: the farthest point named, not 'reaching inf'
     with pytest.raises(
-        ValueError, match=re.escape("voxel: 1e-300 is too small for points reaching 1e+300")
+        ValueError, match=re.escape("voxel: 1e-300 is too small for points reaching 1e+30")
     ):
-        export.voxel_downsample(np.array([[1e300, 0.0, 0.0], [0.0, 0.0, 0.0]]), voxel=1e-300)
+        export.voxel_downsample(np.array([[1e30, 0.0, 0.0], [0.0, 0.0, 0.0]]), voxel=1e-300)
+    # a coordinate past float32 came out as an inf point, NumPy's overflow warning alone
+    with pytest.raises(ValueError) as err:
+        export.voxel_downsample(np.array([[1e39, 0.0, 0.0], [1.0, 1.0, 1.0]]), voxel=1e30)
+    assert str(err.value) == (
+        "points: 1 finite value(s) beyond float32's range (e.g. 1e+39) would come out as inf "
+        "(the points are float32)"
+    )
     pk = tmp_path / "cloud.bin"
     pk.write_bytes(b"PKnot a zip at all")
     with pytest.raises(ValueError, match=re.escape("not a point cloud file (PLY, PCD or NPZ)")):

@@ -854,9 +854,9 @@ def voxel_downsample(
     Raises
     ------
     ValueError
-        If ``points`` is not ``(N, 3)``, ``colors`` is a bare number (a cube side given
-        positionally), does not match ``points`` or holds values outside 0-255, or ``voxel``
-        is not a positive number.
+        If ``points`` is not ``(N, 3)`` or holds a finite coordinate beyond float32's range
+        (``1e39``), ``colors`` is a bare number (a cube side given positionally), does not
+        match ``points`` or holds values outside 0-255, or ``voxel`` is not a positive number.
 
     Warns
     -----
@@ -868,6 +868,8 @@ def voxel_downsample(
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
+    # a point at 1e39 came out as an inf point, NumPy's "overflow encountered in cast" alone
+    refuse_beyond_float32(pts, "points", "would come out as inf (the points are float32)")
     # Not a real number (a string, None): numpy's isfinite failed naming no argument.
     # np.timedelta64 is a numbers.Real too: 3 ns was a cube side of 3
     if isinstance(voxel, NOT_NUMBERS) or not isinstance(voxel, numbers.Real):
