@@ -4613,14 +4613,14 @@ def test_start_up_cameras_and_play_read_their_first_pair_off_the_page(tmp_path, 
     seq.mkdir()
     for side in ("left", "right"):
         cv2.imwrite(str(seq / f"{side}_0001.png"), frame)
-    real = svio.imread
+    real = svio.read_image  # the folder's reader (read_image decodes without imread)
 
     def held(*args: Any, **kwargs: Any) -> Any:
         inside.set()
         gate.wait(1.0)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(svio, "imread", held)
+    monkeypatch.setattr(svio, "read_image", held)
 
     def started(name: str) -> Any:
         app = _scene_app(
@@ -4690,13 +4690,13 @@ def test_capture_waits_for_the_first_pair_of_a_folder_being_played(tmp_path, mon
     for n in ("0001", "0002"):
         for side in ("left", "right"):
             cv2.imwrite(str(seq / f"{side}_{n}.png"), frame)
-    real = svio.imread
+    real = svio.read_image  # the folder's reader (read_image decodes without imread)
 
     def held(*args: Any, **kwargs: Any) -> Any:
         gate.wait(1.0)  # a stalled share (bounded: a broken app cannot hang the test)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(svio, "imread", held)
+    monkeypatch.setattr(svio, "read_image", held)
     said = f"still reading folder {tmp_path.name}/seq (its first pair has not come): wait for it"
 
     async def clicks(source: Any) -> None:
