@@ -6,6 +6,7 @@ import dataclasses
 import re
 import warnings
 from collections.abc import Iterator
+from functools import cache
 from pathlib import Path
 
 import cv2
@@ -179,6 +180,15 @@ def test_disparity_sigma_refuses_a_refined_that_is_no_bool() -> None:
     assert float(sv.depth.disparity_sigma(0.0, refined=np.False_)) == pytest.approx(0.74)
 
 
+@cache
+def _sigma_scene(path: Path, refine: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A GT scene's depth_map ``(disparity, confidence)`` and GT, computed once per module: the
+    refine=True case needs the refine=False maps that its sibling case scores."""
+    scene = load_scene(path)
+    res = sv.depth_map(scene.left, scene.right, max_disparity=scene.max_disparity, refine=refine)
+    return res.disparity, res.confidence, scene.gt
+
+
 @pytest.mark.parametrize("refine", [True, False])
 def test_depth_sigma_predicts_the_error(data_dir: Path, refine: bool) -> None:
     """The error in units of the predicted sigma is about standard normal in its core.
@@ -196,16 +206,14 @@ def test_depth_sigma_predicts_the_error(data_dir: Path, refine: bool) -> None:
         "middlebury2003/cones",
         "middlebury2001/tsukuba",
     ):
-        scene = load_scene(data_dir / name)
-        md = scene.max_disparity
-        res = sv.depth_map(scene.left, scene.right, max_disparity=md, refine=refine)
+        disparity, confidence, gt = _sigma_scene(data_dir / name, refine)
         filled = None
         if refine:
-            raw = sv.depth_map(scene.left, scene.right, max_disparity=md, refine=False)
-            filled = np.isnan(raw.disparity) & np.isfinite(res.disparity)
-        sd = sv.depth.disparity_sigma(res.confidence, refined=refine, filled=filled)
-        ok = np.isfinite(res.disparity) & np.isfinite(scene.gt)
-        ts.append(np.abs(res.disparity[ok] - scene.gt[ok]) / sd[ok])
+            raw = _sigma_scene(data_dir / name, False)[0]
+            filled = np.isnan(raw) & np.isfinite(disparity)
+        sd = sv.depth.disparity_sigma(confidence, refined=refine, filled=filled)
+        ok = np.isfinite(disparity) & np.isfinite(gt)
+        ts.append(np.abs(disparity[ok] - gt[ok]) / sd[ok])
     t = np.concatenate(ts)
     assert 0.5 < float(np.median(t)) < 0.85
     assert 0.6 < float(np.mean(t <= 1)) < 0.8
