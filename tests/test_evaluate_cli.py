@@ -17,7 +17,6 @@ import synthetic_scene as syn
 
 from stereovision.cli import main
 
-SV = [sys.executable, "-m", "stereovision.cli"]
 TIME_KEYS = ("ours_ms", "bm_ms", "sgbm_ms", "runs")
 
 
@@ -85,11 +84,11 @@ def test_eval_runs_interleaves_ours_and_opencv(
 
 
 @pytest.mark.parametrize("value", ["0", "-2", "two"])
-def test_eval_refuses_a_bad_runs_in_one_line(data_dir: Path, value: str) -> None:
+def test_eval_refuses_a_bad_runs_in_one_line(
+    data_dir: Path, value: str, capfd: pytest.CaptureFixture[str]
+) -> None:
     tsukuba = str(data_dir / "middlebury2001" / "tsukuba")
-    proc = subprocess.run(
-        [*SV, "eval", tsukuba, f"--runs={value}"], capture_output=True, text=True, check=False
-    )
+    proc = _eval(capfd, tsukuba, f"--runs={value}")
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [
         "stereovision eval: error: argument --runs: expected a whole number above 0, "
@@ -98,15 +97,12 @@ def test_eval_refuses_a_bad_runs_in_one_line(data_dir: Path, value: str) -> None
 
 
 @pytest.mark.parametrize("value", ["1001", "100000000000000000000"])
-def test_eval_refuses_runs_beyond_its_limit_in_one_line(data_dir: Path, value: str) -> None:
+def test_eval_refuses_runs_beyond_its_limit_in_one_line(
+    data_dir: Path, value: str, capfd: pytest.CaptureFixture[str]
+) -> None:
     """Any count was taken: --runs 100000000000000000000 timed the scene until killed. Refused
     before any work: the missing folder is not reached."""
-    proc = subprocess.run(
-        [*SV, "eval", str(data_dir / "no_such_scene"), f"--runs={value}"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    proc = _eval(capfd, str(data_dir / "no_such_scene"), f"--runs={value}")
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [
         f"stereovision eval: error: argument --runs: expected at most 1000 runs, got {value!r} "
@@ -122,9 +118,14 @@ def test_run_count_takes_one_to_the_limit() -> None:
 
 def _eval(capfd: pytest.CaptureFixture[str], *argv: str) -> subprocess.CompletedProcess[str]:
     """``stereovision eval *argv`` run in this process (a process start each cost a second):
-    its status and all it wrote on file descriptors 1 and 2 (capfd: native writes too)."""
+    its status (an argparse refusal's SystemExit code too) and all it wrote on file descriptors
+    1 and 2 (capfd: native writes too)."""
     capfd.readouterr()
-    status = main(["eval", *argv])
+    try:
+        status = main(["eval", *argv])
+    except SystemExit as exit_:
+        assert isinstance(exit_.code, int), exit_.code  # a status, not a message
+        status = exit_.code
     out, err = capfd.readouterr()
     return subprocess.CompletedProcess(["eval", *argv], status, out, err)
 
