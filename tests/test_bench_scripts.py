@@ -48,16 +48,46 @@ def _run(script: str, *args: str, cwd: Path = ROOT) -> subprocess.CompletedProce
     )
 
 
+def _main(script: str, *args: str) -> subprocess.CompletedProcess[str]:
+    """``python benches/<script> *args`` run in this process, for its command line alone (a
+    process start cost about a second of CPU: Python, NumPy, OpenCV): the script's ``main()``
+    with that ``sys.argv``, its exit status (a SystemExit's, as Python gives it) and what it
+    wrote to stdout and stderr. Help wrapped at ``$COLUMNS`` or 80, as in a pipe."""
+    import contextlib
+    import importlib
+    import io
+    import os
+    from unittest import mock
+
+    out, err = io.StringIO(), io.StringIO()
+    columns = {"COLUMNS": os.environ.get("COLUMNS", "80")}
+    with (
+        mock.patch.object(sys, "path", [str(BENCHES), *sys.path]),
+        mock.patch.object(sys, "argv", [script, *args]),
+        mock.patch.dict(os.environ, columns),
+        contextlib.redirect_stdout(out),
+        contextlib.redirect_stderr(err),
+    ):
+        try:
+            status = importlib.import_module(script.removesuffix(".py")).main() or 0
+        except SystemExit as exit_:
+            code = exit_.code
+            if code is not None and not isinstance(code, int):
+                print(code, file=sys.stderr)  # as Python prints a message's SystemExit
+            status = code if isinstance(code, int) else (0 if code is None else 1)
+    return subprocess.CompletedProcess([script, *args], status, out.getvalue(), err.getvalue())
+
+
 @cache
 def _help(script: str) -> str:
-    done = _run(script, "--help")
+    done = _main(script, "--help")
     assert done.returncode == 0, done.stderr
     return done.stdout
 
 
 @pytest.mark.parametrize(("script", "option"), sorted(TIMING.items()))
 def test_timing_scripts_refuse_fewer_than_five_runs(script: str, option: str) -> None:
-    done = _run(script, option, "4")
+    done = _main(script, option, "4")
     assert done.returncode == 2
     assert f"{option}: " in done.stderr and "at least 5" in done.stderr and "got '4'" in done.stderr
 
