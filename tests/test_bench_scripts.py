@@ -49,10 +49,11 @@ def _run(script: str, *args: str, cwd: Path = ROOT) -> subprocess.CompletedProce
 
 
 def _main(script: str, *args: str) -> subprocess.CompletedProcess[str]:
-    """``python benches/<script> *args`` run in this process, for its command line alone (a
-    process start cost about a second of CPU: Python, NumPy, OpenCV): the script's ``main()``
-    with that ``sys.argv``, its exit status (a SystemExit's, as Python gives it) and what it
-    wrote to stdout and stderr. Help wrapped at ``$COLUMNS`` or 80, as in a pipe."""
+    """``python benches/<script> *args`` run in this process (a process start cost about a
+    second of CPU: Python, NumPy, OpenCV): the script's ``main()`` with that ``sys.argv``, its
+    exit status (a SystemExit's, as Python gives it) and what it wrote to stdout and stderr.
+    Help wrapped at ``$COLUMNS`` or 80, as in a pipe. Only for scripts that leave the process
+    as they found it (eval_gabor_scenes sets OpenCV's threads: a subprocess, ``_run``)."""
     import contextlib
     import importlib
     import io
@@ -132,7 +133,7 @@ def test_bench_fusion_compares_the_sparse_channels(data_dir: Path) -> None:
     # fuse_pair's dense GaborResult for a sparse channel: AttributeError 'xl' on every scene.
     assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
     # a family/scene name, as bench_exposure / bench_temporal take them (it took folders only)
-    done = _run("bench_fusion.py", "middlebury2001/tsukuba")
+    done = _main("bench_fusion.py", "middlebury2001/tsukuba")
     assert done.returncode == 0, done.stderr
     out = done.stdout.splitlines()
     assert out[0] == "channels: gabor + hopfield + mcgm"
@@ -149,7 +150,7 @@ def test_bench_fusion_compares_the_sparse_channels(data_dir: Path) -> None:
 def test_accuracy_times_are_medians_of_the_repeats(data_dir: Path, script: str, ours: str) -> None:
     # the accuracy lines' times were of one run of each side, one after the other
     assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
-    done = _run(script, "--scenes", "middlebury2001/tsukuba", "--no-speed", "--repeats", "5")
+    done = _main(script, "--scenes", "middlebury2001/tsukuba", "--no-speed", "--repeats", "5")
     assert done.returncode == 0, done.stderr
     row = json.loads(done.stdout.splitlines()[-1])
     assert row["case"] == "accuracy" and row["repeats"] == 5
