@@ -8,6 +8,7 @@ import warnings
 from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -220,10 +221,21 @@ def test_depth_sigma_predicts_the_error(data_dir: Path, refine: bool) -> None:
     assert float(np.mean(t <= 2)) > 0.8
 
 
-def test_points_equal_reproject_on_a_metric_scene(data_dir: Path) -> None:
-    """The cloud is Calibration.reproject (cv2.reprojectImageTo3D's maths) at the valid pixels."""
+@pytest.fixture(scope="module")
+def terrace_depth(data_dir: Path) -> tuple[Any, sv.DepthResult]:
+    """ETH3D terrace (metric calib.txt, its range 32 px) and its default
+    ``depth_map(left, right, calib, max_disparity=32)``: the same call for the three tests that
+    read it (none changes it), computed once."""
     scene = load_scene(data_dir / "eth3d" / "terrace")
-    res = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
+    assert scene.calib is not None and scene.max_disparity == 32
+    return scene, sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
+
+
+def test_points_equal_reproject_on_a_metric_scene(
+    terrace_depth: tuple[Any, sv.DepthResult],
+) -> None:
+    """The cloud is Calibration.reproject (cv2.reprojectImageTo3D's maths) at the valid pixels."""
+    scene, res = terrace_depth
     xyz = scene.calib.reproject(np.where(res.confidence > 0, res.disparity, np.nan))
     xs, ys = res.pixels[:, 0], res.pixels[:, 1]
     assert len(res.points) > 100000
@@ -382,10 +394,10 @@ def test_auto_max_disparity_on_real_scene(data_dir: Path) -> None:
     assert md % 16 == 0
 
 
-def test_real_scene_ply_round_trip(tmp_path: Path, data_dir: Path) -> None:
-    scene = load_scene(data_dir / "eth3d" / "terrace")
-    assert scene.calib is not None
-    res = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=scene.max_disparity)
+def test_real_scene_ply_round_trip(
+    tmp_path: Path, terrace_depth: tuple[Any, sv.DepthResult]
+) -> None:
+    _, res = terrace_depth  # depth_map(calib, max_disparity=scene.max_disparity): 32 px
     path = res.to_ply(tmp_path / "cloud.ply")
     pts, cols = read_ply(path)
     np.testing.assert_array_equal(pts, res.points)
@@ -433,14 +445,13 @@ def test_bad_arguments_raise_value_error() -> None:
 
 
 def test_cloud_false_keeps_depth_and_to_ply_writes_the_full_cloud(
-    data_dir: Path, tmp_path: Path
+    terrace_depth: tuple[Any, sv.DepthResult], tmp_path: Path
 ) -> None:
     """depth_map(cloud=False) (live use) has the same depth and no per-frame cloud; to_ply
     still writes every point."""
     from stereovision.io import read_ply
 
-    scene = load_scene(data_dir / "eth3d" / "terrace")
-    full = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
+    scene, full = terrace_depth
     lean = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32, cloud=False)
     assert full.depth is not None and lean.depth is not None
     np.testing.assert_array_equal(lean.depth, full.depth)
