@@ -94,8 +94,11 @@ def test_timing_scripts_refuse_fewer_than_five_runs(script: str, option: str) ->
 
 
 @pytest.mark.parametrize("script", ["mcgm_dump.py", "dump_grey.py"])
-def test_help_prints_usage_and_writes_nothing(script: str, tmp_path: Path) -> None:
-    done = _run(script, "--help", cwd=tmp_path)
+def test_help_prints_usage_and_writes_nothing(
+    script: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # where a script's relative output paths land
+    done = _main(script, "--help")
     assert done.returncode == 0 and done.stdout.startswith(f"usage: {script} ")
     assert list(tmp_path.iterdir()) == []  # mcgm_dump.py wrote a 40 MB "--help.npz"
 
