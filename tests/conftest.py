@@ -121,3 +121,22 @@ def sift_once(monkeypatch: pytest.MonkeyPatch) -> None:
     for module in (rc, uncalibrated):
         monkeypatch.setattr(module, "_features", features_once)
         monkeypatch.setattr(module, "_mutual_matches", matches_once)
+
+
+@pytest.fixture
+def unlistable(monkeypatch: pytest.MonkeyPatch) -> Callable[[Any], None]:
+    """``unlistable(folder)``: ``os.scandir`` of that folder raises PermissionError from then
+    on, as for a user without read permission (the tests run as root, whom chmod does not
+    stop). A descriptor (an int, as os.fwalk passes) is listed as before."""
+    import os
+
+    listing = os.scandir
+    locked: set[str] = set()
+
+    def scandir(path: Any = ".") -> Any:
+        if not isinstance(path, int) and os.fspath(path) in locked:
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return listing(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    return lambda folder: locked.add(os.fspath(folder))

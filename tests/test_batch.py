@@ -1842,7 +1842,7 @@ def test_an_image_of_a_lone_left_camera_folder_is_reported_once(tmp_path: Path) 
 
 
 def test_a_folder_that_cannot_be_listed_is_warned_of(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, unlistable: Callable[[Any], None]
 ) -> None:
     """A sub-folder of the input that cannot be listed (no permission: a copy from another
     user, mode 700) was passed over by os.walk without a word, its pairs left out of a run
@@ -1855,14 +1855,7 @@ def test_a_folder_that_cannot_be_listed_is_warned_of(
         (root / scene).mkdir(parents=True)
         for side in ("left", "right"):
             cv2.imwrite(str(root / scene / f"{side}.png"), img)
-    listing = os.scandir
-
-    def scandir(path: Any = ".") -> Any:
-        if os.fspath(path) == str(root / "locked"):  # root may read any folder: as a user can't
-            raise PermissionError(13, "Permission denied", os.fspath(path))
-        return listing(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    unlistable(str(root / "locked"))
     with pytest.warns(UserWarning) as said:
         jobs, unpaired, _ = _scan(root)
     assert [j.name for j in jobs] == ["a"] and unpaired == []
@@ -1873,22 +1866,15 @@ def test_a_folder_that_cannot_be_listed_is_warned_of(
 
 
 def test_a_folder_that_cannot_be_listed_is_warned_of_once_at_the_callers_line(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, unlistable: Callable[[Any], None]
 ) -> None:
     """seq/right/sub/ that cannot be listed, under a camera folder the search walks three
     times (its images, its named images, the input's walk), was warned of three times, each
     at ``<frozen os>`` (os.walk's onerror gave it): once now, at the line calling find_pairs."""
     root = tmp_path / "in"
     _blank(root, "seq/left/0001.png", "seq/right/0001.png", "seq/right/sub/0002.png")
-    listing = os.scandir
     locked = str(root / "seq/right/sub")
-
-    def scandir(path: Any = ".") -> Any:
-        if not isinstance(path, int) and os.fspath(path) == locked:
-            raise PermissionError(13, "Permission denied", os.fspath(path))
-        return listing(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    unlistable(locked)
     with pytest.warns(UserWarning) as said:
         line = sys._getframe().f_lineno + 1
         jobs = find_pairs(root)
@@ -1904,7 +1890,10 @@ def test_a_folder_that_cannot_be_listed_is_warned_of_once_at_the_callers_line(
 
 
 def test_an_input_folder_that_cannot_be_listed_is_an_error(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    unlistable: Callable[[Any], None],
 ) -> None:
     """The input folder itself that cannot be listed (no permission) was os.walk's warning
     'cannot search folder in: ...; the pairs in it, if any, are left out' and then 'no pair
@@ -1915,14 +1904,7 @@ def test_an_input_folder_that_cannot_be_listed_is_an_error(
 
     root = tmp_path / "in"
     (root / "a").mkdir(parents=True)
-    listing = os.scandir
-
-    def scandir(path: Any = ".") -> Any:
-        if not isinstance(path, int) and os.fspath(path) == str(root):
-            raise PermissionError(13, "Permission denied", os.fspath(path))
-        return listing(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    unlistable(str(root))
     said = f"cannot search input folder {root}: Permission denied"
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the error alone, no warning before it
@@ -1935,7 +1917,7 @@ def test_an_input_folder_that_cannot_be_listed_is_an_error(
 
 
 def test_images_of_a_camera_folder_whose_sibling_cannot_be_listed_are_no_half_pairs(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, unlistable: Callable[[Any], None]
 ) -> None:
     """seq/right/sub/ that cannot be listed (no permission) is warned of as left out, but
     seq/left/sub/0002.png was also a failed pair, 'unpaired image: no seq/right/sub/0002.png
@@ -1950,15 +1932,8 @@ def test_images_of_a_camera_folder_whose_sibling_cannot_be_listed_are_no_half_pa
             if not (side == "right" and f == "0003.png"):
                 (root / "seq" / side / f).parent.mkdir(parents=True, exist_ok=True)
                 cv2.imwrite(str(root / "seq" / side / f), img)
-    listing = os.scandir
     locked = str(root / "seq/right/sub")
-
-    def scandir(path: Any = ".") -> Any:
-        if not isinstance(path, int) and os.fspath(path) == locked:
-            raise PermissionError(13, "Permission denied", os.fspath(path))
-        return listing(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    unlistable(locked)
     with pytest.warns(UserWarning, match="cannot search folder .*right/sub: Permission denied"):
         jobs, unpaired, _ = _scan(root)
     assert [j.name for j in jobs] == ["seq/0001"]
@@ -1968,7 +1943,7 @@ def test_images_of_a_camera_folder_whose_sibling_cannot_be_listed_are_no_half_pa
 
 
 def test_images_under_an_execute_only_sibling_camera_folder_are_no_half_pairs(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, unlistable: Callable[[Any], None]
 ) -> None:
     """seq/right/ that cannot be listed but can be entered (execute-only, d--x--x--x): the walk
     never reached seq/right/sub/, which can be listed, so d2c43757's check of the missing
@@ -1981,15 +1956,8 @@ def test_images_under_an_execute_only_sibling_camera_folder_are_no_half_pairs(
         for side in ("left", "right"):
             (root / "seq" / side / f).parent.mkdir(parents=True, exist_ok=True)
             cv2.imwrite(str(root / "seq" / side / f), np.zeros((4, 6), np.uint8))
-    listing = os.scandir
     locked = str(root / "seq/right")
-
-    def scandir(path: Any = ".") -> Any:
-        if not isinstance(path, int) and os.fspath(path) == locked:
-            raise PermissionError(13, "Permission denied", os.fspath(path))
-        return listing(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    unlistable(locked)
     with pytest.warns(UserWarning, match="cannot search folder .*seq/right: Permission denied"):
         jobs, unpaired, _ = _scan(root)
     assert (jobs, [(u.name, u.error) for u in unpaired]) == ([], [])

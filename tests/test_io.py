@@ -8,6 +8,7 @@ import re
 import shutil
 import struct
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -1817,7 +1818,7 @@ def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:
 
 
 def test_scan_scenes_of_a_root_that_cannot_be_listed_is_an_error(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, unlistable: Callable[[Any], None]
 ) -> None:
     """A scene root that cannot be listed (no permission) was the walk's warning 'cannot
     search folder in: ...; the pairs in it, if any, are left out' and then eval's 'no scene
@@ -1827,14 +1828,7 @@ def test_scan_scenes_of_a_root_that_cannot_be_listed_is_an_error(
 
     root = tmp_path / "in"
     (root / "a").mkdir(parents=True)
-    listing = os.scandir
-
-    def scandir(path: Any = ".") -> Any:
-        if not isinstance(path, int) and os.fspath(path) == str(root):
-            raise PermissionError(13, "Permission denied", os.fspath(path))
-        return listing(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    unlistable(str(root))
     said = f"cannot search scene root {root}: Permission denied"
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the error alone, no warning before it
