@@ -2459,6 +2459,20 @@ def test_a_tilde_the_shell_left_as_typed_is_not_made_a_folder_named_tilde(
     assert str(missing.value) == (
         f"image file not found: ~/l.png (~ is not expanded here: did you mean {home / 'l.png'}?)"
     )
+    # --calib=~/rig.yaml: depth's and batch's calibration readers offer the home's file too
+    from stereovision.batch import find_pairs
+    from stereovision.calibration import Calibration
+
+    (home / "rig.yaml").write_text("not read\n")
+    (cwd / "in").mkdir()
+    said = (
+        "calibration file not found: ~/rig.yaml (~ is not expanded here: did you mean "
+        f"{home / 'rig.yaml'}?)"
+    )
+    for load in (Calibration.load, lambda c: find_pairs(cwd / "in", calib=c)):
+        with pytest.raises(FileNotFoundError) as no_calib:
+            load("~/rig.yaml")
+        assert str(no_calib.value) == said
     (cwd / "~").mkdir()  # a folder of that name, made on purpose: taken
     check_output_folder("~/out", "-o")
     assert not (cwd / "~" / "out").exists()

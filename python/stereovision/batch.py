@@ -364,11 +364,10 @@ def _search(
     _must_list(r, "input folder")
     cal = as_path(calib, "calib") if calib is not None else None
     if cal is not None and not cal.exists():
-        # a link whose target moved: which file is missing is said, as depth --calib says it
-        from stereovision.io import _broken_link
+        # a link whose target moved, a ~ left as typed: said, as depth --calib says them
+        from stereovision.io import _missing_hint
 
-        gone = f" ({_broken_link(cal)})" if cal.is_symlink() else ""
-        raise FileNotFoundError(f"calibration file not found: {cal}{gone}")
+        raise FileNotFoundError(f"calibration file not found: {cal}{_missing_hint(calib, cal)}")
     found: list[PairJob] = []
     unpaired: list[_Unpaired] = []
     cam_found: list[PairJob] = []  # in sibling camera folders

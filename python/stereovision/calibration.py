@@ -1526,11 +1526,10 @@ class Calibration:
     def _read_text(path: PathLike, name: str = "path") -> tuple[Path, str]:
         p = as_path(path, name, file=True)
         if not p.exists():
-            # a link whose target moved: which file is missing is said, as imread says it
-            from stereovision.io import _broken_link
+            # a link whose target moved, a ~ left as typed: said, as imread says them
+            from stereovision.io import _missing_hint
 
-            gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
-            raise FileNotFoundError(f"calibration file not found: {p}{gone}")
+            raise FileNotFoundError(f"calibration file not found: {p}{_missing_hint(path, p)}")
         if not p.is_file():
             raise ValueError(f"calibration path is not a file: {p}")
         try:

@@ -980,14 +980,22 @@ def _other_suffix(path: Path) -> str:
     return f" (did you mean {escaped(str(path.with_name(names[0])))}?)"
 
 
+def _missing_hint(path: PathLike, p: Path) -> str:
+    """What a not-found message adds for ``p`` (``path`` as given): a link whose target moved
+    reads as no file at all, so which one is missing is said; a ``~`` the shell left as typed
+    (``--calib=~/rig.yaml``) names the home's file when that one exists; else ""."""
+    if p.is_symlink():
+        return f" ({_broken_link(p)})"
+    home = _unexpanded_home(path)
+    if home is not None and os.path.exists(home):
+        return f" (~ is not expanded here: did you mean {escaped(home)}?)"
+    return ""
+
+
 def _existing_file(path: PathLike, what: str) -> Path:
     p = as_path(path, file=True)
     if not p.exists():
-        # a link whose target moved reads as no file at all: which one is missing is said
-        gone = f" ({_broken_link(p)})" if p.is_symlink() else ""
-        home = _unexpanded_home(path)
-        if not gone and home is not None and os.path.exists(home):
-            gone = f" (~ is not expanded here: did you mean {escaped(home)}?)"
+        gone = _missing_hint(path, p)
         if not gone and what == "image file":
             gone = _other_suffix(p)
         raise FileNotFoundError(f"{what} not found: {p}{gone}")
