@@ -363,7 +363,7 @@ def _search(
     # naming the layouts, as if it held none of them
     _must_list(r, "input folder")
     cal = as_path(calib, "calib") if calib is not None else None
-    if cal is not None and not cal.exists():
+    if calib is not None and cal is not None and not cal.exists():
         # a link whose target moved, a ~ left as typed: said, as depth --calib says them
         from stereovision.io import _missing_hint
 
