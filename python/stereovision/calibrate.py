@@ -1384,9 +1384,9 @@ def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
 def _image_size(item: object, what: str) -> tuple[tuple[int, int], str]:
     """``(w, h)`` of an image as :func:`_load_gray` reads it, and its name in messages (the
     file's name, else ``what``). A file is decoded grey alone (OpenCV turns it by its EXIF
-    orientation as read_image does): read_image's two decodes in colour took 4 ms of OpenCV's
-    JPEG pairs, 5 s over the calibrate tests; a file it cannot decode so is read by read_image,
-    whose error names the problem."""
+    orientation as read_image does), cheaper than read_image's colour decode (which was two
+    decodes when this pass came: 4 ms of OpenCV's JPEG pairs, 5 s over the calibrate tests); a
+    file it cannot decode so is read by read_image, whose error names the problem."""
     if isinstance(item, (str, os.PathLike)):
         from stereovision.io import _imdecode, _is_pfm, read_image
 
