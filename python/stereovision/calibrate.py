@@ -955,14 +955,12 @@ def _loo_rms(
     size: tuple[int, int],
     flags: int,
     *,
+    fit: Any,
     step: Callable[[], None] | None = None,
-    fit: Any = None,
 ) -> tuple[float, F64, F64]:
-    """Leave-one-view-out RMS of a camera model; also the fit on all views (K, D). ``step`` is
-    called after each view left out (a progress bar's tick); ``fit`` is ``cv2.calibrateCamera``'s
-    fit on all views when already made (:func:`_solve` keeps the chosen model's)."""
-    if fit is None:
-        fit = _fit_all(obj, pts, size, flags)
+    """Leave-one-view-out RMS of a camera model; also the fit on all views (K, D): ``fit``,
+    :func:`_fit_all`'s (:func:`_solve` keeps the chosen model's). ``step`` is called after
+    each view left out (a progress bar's tick)."""
     K, D = np.asarray(fit[1], np.float64), np.asarray(fit[2], np.float64)
     sq = 0.0
     n = 0
@@ -1381,6 +1379,20 @@ def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
     return _board_gray(item, what), name
 
 
+def _same_size(
+    s: tuple[int, int], label: str, size: tuple[int, int] | None, first_name: str
+) -> tuple[tuple[int, int], str]:
+    """``(size, first_name)``: the first image's ``(w, h)`` and name, once one was seen; an
+    image ``label`` of another size ``s`` is refused naming both."""
+    if size is None:
+        return s, label
+    if s != size:
+        raise ValueError(
+            f"{label}: image is {s[0]}x{s[1]}, but {first_name} is {size[0]}x{size[1]}"
+        )
+    return size, first_name
+
+
 def _image_size(item: object, what: str) -> tuple[tuple[int, int], str]:
     """``(w, h)`` of an image as :func:`_load_gray` reads it, and its name in messages (the
     file's name, else ``what``). A file is decoded grey alone (OpenCV turns it by its EXIF
@@ -1750,13 +1762,7 @@ def calibrate(
     for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
         for item, what in ((li, f"left_images[{i}]"), (ri, f"right_images[{i}]")):
             s, label = _image_size(item, what)
-            if size is None:
-                size, first_name = s, label
-            elif s != size:
-                raise ValueError(
-                    f"{label}: image is {s[0]}x{s[1]}, but {first_name} is {size[0]}x{size[1]}"
-                )
-    size = None  # set again from the images as read (the calibration's image_size)
+            size, first_name = _same_size(s, label, size, first_name)
 
     first_gray: np.ndarray | None = None
     for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
@@ -1767,13 +1773,8 @@ def calibrate(
         left_names.append(nl)
         right_names.append(nr)
         for img, label in ((gl, nl or f"left_images[{i}]"), (gr, nr or f"right_images[{i}]")):
-            s = (img.shape[1], img.shape[0])
-            if size is None:
-                size, first_name = s, label
-            elif s != size:
-                raise ValueError(
-                    f"{label}: image is {s[0]}x{s[1]}, but {first_name} is {size[0]}x{size[1]}"
-                )
+            # the images as read against the sizes read first (a file changed in between)
+            size, first_name = _same_size((img.shape[1], img.shape[0]), label, size, first_name)
         ids: npt.NDArray[np.int64] | None = full_ids
         if board is not None:
             if not board.resolved:  # settle dictionary="auto" on the first image showing it
