@@ -520,11 +520,7 @@ def _search(
         # left image decodes to size it, is each pair's error.) In the command line's words
         # for it: cmd_batch searched the input a first time to size it so
         if words == "cli":
-            from stereovision.cli import _HOMOGRAPHIES_USE, load_calibration
-
-            # batch has no --rectification, which the refusal of rectify's homographies named
-            homographies = f"batch takes no homographies; {_HOMOGRAPHIES_USE}"
-            load_calibration(cal, calib_unit, size=size, homographies=homographies)
+            _cli_calibration(cal, calib_unit, size)
         else:
             from stereovision.calibration import Calibration
 
@@ -2405,6 +2401,18 @@ def run_batch(
         return result
 
 
+def _cli_calibration(
+    calib: str | os.PathLike[str] | None, unit: str | None, size: tuple[int, int] | None = None
+) -> None:
+    """Read ``--calib`` as ``stereovision batch`` does, its refusals in the command line's words
+    (``--calib-unit``); batch has no ``--rectification``, which the refusal of rectify's
+    homographies names."""
+    from stereovision.cli import _HOMOGRAPHIES_USE, load_calibration
+
+    homographies = f"batch takes no homographies; {_HOMOGRAPHIES_USE}"
+    load_calibration(calib, unit, size=size, homographies=homographies)
+
+
 def _earlier_output(image: Path, out: Path, pairs: dict[str, Any]) -> bool:
     """Whether ``image`` is an output a run recorded in ``out`` (one of the ``outputs`` of the
     summary's pair whose folder holds it), not an input image.
@@ -2813,19 +2821,12 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from stereovision.io import check_output_folder
 
     if args.calib_unit is not None or (args.calib is not None and Path(args.calib).exists()):
-        from stereovision.cli import _HOMOGRAPHIES_USE, load_calibration
-
         # refused in the CLI's words (--calib-unit), before a cluster starts; one that holds
         # no image size (OpenCV stereo_calib output) is read at the first pair's size by
         # run_batch's search of the input, in these words too (words="cli"): searched here
         # first to size it, the input was searched twice
         if not (args.calib is not None and _sizeless(Path(args.calib))):
-            # batch has no --rectification, which the refusal of rectify's homographies named
-            load_calibration(
-                args.calib,
-                args.calib_unit,
-                homographies=f"batch takes no homographies; {_HOMOGRAPHIES_USE}",
-            )
+            _cli_calibration(args.calib, args.calib_unit)
     if args.scheduler is not None:
         _check_scheduler_address(args.scheduler)
     check_output_folder(args.output, "-o")
