@@ -24,6 +24,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     NOT_NUMBERS,
+    _refuse_masked,
     check_index_range,
     known_unit,
     number_shown,
@@ -67,8 +68,6 @@ def _real_2d(a: object, name: str, field: str = "disparity") -> npt.NDArray[np.f
     from stereovision._validate import not_a_result
 
     not_a_result(a, name, field)
-    from stereovision.triangulation import _refuse_masked
-
     # a masked GT's pixels were scored by their data (depth_from_disparity's rule)
     _refuse_masked(a, name, "np.nan")  # non-finite: unknown, no estimate
     arr = np.asarray(a)
@@ -406,8 +405,6 @@ def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     # a whole result was "depth maps must be real arrays, got object and float32"
     not_a_result(depth, "depth", "depth")
     not_a_result(gt, "gt", "depth")
-    from stereovision.triangulation import _refuse_masked
-
     _refuse_masked(depth, "depth", "np.nan")  # non-finite: missing
     _refuse_masked(gt, "gt", "np.nan")
     e = np.asarray(depth)

@@ -112,7 +112,7 @@ _LOW_UINT16_EFFECT = ", its contrast then below the refinement's var_floor"
 
 
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
-    from stereovision.triangulation import _refuse_masked
+    from stereovision._validate import _refuse_masked
 
     # the masked pixels' values were refined as measured ones (depth_from_disparity's rule)
     _refuse_masked(a, name, "np.nan" if name == "disparity" else "value")

@@ -18,7 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import _real_array, _shown, int_in_range, known_unit, positive_finite
+from stereovision._validate import (
+    _real_array,
+    _refuse_masked,
+    _shown,
+    int_in_range,
+    known_unit,
+    positive_finite,
+)
 from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
@@ -386,20 +393,6 @@ def triangulate(
     XL[~valid] = np.nan
     XR[~valid] = np.nan
     return TriangulationResult(XL=XL * scale, XR=XR * scale, valid=valid, unit=unit)
-
-
-def _refuse_masked(a: object, name: str, fill: str) -> None:
-    """Refuse a :class:`numpy.ma.MaskedArray` with masked pixels, saying to pass
-    ``name.filled(fill)``: ``np.asarray`` reads its data, the masked pixels' values as real
-    ones (a masked 10 px disparity came out a depth of 8.4 m). One rule for the takers of a
-    map (depth_from_disparity, reproject, refine_disparity); a mask of nothing is no loss."""
-    if isinstance(a, np.ma.MaskedArray):
-        n = int(np.count_nonzero(np.ma.getmaskarray(a)))
-        if n:
-            raise ValueError(
-                f"{name}: a masked array (numpy.ma) with {n} masked pixel{'s' * (n != 1)}, "
-                f"whose values would be read as real ones; pass {name}.filled({fill})"
-            )
 
 
 def _disparity(disparity: npt.ArrayLike) -> F64:
