@@ -189,6 +189,13 @@ def test_messages_holding_their_data_as_bytes_decode() -> None:
     _ok, png = cv2.imencode(".png", small)
     out_png = decode_image(_Msg(format="bgr8; png compressed bgr8", data=png.tobytes()))
     np.testing.assert_array_equal(out_png, small)
+    # rosbags' data is a read-only view of the message: a bgr8 frame (no conversion, no
+    # padding) was that view, and cv2.putText on a bag's frame raised where a camera's is drawn
+    f0 = _image_fields(small, "bgr8")
+    held = np.frombuffer(f0["data"].tobytes(), np.uint8)
+    out_view = decode_image(_Msg(**{**f0, "data": held}))
+    np.testing.assert_array_equal(out_view, small)
+    assert out_view.flags.writeable and not held.flags.writeable
 
 
 def test_bad_image_messages(cones: Any) -> None:
@@ -393,6 +400,7 @@ def test_pairs_are_matched_on_their_stamps(cones: Any, tmp_path: Path, flavour: 
         assert cam.max_skew_ms == pytest.approx(PERIOD_NS / 2e6, rel=0.1)  # half of 33 ms
         assert cam.dropped == {"left": 1, "right": 1}  # left 5 and right 9 had no partner
         assert "bag " in cam.describe() and f"{LEFT}: 450x375" in cam.describe()
+    assert got[0].left.flags.writeable and got[0].right.flags.writeable  # as a camera's
     kept = [k for k in range(14) if k not in (5, 9)]
     assert [round((f.t_left * 1e9 - T0) / PERIOD_NS) for f in got] == kept
     for f, k in zip(got, kept, strict=True):

@@ -1043,7 +1043,8 @@ def decode_image(msg: Any) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        ``(H, W, 3)`` BGR, ``uint8`` or, for 16-bit encodings, ``uint16`` (see :func:`to_8bit`).
+        ``(H, W, 3)`` BGR, ``uint8`` or, for 16-bit encodings, ``uint16`` (see :func:`to_8bit`);
+        writable, whatever the message's buffer.
         A compressed grey image whose format names a Bayer encoding (``"bayer_rggb8; png
         compressed "``: image_transport compresses the mosaic as it is) is demosaiced.
 
@@ -1099,7 +1100,11 @@ def decode_image(msg: Any) -> np.ndarray:
     if nbytes == 2:
         arr = rows.view(">u2" if msg.is_bigendian else "<u2").astype(np.uint16)
     arr = arr.reshape((h, w) if ch == 1 else (h, w, ch))
-    return np.asarray(cv2.cvtColor(arr, code)) if code is not None else arr
+    if code is not None:
+        return np.asarray(cv2.cvtColor(arr, code))
+    # unpadded 8-bit BGR is a view of the message's buffer, which rosbags gives read-only: a
+    # bag's bgr8 frames were not writable where a camera's are (cv2.putText on one raised)
+    return arr if arr.flags.writeable else arr.copy()
 
 
 def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
