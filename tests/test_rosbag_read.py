@@ -575,6 +575,37 @@ def test_bag_errors(cones: Any, tmp_path: Path) -> None:
         cam.read()
 
 
+def test_a_topic_given_that_is_no_image_topic_is_said_with_the_nearest_or_its_type(
+    tmp_path: Path,
+) -> None:
+    """A name without its leading '/' or mistyped was refused with the bag's image topics
+    alone, to be compared by eye: the nearest is suggested; a topic of another type (the
+    camera_info given for the image) says its type."""
+    cam = {"image_size": (6, 4), "distortion_model": "plumb_bob", "D": np.zeros(5),
+           "K": np.eye(3), "R": np.eye(3), "P": np.eye(3, 4)}  # fmt: skip
+    tiny = np.zeros((4, 6, 3), np.uint8)
+    bag = write_bag(tmp_path / "rig.bag", [(T0, tiny, T0, tiny)], flavour="ros1", infos=(cam, cam))
+    with pytest.raises(ValueError) as err:
+        BagCamera(bag, left_topic=LEFT[1:], right_topic=RIGHT)
+    assert str(err.value) == (
+        f"left topic {LEFT[1:]!r} is not an image topic of {bag}; did you mean {LEFT!r}? "
+        f"(its image topics: {LEFT}, {RIGHT})"
+    )
+    with pytest.raises(ValueError) as err:
+        BagCamera(bag, left_topic=LEFT, right_topic="/stereo/right/camera_info")
+    assert str(err.value) == (
+        f"right topic '/stereo/right/camera_info' is not an image topic of {bag}: it holds "
+        f"sensor_msgs/msg/CameraInfo, not sensor_msgs/Image or CompressedImage (its image "
+        f"topics: {LEFT}, {RIGHT})"
+    )
+    from stereovision.rosbag import _topic_hint
+
+    images = [LEFT, RIGHT]
+    assert _topic_hint("/stereo/left/imag_raw", images, {}) == f"; did you mean {LEFT!r}?"
+    assert _topic_hint(RIGHT + "/compressed", images, {}) == f"; did you mean {RIGHT!r}?"
+    assert _topic_hint("/x", images, {}) == ""  # nothing near: no guess
+
+
 def test_a_bag_link_whose_target_moved_names_it(tmp_path: Path) -> None:
     """A bag linked in from a disk since unmounted (run.bag -> moved/run.bag) was "bag not
     found: run.bag", of a name ls lists (stream --from-bag said it alike), where the file

@@ -65,6 +65,7 @@ as :class:`~stereovision.capture.StereoCamera`, so ``stream``, ``capture``, ``ca
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import math
 import os
@@ -1200,6 +1201,19 @@ def _base_topic(topic: str) -> str:
     return re.sub(r"/(compressed|theora|ffmpeg|zstd)$", "", topic)
 
 
+def _topic_hint(topic: str, images: list[str], topics: dict[str, Any]) -> str:
+    """What a topic given that is no image topic of the bag is: one of another type (its type
+    named: a ``camera_info`` given for the image), or the image topic nearest its name (a
+    name without its leading ``/``, a typo); ``""`` when none is near. The error listed the
+    bag's image topics alone, to be compared by eye with the name typed."""
+    info = topics.get(topic)
+    if info is not None:
+        msgtype = info.msgtype or " or ".join(sorted({c.msgtype for c in info.connections}))
+        return f": it holds {msgtype}, not sensor_msgs/Image or CompressedImage"
+    near = difflib.get_close_matches(topic, images, n=1, cutoff=0.8)
+    return f"; did you mean {near[0]!r}?" if near else ""
+
+
 def _stereo_pairs(image_topics: list[str]) -> list[tuple[str, str]]:
     """The ``(left, right)`` pairs among ``image_topics``, as :func:`find_stereo_topics` forms
     them: names that differ in one ``/``-separated part, a left/right one."""
@@ -1443,8 +1457,9 @@ class BagCamera(PairSource):
         for side, topic in (("left", left), ("right", right)):
             if topic not in images:
                 raise ValueError(
-                    f"{side} topic {topic!r} is not an image topic of {self.path} (its image "
-                    f"topics: {', '.join(images) or 'none'})"
+                    f"{side} topic {topic!r} is not an image topic of {self.path}"
+                    f"{_topic_hint(topic, images, topics)} (its image topics: "
+                    f"{', '.join(images) or 'none'})"
                 )
         if left == right:
             raise ValueError(f"the left and right topics are the same: {left!r}")
