@@ -2105,6 +2105,30 @@ def test_a_camera_info_topic_without_messages_is_no_calibration(cones: Any, tmp_
         np.testing.assert_array_equal(cam.read().left, cones.left)
 
 
+def test_image_topics_sharing_one_camera_info_topic_are_said_not_taken_for_monocular(
+    tmp_path: Path,
+) -> None:
+    """``/cam/image_left`` and ``/cam/image_right`` have one ``/cam/camera_info`` beside them:
+    its first message (the left camera's) was read for both, and the stereo rig refused as "two
+    monocular calibrations" (no baseline). The shared topic is named, with the remedy."""
+    cams = tuple(
+        {"image_size": (6, 4), "distortion_model": "plumb_bob", "D": np.zeros(5),
+         "K": np.eye(3), "R": np.eye(3), "P": np.hstack([np.eye(3), [[-tx], [0], [0]]])}
+        for tx in (0.0, 0.12)
+    )  # fmt: skip
+    tiny = np.zeros((4, 6, 3), np.uint8)
+    topics = ("/cam/image_left", "/cam/image_right")
+    bag = write_bag(tmp_path / "rig.bag", [(T0, tiny, T0, tiny)], flavour="ros1", topics=topics,
+                    infos=cams)  # fmt: skip
+    with BagCamera(bag) as cam, pytest.raises(ValueError) as err:
+        cam.calibration()
+    assert str(err.value) == (
+        f"bag {bag}: /cam/image_left and /cam/image_right share one camera_info topic "
+        "(/cam/camera_info), so which camera a message describes is not known: give the rig's "
+        "calibration (--calib RIG)"
+    )
+
+
 def test_the_camera_info_of_uncalibrated_cameras_is_no_calibration(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

@@ -1874,12 +1874,22 @@ class BagCamera(PairSource):
             If a ``camera_info`` is not a stereo camera's (no baseline), its model is not
             supported, it describes a region of interest (named) or a malformed one (a zero
             width or height alone), or the two bin differently; if the first ``camera_info``
-            message cannot be read (a damaged bag, named).
+            message cannot be read (a damaged bag, named); if the two image topics share one
+            ``camera_info`` topic (one namespace).
         """
         from stereovision.calibration import Calibration, _ros_yaml
 
         if self._reader is None or None in self.info_topics.values():
             return None
+        if self.info_topics["left"] == self.info_topics["right"]:
+            # two image topics of one namespace have one camera_info beside them: its first
+            # message, one camera's, was read for both, and a stereo rig's calibration was
+            # refused as "two monocular calibrations" (no baseline)
+            raise ValueError(
+                f"bag {self.path}: {self.topics['left']} and {self.topics['right']} share one "
+                f"camera_info topic ({self.info_topics['left']}), so which camera a message "
+                "describes is not known: give the rig's calibration (--calib RIG)"
+            )
         texts: list[str] = []
         binning: list[tuple[int, int]] = []
         for side in ("left", "right"):
