@@ -2537,6 +2537,28 @@ def test_positive_rate_refuses_an_infinite_rate() -> None:
             positive_rate(bad)
 
 
+def test_whole_number_options_take_a_whole_number_written_with_a_point() -> None:
+    """``--max-disparity 64.0`` (and ``--frames 5.0``, ``--runs 5.0``) was refused as "expected
+    a whole number", which it is, while the library takes 64.0: every whole-number option now
+    takes it; a fraction, NaN or word is still refused, as typed."""
+    import argparse
+
+    from stereovision.bench import _run_count
+    from stereovision.cli import positive_count, positive_pixels, run_count
+
+    assert [positive_pixels(t) for t in ("64", "64.0", " 64 ", "6.4e1")] == [64] * 4
+    assert (positive_count("5.0"), run_count("5.0"), _run_count("5.0")) == (5, 5, 5)
+    for bad in ("64.5", "nan", "inf", "0.0", "-64.0", "abc", "1e999999999999"):
+        with pytest.raises(argparse.ArgumentTypeError) as info:
+            positive_pixels(bad)
+        assert str(info.value) == f"expected a whole number of pixels above 0, got {bad!r}"
+    refused = argparse.ArgumentTypeError
+    with pytest.raises(refused, match=r"^expected a whole number, got '5\.5'$"):
+        _run_count("5.5")
+    with pytest.raises(refused, match=r"^expected at most 1000 runs, got '1e4'$"):
+        run_count("1e4")
+
+
 def test_commit_outputs_keeps_a_link_the_user_put_under_an_earlier_output_name(
     tmp_path: Path,
 ) -> None:

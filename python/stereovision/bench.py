@@ -183,12 +183,11 @@ def _run_count(text: str) -> int:
     ('stereovision bench: error: argument --runs: ...'), not as a bare 'stereovision: error:'."""
     import argparse
 
-    from stereovision.cli import MAX_RUNS
+    from stereovision.cli import MAX_RUNS, whole_number
 
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    value = whole_number(text)  # 5.0 too, as every whole-number option takes it
+    if value is None:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}")
     if value < MIN_RUNS:
         raise argparse.ArgumentTypeError(
             f"expected at least {MIN_RUNS} runs (evaluation.md: the median of >= {MIN_RUNS} "

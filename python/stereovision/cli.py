@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import decimal
 import difflib
 import functools
 import json
@@ -40,6 +41,7 @@ from stereovision._validate import (
     first_line,
     float32_reach,
     internal_error,
+    whole_value,
 )
 
 EXIT_ERROR = 2
@@ -2345,12 +2347,20 @@ def run_count(text: str) -> int:
     return value
 
 
-def _whole_above_zero(text: str, what: str) -> int:
+def whole_number(text: str) -> int | None:
+    """The whole number ``text`` writes, else None: ``64``, ``64.0`` and ``6.4e1`` alike, as
+    the library takes ``64.0`` (:func:`~stereovision._validate.whole_value`); ``64.5``, ``nan``
+    and words none. One rule for every whole-number option: ``--max-disparity 64.0`` was
+    refused as "expected a whole number", which it is."""
     try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
+        return whole_value(decimal.Decimal(text))
+    except (decimal.InvalidOperation, TypeError):
+        return None
+
+
+def _whole_above_zero(text: str, what: str) -> int:
+    value = whole_number(text)
+    if value is None or value < 1:
         raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
     return value
 
