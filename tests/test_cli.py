@@ -2559,6 +2559,19 @@ def test_whole_number_options_take_a_whole_number_written_with_a_point() -> None
         run_count("1e4")
 
 
+def test_check_tolerance_is_refused_as_typed(capsys: pytest.CaptureFixture[str]) -> None:
+    """``check --tolerance 1e400`` said "got inf" (the parsed float): the value as typed now,
+    by the parser, before the pair is read."""
+    for bad in ("1e400", "-1e400"):  # nan, -1 and 0: test_rectification_check
+        with pytest.raises(SystemExit) as exit_:
+            main(["check", "no_l.png", "no_r.png", "--tolerance", bad])
+        assert exit_.value.code == 2
+        assert capsys.readouterr().err == (
+            "stereovision check: error: argument --tolerance: expected a positive number of "
+            f"pixels, got '{bad}' (see stereovision check --help)\n"
+        )
+
+
 def test_commit_outputs_keeps_a_link_the_user_put_under_an_earlier_output_name(
     tmp_path: Path,
 ) -> None:
@@ -3411,8 +3424,8 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
         # told to write --tolerance=-1px, which is no number either (then: no word of the unit)
         (
             ["check", "l.png", "r.png", "--tolerance", "-1px"],
-            "stereovision check: error: argument --tolerance: expected a number without a unit "
-            "(5 for 5 px), got '-1px' (see stereovision check --help)",
+            "stereovision check: error: argument --tolerance: expected a positive number of "
+            "pixels without a unit (5 for 5 px), got '-1px' (see stereovision check --help)",
         ),
         # capture --square 25mm: "expected a number"; nan: the library's "square_size:"
         (

@@ -2326,6 +2326,19 @@ def positive_pixels(text: str) -> int:
     return _whole_above_zero(text, "a whole number of pixels above 0")
 
 
+def pixel_tolerance(text: str) -> float:
+    """argparse type of ``check --tolerance``: a finite number of pixels above 0, refused in
+    the option's name with the value as typed (``1e400`` was said as "got inf", after the
+    parsing)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number of pixels, got {text!r}")
+    return value
+
+
 def positive_count(text: str) -> int:
     """argparse type of a count (``--frames``, ``--every``, ``--check-every``): a whole number
     above 0, refused in the option's name (the library's parameter name, ``frames:`` or
@@ -2949,7 +2962,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("right", help="right image, the same size")
     d.add_argument("--calib", help="the rig's calibration (omit for a rectified pair)")
     add_calib_unit(d)
-    d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
+    d.add_argument(
+        "--tolerance", type=pixel_tolerance, default=0.5, help="median |dy| in px (default 0.5)"
+    )
     d.add_argument(
         "--json",
         action="store_true",
