@@ -814,6 +814,23 @@ def test_bench_says_a_gt_with_known_pixels_at_0_px(
     ]
 
 
+def test_bench_says_a_gt_without_a_known_pixel(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A gt_disp.pfm all +inf: eval skips the scene saying so; bench timed it with '-' for every
+    figure and a sparse count of 0, without a word on the GT. Said now, the figures as before."""
+    from stereovision.io import write_pfm
+
+    scene = syn.narrow_scene(tmp_path, 20, 40)
+    write_pfm(scene / "gt_disp.pfm", np.full((20, 40), np.inf, np.float32))
+    monkeypatch.setattr(stereovision.bench, "bench_scene", lambda scene, runs: [])
+    assert main(["bench", str(scene), "--json"]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: {scene}: no ground truth: gt_disp.pfm has no known (finite) pixel, "
+        "times only"
+    ]
+
+
 def test_bench_of_a_scene_whose_gt_kept_middleburys_name_says_to_rename_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -435,6 +435,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
                         f"only{hint}",
                         file=sys.stderr,
                     )
+                elif scene.gt is not None and not np.isfinite(scene.gt).any():
+                    # as eval's skip line: every figure '-' (null) and each sparse count 0, unsaid
+                    tqdm.write(
+                        f"stereovision: {escaped(str(d))}: no ground truth: gt_disp.pfm has no "
+                        "known (finite) pixel, times only",
+                        file=sys.stderr,
+                    )
                 # as eval: a GT converted keeping KITTI's 0 = unknown was scored against its 0s
                 zero_note = gt_at_zero_note(scene.gt)
                 if zero_note is not None:
