@@ -2537,26 +2537,38 @@ def test_positive_rate_refuses_an_infinite_rate() -> None:
             positive_rate(bad)
 
 
-def test_whole_number_options_take_a_whole_number_written_with_a_point() -> None:
-    """``--max-disparity 64.0`` (and ``--frames 5.0``, ``--runs 5.0``) was refused as "expected
-    a whole number", which it is, while the library takes 64.0: every whole-number option now
-    takes it; a fraction, NaN or word is still refused, as typed."""
+def test_whole_number_options_take_a_whole_number_written_with_a_point(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``--max-disparity 64.0`` (and ``--frames 5.0``, ``--runs 5.0``, the ``type=int`` options'
+    ``--workers 2.0``) was refused as "expected a whole number", which it is, while the library
+    takes 64.0: every whole-number option now takes it; a fraction, NaN, an exponent or a word
+    is still refused, as typed."""
     import argparse
 
     from stereovision.bench import _run_count
-    from stereovision.cli import positive_count, positive_pixels, run_count
+    from stereovision.cli import _Parser, positive_count, positive_pixels, run_count
 
-    assert [positive_pixels(t) for t in ("64", "64.0", " 64 ", "6.4e1")] == [64] * 4
+    assert [positive_pixels(t) for t in ("64", "64.0", " 64. ", "1_000")] == [64, 64, 64, 1000]
     assert (positive_count("5.0"), run_count("5.0"), _run_count("5.0")) == (5, 5, 5)
-    for bad in ("64.5", "nan", "inf", "0.0", "-64.0", "abc", "1e999999999999"):
+    for bad in ("64.5", "nan", "inf", "0.0", "-64.0", "abc", "6.4e1", "1e400"):
         with pytest.raises(argparse.ArgumentTypeError) as info:
             positive_pixels(bad)
         assert str(info.value) == f"expected a whole number of pixels above 0, got {bad!r}"
     refused = argparse.ArgumentTypeError
     with pytest.raises(refused, match=r"^expected a whole number, got '5\.5'$"):
         _run_count("5.5")
-    with pytest.raises(refused, match=r"^expected at most 1000 runs, got '1e4'$"):
-        run_count("1e4")
+    with pytest.raises(refused, match=r"^expected at most 1000 runs, got '1001\.0'$"):
+        run_count("1001.0")
+    parser = _Parser(prog="stereovision batch")
+    parser.add_argument("--workers", type=int)
+    assert parser.parse_args(["--workers", "2.0"]).workers == 2
+    with pytest.raises(SystemExit):
+        parser.parse_args(["--workers", "2.5"])
+    assert capsys.readouterr().err == (
+        "stereovision batch: error: argument --workers: expected a whole number, got '2.5' "
+        "(see stereovision batch --help)\n"
+    )
 
 
 def test_check_tolerance_is_refused_as_typed(capsys: pytest.CaptureFixture[str]) -> None:

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
-import decimal
 import difflib
 import functools
 import json
@@ -41,7 +40,6 @@ from stereovision._validate import (
     first_line,
     float32_reach,
     internal_error,
-    whole_value,
 )
 
 EXIT_ERROR = 2
@@ -2360,15 +2358,30 @@ def run_count(text: str) -> int:
     return value
 
 
+#: A whole number as typed: digits, a point and zeros after them or not (``64``, ``64.0``).
+_WHOLE_TEXT = re.compile(r"\s*([-+]?\d+)(?:\.0*)?\s*")
+
+
 def whole_number(text: str) -> int | None:
-    """The whole number ``text`` writes, else None: ``64``, ``64.0`` and ``6.4e1`` alike, as
-    the library takes ``64.0`` (:func:`~stereovision._validate.whole_value`); ``64.5``, ``nan``
-    and words none. One rule for every whole-number option: ``--max-disparity 64.0`` was
-    refused as "expected a whole number", which it is."""
+    """The whole number ``text`` writes, else None: ``64`` and ``64.0`` alike, as the library
+    takes ``64.0`` (:func:`~stereovision._validate.whole_value`); ``64.5``, ``nan`` and words
+    none, nor an exponent (``1e400`` is no count to take as 401 digits). One rule for every
+    whole-number option: ``--max-disparity 64.0`` was refused as "expected a whole number"."""
+    typed = _WHOLE_TEXT.fullmatch(text)
     try:
-        return whole_value(decimal.Decimal(text))
-    except (decimal.InvalidOperation, TypeError):
+        return int(typed[1] if typed else text)  # int's own reading too (1_000)
+    except ValueError:  # no number, or past Python's 4300 digits
         return None
+
+
+def _typed_int(text: str) -> int:
+    """argparse's ``type=int`` in :class:`_Parser`: :func:`whole_number`'s rule, so that the
+    plain ``type=int`` options (``--workers``, ``--max-pairs``, ``--count``, ``--port``) take
+    ``64.0`` as every other whole-number option does; refused as argparse refuses ``int``."""
+    value = whole_number(text)
+    if value is None:
+        raise ValueError(text)
+    return value
 
 
 def _whole_above_zero(text: str, what: str) -> int:
@@ -2673,6 +2686,11 @@ class _Parser(argparse.ArgumentParser):
 
     #: The words this parser (a subcommand's: those after its name) was given, for error().
     typed: tuple[str, ...] = ()
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        # type=int read as the other whole-number options: --workers 2.0 was refused
+        self.register("type", int, _typed_int)
 
     def parse_known_args(  # type: ignore[override]
         self, args: Sequence[str] | None = None, namespace: Any = None
