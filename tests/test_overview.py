@@ -457,6 +457,12 @@ def test_colour_levels_of_infinities_without_an_overflow() -> None:
         warnings.simplefilter("error")
         levels = colour_levels(values, 1.0, 3.0)
     assert levels.tolist() == [255, 0, 0, 0, 255, 127]
+    # finite float32 values further apart than float32's largest: the difference overflowed
+    # (a RuntimeWarning, said as a 'warning:' line by the CLI's colorize)
+    wide = np.array([-3e38, 0.0, 3e38], np.float32)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert colour_levels(wide, -3e38, 3e38).tolist() == [0, 127, 255]
 
 
 def test_the_depth_caption_names_the_limits_and_no_fill_it_did_not_make(terrace_run: tuple) -> None:

@@ -95,7 +95,10 @@ def colour_levels(values: npt.NDArray[Any], lo: float, hi: float) -> npt.NDArray
     level 0, +inf at 255 and -inf at 0, without an overflow on the way."""
     scale = 255.0 / max(hi - lo, 1e-9)
     finite = np.nan_to_num(values, nan=lo, posinf=hi, neginf=lo)
-    return np.clip((finite - lo) * scale, 0, 255).astype(np.uint8)
+    # float32 values more than float32's largest apart (-3e38 and 3e38) overflow to inf in
+    # the difference, which the clip takes to 255 as it should: no RuntimeWarning for that
+    with np.errstate(over="ignore"):
+        return np.clip((finite - lo) * scale, 0, 255).astype(np.uint8)
 
 
 @dataclass
