@@ -110,6 +110,18 @@ def test_eval_refuses_runs_beyond_its_limit_in_one_line(
     ]
 
 
+def test_eval_help_says_runs_1_has_no_warm_up(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--runs``'s help said "time every method N times ... after a warm-up round": eval times
+    only the --method chosen beside OpenCV's two, and ``--runs 1`` has no warm-up (README)."""
+    with pytest.raises(SystemExit):
+        main(["eval", "--help"])
+    said = " ".join(capsys.readouterr().out.split())
+    assert (
+        "--runs N time ours (--method), StereoBM and SGBM-3WAY N times, interleaved, after a "
+        "warm-up round when N > 1 (--runs 1: one run, no warm-up), and print the medians"
+    ) in said
+
+
 def test_run_count_takes_one_to_the_limit() -> None:
     from stereovision.cli import MAX_RUNS, run_count
 

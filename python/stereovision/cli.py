@@ -3069,8 +3069,9 @@ def build_parser() -> argparse.ArgumentParser:
         type=run_count,
         default=None,
         metavar="N",
-        help="time every method N times, interleaved with OpenCV's, after a warm-up round, and "
-        "print the medians (a time line per scene; --json: always, one run without --runs); "
+        help="time ours (--method), StereoBM and SGBM-3WAY N times, interleaved, after a "
+        "warm-up round when N > 1 (--runs 1: one run, no warm-up), and print the medians (a "
+        "time line per scene; --json: always, one run without --runs); "
         f"evaluation.md's speed figures need >= 5 (at most {MAX_RUNS}); accuracy is the same "
         "for any N",
     )
