@@ -740,6 +740,17 @@ def test_end_labels_just_under_1000_are_not_written_in_exponent() -> None:
     assert ov.bars["depth"].ticks[0][1] == "999 mm"
 
 
+def test_bar_labels_of_a_far_depth_are_in_exponent_form() -> None:
+    """A depth map of ~0 px disparities (3e38 m) was labelled with all 39 digits of 3e38, a
+    label column that made the overview (446 px wide) 906 px wide; 1e9 and up are now
+    written as ``3e+38``, a depth under a billion as before."""
+    ov = overview_image(_result_with_depth(30, 40, 1e38, 3e38), "t")
+    assert [t[1] for t in ov.bars["depth"].ticks] == ["1e+38 m", "3e+38 m"]
+    near = overview_image(_result_with_depth(30, 40, 1e6, 3e6), "t")
+    assert [t[1] for t in near.bars["depth"].ticks] == ["1000000 m", "3000000 m"]
+    assert ov.image.shape == near.image.shape
+
+
 @pytest.mark.parametrize("length", [60, 200])
 def test_a_long_title_is_scaled_into_the_picture(length: int) -> None:
     """200 x's scaled by the ratio of the widths still ran out of the picture (cv2 rounds

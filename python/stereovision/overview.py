@@ -232,7 +232,7 @@ def _place_ticks(
     for value, ty in sorted(inner, key=lambda t: t[1]):
         if ty - last_y < _TICK_SPACING or bottom - ty < _TICK_SPACING:
             continue
-        text = figure_shown(value)
+        text = _label(value)
         _, y0, _, y1 = _text_box(text, 0, ty)
         if any(y0 - _END_GAP < e1 and e0 < y1 + _END_GAP for _, e0, _, e1 in end_boxes):
             continue
@@ -271,9 +271,22 @@ def _bar(
     return bar
 
 
+#: Bar labels from here up are in exponent form: a depth map of ~0 px disparities (3e38 m)
+#: was labelled with all 39 digits, a label column that made the overview twice as wide.
+_EXPONENT_FROM = 1e9
+
+
+def _label(value: float) -> str:
+    """A bar label's number: :func:`figure_shown`'s, in exponent form from
+    :data:`_EXPONENT_FROM` up (``3e+38``)."""
+    if math.isfinite(value) and abs(value) >= _EXPONENT_FROM:
+        return f"{value:.3g}"
+    return figure_shown(value)
+
+
 def _end_label(value: float, unit: str) -> str:
     """An end of a bar: its value as the ticks print theirs, and the unit (``"52.3 px"``)."""
-    return f"{figure_shown(value)} {unit}" if unit else figure_shown(value)
+    return f"{_label(value)} {unit}" if unit else _label(value)
 
 
 #: ``str.translate`` table of :func:`cv2_text`: the ASCII control characters as ``?``.
