@@ -2547,7 +2547,7 @@ def test_whole_number_options_take_a_whole_number_written_with_a_point(
     import argparse
 
     from stereovision.bench import _run_count
-    from stereovision.cli import _Parser, positive_count, positive_pixels, run_count
+    from stereovision.cli import _Parser, port_number, positive_count, positive_pixels, run_count
 
     assert [positive_pixels(t) for t in ("64", "64.0", " 64. ", "1_000")] == [64, 64, 64, 1000]
     assert (positive_count("5.0"), run_count("5.0"), _run_count("5.0")) == (5, 5, 5)
@@ -2563,6 +2563,7 @@ def test_whole_number_options_take_a_whole_number_written_with_a_point(
     parser = _Parser(prog="stereovision batch")
     parser.add_argument("--workers", type=int)
     assert parser.parse_args(["--workers", "2.0"]).workers == 2
+    assert (port_number("8080.0"), port_number("8080")) == (8080, 8080)  # as gui --port
     with pytest.raises(SystemExit):
         parser.parse_args(["--workers", "2.5"])
     assert capsys.readouterr().err == (

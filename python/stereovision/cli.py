@@ -2624,11 +2624,8 @@ PORT_WORDS = "expected a port 1 to 65535, or 0 for a free one"
 
 def port_number(text: str) -> int:
     """argparse type of ``--serve``: a TCP port, 0 (any free one) to 65535."""
-    try:
-        value = int(text)
-        shown = str(value)
-    except ValueError:
-        value, shown = -1, repr(text)
+    whole = whole_number(text)  # 8080.0 too, as gui --port (type=int) and every count
+    value, shown = (-1, repr(text)) if whole is None else (whole, str(whole))
     if not 0 <= value <= 65535:
         # in gui --port's words (PORT_WORDS): one wording for both options
         raise argparse.ArgumentTypeError(f"{PORT_WORDS}, got {shown}")
