@@ -2564,6 +2564,13 @@ def test_whole_number_options_take_a_whole_number_written_with_a_point(
     parser.add_argument("--workers", type=int)
     assert parser.parse_args(["--workers", "2.0"]).workers == 2
     assert (port_number("8080.0"), port_number("8080")) == (8080, 8080)  # as gui --port
+    from stereovision.capture import _temporal_frames
+    from stereovision.render import _point_count
+    from stereovision.stream import temporal_pairs
+
+    assert (_temporal_frames("8.0"), temporal_pairs("8.0"), _point_count("1000.0")) == (8, 8, 1000)
+    with pytest.raises(refused, match=r"^expected 2-255 pairs to average, got '8\.5'$"):
+        temporal_pairs("8.5")
     with pytest.raises(SystemExit):
         parser.parse_args(["--workers", "2.5"])
     assert capsys.readouterr().err == (

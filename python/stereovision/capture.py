@@ -3831,10 +3831,12 @@ def _temporal_frames(text: str) -> int:
     """argparse type of ``capture --temporal``: a whole number, refused in the words of
     :func:`cmd_capture`'s range check (``8.5`` was "expected a whole number", ``1`` "expected
     2-255 frames a pair": two wordings of one refusal). The range is checked there."""
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected 2-255 frames a pair, got {text!r}") from None
+    from stereovision.cli import whole_number  # 8.0 too, as every whole-number option
+
+    value = whole_number(text)
+    if value is None:
+        raise argparse.ArgumentTypeError(f"expected 2-255 frames a pair, got {text!r}")
+    return value
 
 
 def add_cli(subparsers: Any) -> None:

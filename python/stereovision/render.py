@@ -1812,11 +1812,10 @@ def _point_count(text: str) -> int:
     """argparse type of ``view``'s ``--max-points``: a whole number of 0 or more, refused in
     one wording (-1 was the command's "--max-points: expected 0 (all) or more", 1.5 argparse's
     "expected a whole number")."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
+    from stereovision.cli import whole_number  # 1000.0 too, as every whole-number option
+
+    value = whole_number(text)
+    if value is None or value < 0:
         raise argparse.ArgumentTypeError(
             f"expected a whole number of points, 0 (all) or more, got {text!r}"
         )

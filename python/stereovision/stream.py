@@ -1891,11 +1891,10 @@ def temporal_pairs(text: str) -> int:
     """argparse type of ``--temporal``: 2 to 255 pairs (the filter's bounds), refused in the
     option's name as the other counts are (``8.5`` was argparse's "invalid int value", and ``1``
     was refused only after ``--calib`` was read)."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 2 <= value <= 255:
+    from stereovision.cli import whole_number  # 8.0 too, as every whole-number option
+
+    value = whole_number(text)
+    if value is None or not 2 <= value <= 255:
         raise argparse.ArgumentTypeError(f"expected 2-255 pairs to average, got {text!r}")
     return value
 
