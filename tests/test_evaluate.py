@@ -103,6 +103,21 @@ def test_depth_metrics_no_overlap() -> None:
         depth_metrics(np.ones((2, 2)), np.ones((3, 2)))
 
 
+def test_figures_beyond_float64_are_inf_without_numpy_warnings() -> None:
+    """float64 maps of 1e300 overflowed the squares (and 1e300 / 1e-10 the relative error):
+    NumPy's "overflow encountered in square" RuntimeWarning out of dense_metrics,
+    depth_metrics and table1_report (an error under -W error). The figures are inf, as before."""
+    big, one = np.full((2, 2), 1e300), np.ones((2, 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dense = dense_metrics(big, -big)
+        depth = depth_metrics(big, np.full((2, 2), 1e-10))
+        rep = table1_report(big, one, n_points=3)
+    assert (dense.avgerr, dense.rms, dense.bad[2.0]) == (2e300, INF, 100.0)
+    assert (depth.median_rel, depth.rmse, depth.rmse_pct, depth.n) == (INF, INF, INF, 4)
+    assert (rep.rmse, rep.mean_error, rep.mean_distance) == (INF, 1e300 - 1, 1.0)
+
+
 def _rect_calib(f: float = 500.0, b_mm: float = 100.0, doffs: float = 0.0) -> Calibration:
     K1 = np.array([[f, 0, 100.0], [0, f, 50.0], [0, 0, 1]])
     K2 = K1.copy()

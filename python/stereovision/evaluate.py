@@ -245,14 +245,19 @@ def dense_metrics(
     _warn_if_png_gt(g, np.asarray(gt).dtype.kind in "iu", scored=known)
     n_gt = int(known.sum())
     est = np.isfinite(d) & known
-    err = np.abs(d[est] - g[est])
     n_both = int(est.sum())
+    # float64 maps beyond 1e154 overflow the squares (1e308 apart, the difference): those
+    # figures are inf, as they were, without NumPy's RuntimeWarning on the way
+    with np.errstate(over="ignore"):
+        err = np.abs(d[est] - g[est])
+        avgerr = float(err.mean()) if n_both else math.nan
+        rms = float(np.sqrt(np.mean(err**2))) if n_both else math.nan
     bad = {float(t): _pct(n_gt - int(np.count_nonzero(err <= t)), n_gt) for t in ts}
     return DenseMetrics(
         bad=bad,
         density=_pct(n_both, n_gt),
-        avgerr=float(err.mean()) if n_both else math.nan,
-        rms=float(np.sqrt(np.mean(err**2))) if n_both else math.nan,
+        avgerr=avgerr,
+        rms=rms,
         n_gt=n_gt,
         n_both=n_both,
     )
@@ -420,13 +425,15 @@ def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     n = int(both.sum())
     if n == 0:
         return DepthMetrics(math.nan, math.nan, math.nan, math.nan, 0, 0.0)
-    diff = e[both] - g[both]
-    rel = np.abs(diff) / g[both]
-    rmse = float(np.sqrt(np.mean(diff**2)))
+    with np.errstate(over="ignore"):  # as dense_metrics: inf beyond float64, unwarned
+        diff = e[both] - g[both]
+        rel = np.abs(diff) / g[both]
+        rmse = float(np.sqrt(np.mean(diff**2)))
+        mean_gt = float(np.mean(g[both]))
     return DepthMetrics(
         median_rel=100.0 * float(np.median(rel)),
         share_off_5=_pct(int(np.count_nonzero(rel > DEPTH_OFF_FRACTION)), n),
-        rmse_pct=100.0 * rmse / float(np.mean(g[both])),
+        rmse_pct=100.0 * rmse / mean_gt,
         rmse=rmse,
         n=n,
         density=_pct(n, e.size),
@@ -710,18 +717,21 @@ def table1_report(
         missing = ~both[ys, xs]
         if missing.any():
             raise ValueError(f"points: {pts[missing].tolist()} lack an estimated or GT distance")
-    est = e[ys, xs] * factor
-    ref = g[ys, xs] * factor
-    err = est - ref
-    rmse = float(np.sqrt(np.mean(err**2)))
-    mean_d = float(np.mean(ref))
+    with np.errstate(over="ignore"):  # as dense_metrics: inf beyond float64, unwarned
+        est = e[ys, xs] * factor
+        ref = g[ys, xs] * factor
+        err = est - ref
+        rmse = float(np.sqrt(np.mean(err**2)))
+        mean_d = float(np.mean(ref))
+        mean_error = float(np.mean(err))
+        mean_abs_error = float(np.mean(np.abs(err)))
     return Table1Report(
         x=np.asarray(xs, dtype=np.int64),
         y=np.asarray(ys, dtype=np.int64),
         estimated=est,
         ground_truth=ref,
-        mean_error=float(np.mean(err)),
-        mean_abs_error=float(np.mean(np.abs(err))),
+        mean_error=mean_error,
+        mean_abs_error=mean_abs_error,
         rmse=rmse,
         rmse_pct=100.0 * rmse / mean_d,
         mean_distance=mean_d,
