@@ -2544,6 +2544,15 @@ def test_the_view_colours_the_whole_range_and_waits_for_a_new_frame() -> None:
         srv.close()
 
 
+def test_the_view_closes_at_once() -> None:
+    """close() waited for socketserver's 0.5 s poll to see the stop: every stream with a view
+    ended 0.45-0.5 s late (after Ctrl-C too); it waits one SERVE_POLL_S now."""
+    srv = FrameServer("127.0.0.1", 0)
+    t0 = time.perf_counter()
+    srv.close()
+    assert time.perf_counter() - t0 < 0.25 and srv.closed
+
+
 def test_the_view_encodes_each_frame_once_for_every_viewer(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
