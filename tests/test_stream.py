@@ -1859,6 +1859,30 @@ def test_a_first_pair_that_does_not_decode_is_a_value_error() -> None:
     assert (rep.frames, rep.ended, rep.error) == (1, "source failed", "frame 1 does not decode")
 
 
+def test_a_later_frame_the_temporal_filter_cannot_average_ends_the_stream() -> None:
+    """A 16-bit image after 8-bit pairs (a sequence mixing them) with ``temporal`` raised the
+    filter's ValueError out of run_stream, the summary of the pairs done lost (the CLI said the
+    error line alone); it ends the stream as a source failing, those pairs reported. On the
+    first pair it is raised as before."""
+    from stereovision.capture import StereoFrame
+    from stereovision.temporal import TemporalFilter
+
+    deep = _frame(2)
+    deep = StereoFrame(deep.left.astype(np.uint16) * 257, deep.right.astype(np.uint16) * 257,
+                       deep.t_left, deep.t_right, 2)  # fmt: skip
+    rig = _FakeRig([_frame(0), _frame(1), deep])
+    rep = run_stream(rig, max_disparity=8, pipelined=False, check=False, temporal=TemporalFilter(4))  # type: ignore[arg-type]
+    assert (rep.frames, rep.ended) == (2, "source failed")
+    assert rep.error == (
+        "temporal averaging takes 8-bit frames: the left source delivers uint16 ones (a 16-bit "
+        "image sequence?); convert them to 8 bits, or leave the averaging out"
+    )
+    with pytest.raises(ValueError, match="temporal averaging takes 8-bit frames") as err:
+        run_stream(_FakeRig([deep]), max_disparity=8, pipelined=False, check=False,  # type: ignore[arg-type]
+                   temporal=TemporalFilter(4))  # fmt: skip
+    assert type(err.value) is ValueError
+
+
 def test_a_later_frame_that_does_not_decode_is_no_end_of_the_source() -> None:
     """A camera whose first pair was read before the stream (a preview) and whose next frame
     does not decode: no pair was done, so the error is raised, a SourceError that is not an end

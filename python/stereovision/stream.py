@@ -194,7 +194,8 @@ class StreamReport:
     ended : str
         ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C),
         ``"terminated"`` (SIGTERM, under the CLI), ``"source failed"`` (a source failed
-        after the first pair: a frame that does not decode or of another shape, a camera
+        after the first pair: a frame that does not decode, of another shape or, with
+        ``temporal``, of more than 8 bits, a camera
         device or live stream (``rtsp://``) that stopped delivering, unplugged or its network
         gone; see :attr:`error`) or ``"output failed"``
         (``on_result`` or ``on_stamped_result`` raised an OSError, e.g. a bag on a full disk:
@@ -697,7 +698,15 @@ def _pairs(
         if temporal is not None:
             if n == 0:
                 note = resampled_for_temporal_note(camera, fr)
-            left, right = temporal_average(temporal, fr)
+            try:
+                left, right = temporal_average(temporal, fr)
+            except ValueError as exc:
+                # a frame it cannot average after pairs were done (a 16-bit image in an 8-bit
+                # sequence): raised as it was, it lost the summary of those pairs (a --bag's
+                # line too); the source failing ends the stream, as a frame that does not decode
+                if n == 0:
+                    raise
+                raise SourceError(str(exc), end=False, frames=camera.count) from exc
             averaged = temporal.mean_frames()
             filtered = (temporal.frames, temporal.restarts, _filter_noise(temporal))
         t2 = time.perf_counter()
@@ -1021,7 +1030,8 @@ def run_stream(
     ------
     SourceError
         If a source delivers no first frame, or fails on the first pair. A failure after it
-        (a frame that does not decode or of another shape; a camera device or a live stream
+        (a frame that does not decode, of another shape or, with ``temporal``, of more than 8
+        bits; a camera device or a live stream
         such as ``rtsp://``, unlike a file, that stops delivering) ends the stream instead:
         the pairs done are reported, with ``ended`` ``"source failed"`` and the error in
         ``error``; an OSError of ``on_result`` or ``on_stamped_result`` (an output that cannot
