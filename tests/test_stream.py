@@ -1847,6 +1847,21 @@ def test_run_stream_refuses_a_report_period_that_is_no_number_of_seconds() -> No
         assert (rep.frames, len(rep.reports)) == (3, reports)
 
 
+def test_the_report_keeps_the_latest_reports_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """StreamReport.reports kept every per-second report, 1.3 kB each: 114 MB a day at the
+    default period, 140 MB an hour with one per pair at 30 fps. It keeps the latest
+    REPORTS_KEPT; on_report still gets every one."""
+    import stereovision.stream as stream
+
+    monkeypatch.setattr(stream, "REPORTS_KEPT", 2, raising=False)  # (fails on the old code)
+    got: list[dict[str, Any]] = []
+    rig = _FakeRig([_frame(i) for i in range(4)])
+    rep = run_stream(rig, max_disparity=8, pipelined=False, check=False, report_period=0.0,  # type: ignore[arg-type]
+                     on_report=got.append)  # fmt: skip
+    assert [r["total_frames"] for r in got] == [1, 2, 3, 4]
+    assert rep.reports == got[2:] and isinstance(rep.reports, list)
+
+
 def test_a_first_pair_that_does_not_decode_is_a_value_error() -> None:
     """A recording's first frame that does not decode raises its ValueError as it is; only a
     later one becomes the source failing (SourceError, the stream's summary)."""
