@@ -2476,6 +2476,22 @@ class _SkippingRig(_FakeRig):
         pass
 
 
+def test_the_temporal_line_says_one_restart_in_the_singular(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The summary's temporal line said "1 restarts" (pairs and frames are said in the
+    singular since fd8a1f4): a still view, then another one, restarts once."""
+    import stereovision.stream as stream
+
+    rig = _SkippingRig([_frame(0), _frame(0), _frame(1)])
+    rig.skipped = 0
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: rig)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check"]
+    assert main([*argv, "--no-pipeline", "--max-disparity", "8", "--temporal", "4"]) == 0
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert line.startswith("temporal: 1.3 frames averaged per pixel on average, 1 restart (the")
+
+
 @PIPELINED
 def test_the_pairs_a_realtime_stream_skipped_are_said(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch

@@ -1846,7 +1846,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
             file=out,
         )
         if report.temporal is not None and not report.frames:
-            print(f"temporal: no pair filtered, {report.temporal['restarts']} restarts", file=out)
+            restarts = _counted(int(report.temporal["restarts"]), "restart")
+            print(f"temporal: no pair filtered, {restarts}", file=out)
         elif report.temporal is not None:
             tp = report.temporal
             noise = (
@@ -1856,7 +1857,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             )
             print(
                 f"temporal: {tp['frames_averaged']:.1f} frames averaged per pixel on average,"
-                f" {tp['restarts']} restarts (the rig or the view moved), {noise}",
+                f" {_counted(int(tp['restarts']), 'restart')} (the rig or the view moved), {noise}",
                 file=out,
             )
         found = [g for g in report.grounds if g["found"]]
