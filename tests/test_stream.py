@@ -2770,6 +2770,28 @@ def _blank_frame(index: int) -> Any:
     return StereoFrame(img, img.copy(), now, now, index)
 
 
+def test_a_range_estimated_from_a_flat_first_pair_is_said() -> None:
+    """A first pair of one flat level (a capped lens, a webcam's first black frames) gave the
+    estimate's fallback, searched for the whole run without a word; it is said. A textured
+    first pair, or a range given, says nothing."""
+    from stereovision.capture import StereoFrame
+
+    black = StereoFrame(np.zeros((48, 64, 3), np.uint8), np.zeros((48, 64, 3), np.uint8),
+                        0.0, 0.0, 0)  # fmt: skip
+    rig: Any = _FakeRig([black, _frame(1)])
+    with pytest.warns(UserWarning) as said:
+        rep = run_stream(rig, pipelined=False, check=False)
+    assert rep.max_disparity == 16 and [str(w.message) for w in said] == [
+        "the first pair, which the disparity range is estimated from, is one flat level (a "
+        "capped lens, a dark room, a camera still starting): the stream searches 16 px, a "
+        "guess, throughout; give the range (--max-disparity N)"
+    ]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run_stream(_FakeRig([_frame(0)]), pipelined=False, check=False)  # type: ignore[arg-type]
+        run_stream(_FakeRig([black]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+
+
 def test_a_stream_without_a_floor_says_why(
     data_dir: Path,
     tmp_path: Path,
