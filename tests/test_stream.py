@@ -3112,6 +3112,26 @@ def test_the_view_listens_on_the_loopback_by_default() -> None:
             FrameServer(host, 0)
 
 
+def test_a_view_on_every_interface_says_where_to_open_it(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--host 0.0.0.0`` (to watch from a laptop) said "serving the live view on
+    http://0.0.0.0:PORT/", an address browsers refuse: the line says where to open it."""
+    import stereovision.stream as stream
+
+    rig = _SkippingRig([_frame(0)])
+    rig.skipped = 0
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: rig)
+    argv = ["stream", "--left", "0", "--right", "1", "--serve", "0", "--no-check", "--no-pipeline"]
+    assert main([*argv, "--host", "0.0.0.0", "--max-disparity", "8"]) == 0
+    line = capsys.readouterr().err.splitlines()[0]
+    port = re.fullmatch(r"serving the live view on http://0\.0\.0\.0:(\d+)/ .*", line)
+    assert port is not None and line.endswith(
+        f"/ (every interface: http://127.0.0.1:{port[1]}/ on this machine, its network address "
+        "from others)"
+    )
+
+
 def _ipv6_loopback() -> bool:
     import socket
 

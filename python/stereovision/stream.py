@@ -1749,7 +1749,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 "127.0.0.1" if args.host is None else args.host,
                 DEFAULT_PORT if args.serve is None else args.serve,
             )
-            print(f"serving the live view on {server.url}", file=log, flush=True)
+            serving = f"serving the live view on {server.url}{_every_interface(server)}"
+            print(serving, file=log, flush=True)
             srv = server
             sinks.append(
                 lambda left, res: srv.update(left, res.disparity, float(res.max_disparity))
@@ -1904,6 +1905,21 @@ def cmd_stream(args: argparse.Namespace) -> int:
         # the summary and the bag are out; the exit status still tells a script it was cut short
         return cut
     return EXIT_ERROR if report.error is not None else 0
+
+
+def _every_interface(server: FrameServer) -> str:
+    """How to open a view served on every interface (``--host 0.0.0.0`` or ``::``), whose URL
+    alone is no address to browse (browsers refuse 0.0.0.0); "" for any other host."""
+    import ipaddress
+
+    try:
+        unspecified = ipaddress.ip_address(server._host).is_unspecified
+    except ValueError:  # a name, or a scoped address
+        return ""
+    if not unspecified:
+        return ""
+    here = _host_port("::1" if ":" in server._host else "127.0.0.1", server.port)
+    return f" (every interface: http://{here}/ on this machine, its network address from others)"
 
 
 def _bag_line(bag: Any, pairs: int) -> str:
