@@ -2134,6 +2134,25 @@ def test_check_every_one_checks_every_pair() -> None:
     assert [c["pair"] for c in rep.checks] == [0, 1, 2]
 
 
+def test_a_check_that_cannot_tell_does_not_warn_of_the_same_bump_again() -> None:
+    """Rows that stopped agreeing warn once; a check that could not tell in between (ok None:
+    too few matches, a dark or bare view) made the next failing one warn again, for the same
+    bump. Rows that agree again, then fail, still warn."""
+    from types import SimpleNamespace
+
+    from stereovision.stream import _note_check
+
+    def result(ok: bool | None) -> Any:
+        return SimpleNamespace(ok=ok, as_dict=lambda: {"ok": ok}, summary=lambda: f"ok {ok}")
+
+    checks: list[dict[str, Any]] = []
+    with pytest.warns(UserWarning) as said:
+        for pair, ok in enumerate((True, False, None, False, None, True, False)):
+            _note_check(pair, result(ok), checks)
+    assert [str(w.message) for w in said] == ["pair 1: ok False", "pair 6: ok False"]
+    assert [c["pair"] for c in checks] == list(range(7))
+
+
 @pytest.mark.parametrize("pipelined", [False, True])
 @PIPELINED
 def test_a_source_failing_on_the_first_pair_is_raised(pipelined: bool) -> None:

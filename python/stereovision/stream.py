@@ -1440,7 +1440,9 @@ def _note_flat_range(left: np.ndarray, md: float) -> None:
 
 def _note_check(pair: int, result: RectificationCheck, checks: list[dict[str, Any]]) -> None:
     """Record a pair's check; warn when the rows stop agreeing (once per change)."""
-    was_ok = checks[-1]["ok"] if checks else True
+    # against the last check that could tell: one that could not (too few matches: a dark or
+    # bare view, ok None) between two failing ones warned of the same bump again
+    was_ok = next((c["ok"] for c in reversed(checks) if c["ok"] is not None), True)
     checks.append({"pair": pair, **result.as_dict()})
     if result.ok is False and was_ok is not False:
         where = "first pair" if pair == 0 else f"pair {pair}"
