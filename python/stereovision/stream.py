@@ -16,7 +16,7 @@ The result is shown by serving it over HTTP (OpenCV's own windows are not part o
 OpenCV build the package depends on): ``http://HOST:PORT/`` is a page with the live left image and
 colour-mapped disparity side by side, ``/stream.mjpg`` the MJPEG stream itself (any browser or
 ``ffplay`` plays it) and ``/frame.jpg`` the latest frame. Frames are encoded only while a client
-asks for them. ``--no-display`` turns the server off (headless robots).
+asks for them, each once for all clients. ``--no-display`` turns the server off (headless robots).
 """
 
 from __future__ import annotations
