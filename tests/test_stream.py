@@ -2627,6 +2627,29 @@ def test_the_view_closes_at_once() -> None:
     assert time.perf_counter() - t0 < 0.25 and srv.closed
 
 
+def test_the_view_answers_a_head_request() -> None:
+    """A health check's HEAD (``curl -I``, a monitor's probe) got 501 "Unsupported method", as
+    if the view were down: it gets the GET's status and headers, without the body."""
+    srv = FrameServer("127.0.0.1", 0)
+    try:
+
+        def head(path: str) -> tuple[int, str, bytes]:
+            req = urllib.request.Request(srv.url + path, method="HEAD")
+            try:
+                with urllib.request.urlopen(req, timeout=60) as r:
+                    return r.status, r.headers["Content-Type"], r.read()
+            except urllib.error.HTTPError as e:
+                return e.code, e.headers["Content-Type"], e.read()
+
+        assert head("frame.jpg") == (503, "text/plain", b"")
+        srv.update(np.zeros((8, 8, 3), np.uint8), np.zeros((8, 8), np.float32), 8.0)
+        assert head("frame.jpg") == (200, "image/jpeg", b"")
+        assert head("")[:2] == (200, "text/html; charset=utf-8")
+        assert head("stream.mjpg")[:2] == (200, "multipart/x-mixed-replace; boundary=frame")
+    finally:
+        srv.close()
+
+
 def test_the_view_encodes_each_frame_once_for_every_viewer(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -351,7 +351,8 @@ class FrameServer:
     """A tiny MJPEG-over-HTTP view of the latest result.
 
     ``GET /`` returns a page showing the stream, ``/stream.mjpg`` the multipart MJPEG stream,
-    ``/frame.jpg`` the latest frame as one JPEG (503 before the first one).
+    ``/frame.jpg`` the latest frame as one JPEG (503 before the first one); ``HEAD`` their
+    status and headers.
 
     Parameters
     ----------
@@ -392,8 +393,17 @@ class FrameServer:
         server = self
 
         class Handler(BaseHTTPRequestHandler):
+            #: a HEAD request: the GET's status and headers, no body
+            head = False
+
             def log_message(self, format: str, *args: Any) -> None:  # quiet
                 return
+
+            def do_HEAD(self) -> None:
+                # a robot's health check (curl -I, a monitor's probe of /frame.jpg) got 501
+                # "Unsupported method", as if the view were down
+                self.head = True
+                self.do_GET()
 
             def do_GET(self) -> None:
                 path = self.path.split("?", 1)[0]
@@ -421,13 +431,16 @@ class FrameServer:
                 self.send_header("Content-Length", str(len(body)))
                 self.send_header("Cache-Control", "no-store")
                 self.end_headers()
-                self.wfile.write(body)
+                if not self.head:
+                    self.wfile.write(body)
 
             def _stream(self) -> None:
                 self.send_response(200)
                 self.send_header("Content-Type", "multipart/x-mixed-replace; boundary=frame")
                 self.send_header("Cache-Control", "no-store")
                 self.end_headers()
+                if self.head:
+                    return
                 seen = -1
                 try:
                     while True:
