@@ -1700,6 +1700,27 @@ def test_laser_scan_range_max_is_finite() -> None:
         laser_scan(pts, plane, **angles, range_max=math.inf)
 
 
+def test_laser_scan_refuses_points_of_another_image_size() -> None:
+    """An image of points of another size than the plane's map or the calibration's images
+    (another frame, rig or resolution) was scanned with the calibration's beams without a word;
+    it is refused naming the sizes. A cloud has no size to check: the same scan as its image."""
+    plane, pts = _level_floor()
+    angles = {"angle_min": -0.5, "angle_max": 0.5}
+    want = laser_scan(pts, plane, **angles).ranges
+    np.testing.assert_array_equal(laser_scan(pts.reshape(-1, 3), plane, **angles).ranges, want)
+    big = np.repeat(np.repeat(pts, 2, axis=0), 2, axis=1)
+    with pytest.raises(
+        ValueError, match=re.escape("points: an image of 8x8 points, where this plane's map is 4x4")
+    ):
+        laser_scan(big, plane, **angles)
+    rig_plane = replace(plane, inliers=np.zeros(SIZE[::-1], bool))
+    assert len(laser_scan(pts.reshape(-1, 3), rig_plane, RIG).ranges) == SIZE[0]
+    with pytest.raises(ValueError, match=re.escape("the calibration's images are 480x360")):
+        laser_scan(pts, plane, RIG)
+    with pytest.raises(ValueError, match=re.escape("points: an image of 4x4 points, where this")):
+        laser_scan(pts, rig_plane, RIG)
+
+
 def test_scan_dict_keeps_the_sign_of_an_infinity_and_is_strict_json() -> None:
     """A hand-made scan's -inf (REP 117: an obstacle too near to measure) was written "inf",
     the beam free; its scalar fields went to json.dumps as they were: an infinite range_max as
@@ -1751,7 +1772,8 @@ def test_support_counts_as_the_fit_counts() -> None:
 
 def test_laser_scan_angles_given_with_calib() -> None:
     """With calib, a given angle_min, angle_max or angle_increment overrides the image's."""
-    plane, pts = _level_floor()
+    plane, image = _level_floor()
+    pts = image.reshape(-1, 3)  # a cloud: the 4 x 4 image is not the rig's 480 x 360
     scan = laser_scan(pts, plane, RIG, angle_min=-0.2, angle_increment=0.01)
     assert scan.angle_min == -0.2 and scan.angle_increment == 0.01
     full = laser_scan(pts, plane, RIG)

@@ -1443,6 +1443,22 @@ def _beam_span(calib: Calibration, axes: F64) -> tuple[float, float, int]:
     return float(ang.min()), float(ang.max()), w
 
 
+def _same_image(pts: F64, plane: GroundPlane, calib: Calibration | None) -> None:
+    """A ``ValueError`` for an image of points (``(H, W, 3)``) of another size than the plane's
+    map, or than the calibration's images: points of another frame or rig, whose scan the beams
+    of ``calib`` (one per column of its images) do not describe. A cloud (``(N, 3)``) has no
+    image size to check."""
+    if pts.ndim != 3:
+        return
+    h, w = pts.shape[:2]
+    sizes = {"this plane's map is": plane.inliers.shape}
+    if calib is not None:
+        sizes["the calibration's images are"] = calib.image_size[::-1]
+    if any(tuple(size) != (h, w) for size in sizes.values()):
+        said = " and ".join(f"{what} {size[1]}x{size[0]}" for what, size in sizes.items())
+        raise ValueError(f"points: an image of {w}x{h} points, where {said}")
+
+
 def laser_scan(
     points: npt.ArrayLike,
     plane: GroundPlane,
@@ -1491,10 +1507,11 @@ def laser_scan(
     Raises
     ------
     ValueError
-        For points not real or not of shape ``(..., 3)``, no angles (no ``calib`` and no
-        ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, beams over more than a full
-        turn, a non-positive increment or over 100000 beams, a bad height band or range
-        (``range_max`` infinite too), or ``min_points < 1``.
+        For points not real or not of shape ``(..., 3)``, an image of points (``(H, W, 3)``)
+        of another size than the plane's map or the calibration's images, no angles (no
+        ``calib`` and no ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, beams over
+        more than a full turn, a non-positive increment or over 100000 beams, a bad height band
+        or range (``range_max`` infinite too), or ``min_points < 1``.
     TypeError
         If ``plane`` is not a :class:`GroundPlane`, or ``calib`` is given and is not a
         :class:`~stereovision.Calibration` (a path: read it with ``Calibration.from_file``).
@@ -1507,6 +1524,7 @@ def laser_scan(
     pts = _points_array(points, "point_image()")
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
+    _same_image(pts, plane, calib)
     lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
     if not (math.isfinite(lo) and lo >= 0 and hi > lo):
         raise ValueError(
