@@ -1498,7 +1498,9 @@ def laser_scan(
     range_min, range_max : float
         Distances kept (metres, on the floor from the point under the camera).
     min_points : int
-        Obstacle points a beam needs; its range is the distance of that many-th nearest.
+        Obstacle points a beam needs; its range is the distance of that many-th nearest. At
+        most the number of points given (rows of ``points``, NaN included), or
+        :data:`MIN_OBSTACLE_POINTS`.
 
     Returns
     -------
@@ -1511,7 +1513,8 @@ def laser_scan(
         of another size than the plane's map or the calibration's images, no angles (no
         ``calib`` and no ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, beams over
         more than a full turn, a non-positive increment or over 100000 beams, a bad height band
-        or range (``range_max`` infinite too), or ``min_points < 1``.
+        or range (``range_max`` infinite too), or ``min_points`` under 1 or more than the
+        points given (and than :data:`MIN_OBSTACLE_POINTS`).
     TypeError
         If ``plane`` is not a :class:`GroundPlane`, or ``calib`` is given and is not a
         :class:`~stereovision.Calibration` (a path: read it with ``Calibration.from_file``).
@@ -1545,7 +1548,15 @@ def laser_scan(
         or min_points < 1
     ):
         raise ValueError(f"min_points: expected an integer >= 1, got {min_points!r}")
-    min_points = min(int(min_points), 2**62)  # more than any cloud's points: no beam returns
+    # more than the points given: no beam could hold an obstacle, and every beam that saw the
+    # floor said free (+inf) whatever stood on it (10**30: every beam free or unseen)
+    n_given = pts.size // 3
+    if int(min_points) > max(n_given, MIN_OBSTACLE_POINTS):
+        raise ValueError(
+            f"min_points: {reprlib.repr(int(min_points))} is more than the {n_given} points "
+            "given: no beam could hold an obstacle, and each one seeing the floor would say free"
+        )
+    min_points = int(min_points)
     axes = floor_frame(plane)
     if angle_min is None or angle_max is None:
         if calib is None:
