@@ -113,6 +113,13 @@ MIN_NEAR = 0.01  # metres
 #: whole by the 1 cm floor.
 MIN_NEAR_OF_FAR = 0.001
 CLIP_SAMPLE = 20_000  # points used to estimate the range
+#: :func:`point_cloud` leaves out a point farther than this many times the cloud's spread (the
+#: median distance of its points from their median point) from that point. VTK draws in float32,
+#: shifted to the middle of the bounds and scaled by their size: one point 1e8 m away from a
+#: cloud of 2-4 m (spread 1 m) left its points metres apart and the picture blank; one 1e6 m
+#: away moved 23 % of its pixels, 1e5 m 4 % (kept: a near-zero disparity is kilometres away, and
+#: the robust clipping range hides it). Such points lie far past the far clipping plane.
+DISPLAY_MAX_SPREADS = 1e6
 
 #: The camera looks at a point this far ahead when there is no scene depth to use (metres).
 _DEFAULT_FOCAL_DISTANCE = 1.0
@@ -911,6 +918,38 @@ def texture_of(mesh: pv.PolyData) -> pv.Texture | None:
     return pv.Texture(rgb)
 
 
+def _far_points(pts: npt.NDArray[np.float32], keep: npt.NDArray[np.bool_]) -> Any:
+    """The finite points (``keep``) over :data:`DISPLAY_MAX_SPREADS` spreads from the cloud's
+    median point, after a warning counting them, or None when there are none."""
+    from stereovision._validate import source_warning
+
+    idx = np.flatnonzero(keep)
+    sample = idx[np.linspace(0, len(idx) - 1, min(len(idx), CLIP_SAMPLE)).astype(np.int64)]
+    mid = np.median(pts[sample].astype(np.float64), axis=0)
+    spread = float(np.median(np.linalg.norm(pts[sample] - mid, axis=1)))
+    if not spread > 0:  # most points in one place: no scale to measure against
+        return None
+    # the largest coordinate first (fmin / fmax skip NaN; over the flat array, one fast pass):
+    # when every point is within reach of the middle, none is far (the distances of 2 M points
+    # took 0.7-1 s)
+    flat = pts.reshape(-1)
+    reach = max(float(np.fmax.reduce(flat)), -float(np.fmin.reduce(flat)))
+    if (reach + float(np.abs(mid).max())) * math.sqrt(3) <= DISPLAY_MAX_SPREADS * spread:
+        return None
+    dist = np.zeros(len(pts))
+    dist[idx] = np.linalg.norm(pts[idx].astype(np.float64) - mid, axis=1)
+    far = dist > DISPLAY_MAX_SPREADS * spread
+    if not far.any():
+        return None
+    source_warning(
+        f"points: {int(far.sum())} point(s) over {DISPLAY_MAX_SPREADS:g} times the cloud's "
+        f"spread ({spread:.3g} m) from its middle (e.g. {float(dist[far][0]):.3g} m away) left "
+        "out (not shown): drawn in float32 with it, they blur or blank the picture"
+    )
+    out: npt.NDArray[np.bool_] = far
+    return out
+
+
 def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> pv.PolyData:
     """Coloured point cloud as pyvista vertices.
 
@@ -934,7 +973,9 @@ def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> p
     -----
     UserWarning
         Naming how many points have a finite coordinate beyond float32's range (``1e39``):
-        they become inf in the cast and are dropped.
+        they become inf in the cast and are dropped; and how many lie over
+        :data:`DISPLAY_MAX_SPREADS` times the cloud's spread from its median point: they are
+        left out, as drawn they blanked the picture (a point 1e8 m away from a cloud of metres).
     """
     pv = _pv()
     from stereovision._validate import points_as_float32, source_warning
@@ -947,6 +988,9 @@ def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> p
     keep = np.isfinite(pts).all(axis=1)
     if not keep.any():
         raise ValueError("empty point cloud: no finite 3-D point to show")
+    far = _far_points(pts, keep)
+    if far is not None:
+        keep &= ~far
     cloud = pv.PolyData(pts[keep])
     if colors is not None:
         cols = np.asarray(colors)
