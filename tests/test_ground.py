@@ -382,6 +382,19 @@ def test_support_refuses_a_map_of_another_size() -> None:
             plane.support(floor, RIG, inlier_px=tol)
 
 
+def test_a_bool_mask_is_no_disparity_map() -> None:
+    """A mask passed for the disparity (the plane's inliers, obstacle_mask's) was a map of 0
+    and 1 px: support() said 0.02 of the floor it was fitted on ("the camera moved"), the fit
+    found no floor; both refuse it naming it."""
+    plane = replace(_level_floor()[0], inliers=np.ones(SIZE[::-1], bool))
+    for call in (lambda m: plane.support(m, RIG), lambda m: fit_ground_plane(m, RIG)):
+        with pytest.raises(
+            ValueError, match=re.escape("disparity: expected a map of pixels (numbers), got a bool")
+        ):
+            call(plane.inliers)
+    assert plane.support(np.full(SIZE[::-1], np.nan), RIG) == 0.0
+
+
 @pytest.mark.parametrize(("doffs", "fy"), [(0.0, F), (15.0, F), (0.0, 0.8 * F)])
 def test_plane_geometry_round_trips(doffs: float, fy: float) -> None:
     """A floor written as a disparity map from its 3-D plane is found exactly: the disparity

@@ -307,8 +307,8 @@ class GroundPlane:
         Raises
         ------
         ValueError
-            If ``disparity`` is not a real 2-D map, or its size is not the calibration's and the
-            plane's, or ``inlier_px`` is not a positive number.
+            If ``disparity`` is not a real 2-D map (a bool mask is not), or its size is not the
+            calibration's and the plane's, or ``inlier_px`` is not a positive number.
         TypeError
             If ``disparity`` is a whole ``DepthResult`` (pass ``result.disparity``) or ``calib``
             is not a :class:`~stereovision.Calibration`.
@@ -687,8 +687,8 @@ def fit_ground_plane(
     Raises
     ------
     ValueError
-        If ``disparity`` is not 2-D or its size is not the calibration's, or a parameter is out
-        of range.
+        If ``disparity`` is not a 2-D map of numbers (a bool mask is not) or its size is not
+        the calibration's, or a parameter is out of range.
     """
     return _fit_ground(disparity, calib, inlier_px, max_tilt_deg, seed)[0]
 
@@ -832,8 +832,8 @@ def _fit_ground(
 
 def _disparity_map(disparity: npt.ArrayLike) -> F64:
     """``disparity`` as a float64 ``(H, W)`` map, after the checks of what is none: a whole
-    ``DepthResult`` (TypeError naming ``result.disparity``), complex values, a map past the
-    kernels' 32-bit indices (before the copy), another number of dimensions."""
+    ``DepthResult`` (TypeError naming ``result.disparity``), complex values, a bool mask, a map
+    past the kernels' 32-bit indices (before the copy), another number of dimensions."""
     from stereovision._validate import check_index_range, not_a_result
 
     not_a_result(disparity, "disparity", "disparity")
@@ -841,6 +841,10 @@ def _disparity_map(disparity: npt.ArrayLike) -> F64:
         raise ValueError("disparity: expected a real map, got complex values")
     if isinstance(disparity, np.ndarray) and disparity.ndim == 2:  # before the float64 copy
         check_index_range(disparity.shape, "disparity", "map")
+    if np.asarray(disparity).dtype.kind == "b":
+        # a mask (plane.inliers, obstacle_mask's) was a map of 0 and 1 px: no floor found, or
+        # support 0.02 of the floor it was fitted on ("the camera moved")
+        raise ValueError("disparity: expected a map of pixels (numbers), got a bool mask")
     disp = np.asarray(disparity, np.float64)
     if disp.ndim != 2:
         raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
