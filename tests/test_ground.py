@@ -2361,6 +2361,21 @@ def test_a_hand_made_plane_of_an_infinite_height_is_refused(height: float) -> No
     assert str(exc.value) == f"height: expected a finite number of metres, got {height!r}"
 
 
+def test_a_hand_made_plane_with_the_camera_under_it_is_refused() -> None:
+    """A negative height (another tool's sign) built: 'camera -1.000 m above it', and the points
+    0.5 m above the floor lay 1.5 m below it: obstacle_mask marked none, the scan hit none.
+    Refused naming the same plane's figures; at +1 m the points are marked, 0 m builds."""
+    plane, pts = _level_floor()
+    with pytest.raises(ValueError) as exc:
+        replace(plane, height=-1.0)
+    assert str(exc.value) == (
+        "height: expected the camera's distance above the floor (>= 0 m), got -1.0: the same "
+        "plane with the camera above it is -normal, -height"
+    )
+    assert int(obstacle_mask(pts, plane).sum()) == 15
+    assert replace(plane, height=0.0).height == 0.0
+
+
 @pytest.mark.parametrize(
     ("field", "value", "says"),
     [

@@ -145,7 +145,8 @@ class GroundPlane:
     normal : numpy.ndarray
         ``(3,)`` unit normal pointing up, in the left rectified camera frame.
     height : float
-        Camera's distance above the plane (metres): the plane is ``normal . X + height = 0``.
+        Camera's distance above the plane (metres, not negative): the plane is ``normal . X +
+        height = 0``.
     disparity_plane : tuple of float
         ``(a, b, c)`` with the floor's disparity ``d = a u + b v + c`` (pixels).
     inliers : numpy.ndarray
@@ -202,6 +203,13 @@ class GroundPlane:
         # obstacle marked, 'camera inf m above it', as_dict's Infinity not JSON)
         if not math.isfinite(_number(self.height, "height")):
             raise ValueError(f"height: expected a finite number of metres, got {self.height!r}")
+        # a negative one (another tool's sign) put the camera under the floor: "camera -1.000 m
+        # above it", every point above the floor below it (no obstacle marked, no beam hit)
+        if self.height < 0:
+            raise ValueError(
+                f"height: expected the camera's distance above the floor (>= 0 m), got "
+                f"{self.height!r}: the same plane with the camera above it is -normal, -height"
+            )
         # the fit's figures alike: a NaN or infinite one built, and went to as_dict as NaN or
         # Infinity (not JSON); a fitted plane's are finite
         for name in ("inlier_share", "rms_px", "below_share"):
