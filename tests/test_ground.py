@@ -1635,6 +1635,30 @@ def test_height_limits_out_of_range() -> None:
             obstacle_mask(pts, plane, **kw)
 
 
+def test_points_near_float64s_largest_are_far_outside_without_a_warning() -> None:
+    """A point near float64's largest (1.7e308 m) warned NumPy's "overflow encountered in
+    matmul" from height_of, obstacle_mask, laser_scan and occupancy_grid (and hypot's); it is
+    infinitely far, outside the band, the beams and the grid, without a word: each result as
+    without the point."""
+    from stereovision.ground import occupancy_grid
+
+    plane, pts = _level_floor()
+    tilted = replace(plane, normal=np.array([0.0, -math.cos(0.1), -math.sin(0.1)]))
+    far, gone = pts.copy(), pts.copy()
+    far[3, 3], gone[3, 3] = 1.7e308, np.nan
+    angles = {"angle_min": -0.5, "angle_max": 0.5, "min_points": 1}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert tilted.height_of(far)[3, 3] == -math.inf
+        mask = obstacle_mask(far, tilted)
+        scan = laser_scan(far, tilted, **angles)
+        grid = occupancy_grid(far, tilted, resolution=0.5)
+    np.testing.assert_array_equal(mask, obstacle_mask(gone, tilted))
+    np.testing.assert_array_equal(scan.ranges, laser_scan(gone, tilted, **angles).ranges)
+    np.testing.assert_array_equal(grid.data, occupancy_grid(gone, tilted, resolution=0.5).data)
+    assert np.isfinite(scan.ranges).any()
+
+
 def test_points_outside_the_band_or_behind_the_grid_are_no_obstacle() -> None:
     """Obstacle points above max_height (what the robot passes under) return no beam; points
     just behind a grid's near edge (x -0.2 m, cells from 0) are outside it, not in its first

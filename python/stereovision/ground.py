@@ -282,7 +282,10 @@ class GroundPlane:
         pts = _points_array(points, "points")
         if pts.ndim == 0 or pts.shape[-1] != 3:
             raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
-        out: F64 = pts @ self.normal + self.height  # the camera (X = 0) is at +height
+        # a point near float64's largest (1.7e308 m) is -inf or +inf high, far outside any
+        # band, not NumPy's "overflow encountered in matmul"
+        with np.errstate(over="ignore"):
+            out: F64 = pts @ self.normal + self.height  # the camera (X = 0) is at +height
         return out
 
     def support(
@@ -1262,8 +1265,9 @@ def occupancy_grid(
     flat = pts.reshape(-1, 3)
     flat = flat[np.all(np.isfinite(flat), axis=1)]
     axes = floor_frame(plane)
-    xyz = flat @ axes.T
-    h = xyz[:, 2] + plane.height  # height above the floor
+    with np.errstate(over="ignore"):  # a point near float64's largest: infinite, outside
+        xyz = flat @ axes.T
+        h = xyz[:, 2] + plane.height  # height above the floor
     # a point 1e308 m away: its quotient inf (outside), not "overflow encountered in divide"
     with np.errstate(over="ignore"):
         fj = np.floor((xyz[:, 0] - x0) / res)
@@ -1605,9 +1609,10 @@ def laser_scan(
         )
     flat = pts.reshape(-1, 3)
     flat = flat[np.all(np.isfinite(flat), axis=1)]
-    xyz = flat @ axes.T
-    h = xyz[:, 2] + plane.height
-    dist = np.hypot(xyz[:, 0], xyz[:, 1])
+    with np.errstate(over="ignore"):  # a point near float64's largest: infinitely far, out
+        xyz = flat @ axes.T
+        h = xyz[:, 2] + plane.height
+        dist = np.hypot(xyz[:, 0], xyz[:, 1])
     # each point's angle from angle_min, taken once round the circle: arctan2's -pi..pi put
     # every point to the right (negative angles) outside a scan given as 0 to 2 pi, and KITTI
     # 000005's nearest obstacle (4.58 m) was missed. Angles already in the turn keep their bits.
