@@ -1202,11 +1202,16 @@ def test_laser_scan_refuses_more_min_points_than_points(count: int) -> None:
     plane, pts = _level_floor()
     angles = {"angle_min": -0.5, "angle_max": 0.5}
     with pytest.raises(
-        ValueError, match=re.escape(f"min_points: {int(count)} is more than the 16 points given")
+        ValueError,
+        match=re.escape(f"min_points: {int(count)} is more than the 16 points of the image given"),
     ):
         laser_scan(pts, plane, **angles, min_points=count)
     assert not np.isfinite(laser_scan(pts, plane, **angles, min_points=16).ranges).any()
     assert len(laser_scan(pts[0, :2].reshape(-1, 3), plane, **angles).ranges) == 230
+    # a cloud's rows vary frame to frame: fewer than min_points is a scan with no hit, not an
+    # error a robot's loop would fail on
+    cloud = laser_scan(pts.reshape(-1, 3), plane, **angles, min_points=count)
+    assert not np.isfinite(cloud.ranges).any() and len(cloud.ranges) == 230
 
 
 def _matrix_of_quaternion(x: float, y: float, z: float, w: float) -> np.ndarray:

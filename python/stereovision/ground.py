@@ -1514,9 +1514,9 @@ def laser_scan(
     range_min, range_max : float
         Distances kept (metres, on the floor from the point under the camera).
     min_points : int
-        Obstacle points a beam needs; its range is the distance of that many-th nearest. At
-        most the number of points given (rows of ``points``, NaN included), or
-        :data:`MIN_OBSTACLE_POINTS`.
+        Obstacle points a beam needs; its range is the distance of that many-th nearest. For
+        an image of points, at most its pixels (or :data:`MIN_OBSTACLE_POINTS`); a cloud of
+        fewer rows is taken (no beam holds an obstacle: a frame's cloud may be small).
 
     Returns
     -------
@@ -1530,7 +1530,7 @@ def laser_scan(
         ``calib`` and no ``angle_min`` / ``angle_max``), ``angle_max <= angle_min``, beams over
         more than a full turn, a non-positive increment or over 100000 beams, a bad height band
         or range (``range_max`` infinite too), or ``min_points`` under 1 or more than the
-        points given (and than :data:`MIN_OBSTACLE_POINTS`).
+        pixels of an image of points (and than :data:`MIN_OBSTACLE_POINTS`).
     TypeError
         If ``plane`` is not a :class:`GroundPlane`, or ``calib`` is given and is not a
         :class:`~stereovision.Calibration` (a path: read it with ``Calibration.from_file``).
@@ -1564,15 +1564,18 @@ def laser_scan(
         or min_points < 1
     ):
         raise ValueError(f"min_points: expected an integer >= 1, got {min_points!r}")
-    # more than the points given: no beam could hold an obstacle, and every beam that saw the
-    # floor said free (+inf) whatever stood on it (10**30: every beam free or unseen)
+    # more than an image of points holds: no beam could hold an obstacle, and every beam that
+    # saw the floor said free (+inf) whatever stood on it (10**30: every beam free or unseen).
+    # Only an image's size is a bound of the rig: a cloud's rows vary frame to frame (a dark
+    # frame's few points), and a live loop must not fail on one, so a cloud is never refused.
     n_given = pts.size // 3
-    if int(min_points) > max(n_given, MIN_OBSTACLE_POINTS):
+    if pts.ndim == 3 and int(min_points) > max(n_given, MIN_OBSTACLE_POINTS):
         raise ValueError(
             f"min_points: {reprlib.repr(int(min_points))} is more than the {n_given} points "
-            "given: no beam could hold an obstacle, and each one seeing the floor would say free"
+            "of the image given: no beam could hold an obstacle, and each one seeing the floor "
+            "would say free"
         )
-    min_points = int(min_points)
+    min_points = min(int(min_points), 2**62)  # more than any cloud's points: no beam returns
     axes = floor_frame(plane)
     if angle_min is None or angle_max is None:
         if calib is None:
