@@ -971,6 +971,21 @@ def test_depth_in_an_unknown_unit_or_without_depth_is_named() -> None:
         assert str(err.value).startswith(f"no {what}: depth_map was called without a calibration")
 
 
+def test_a_hand_made_result_whose_cloud_arrays_disagree_is_refused_up_front() -> None:
+    """5 colours for 6 points were taken without a word, then filtered() failed in NumPy's
+    words ("boolean index did not match indexed array along axis 0")."""
+    good = _known_depth_result(_rect_calib(2, 2))
+    with pytest.raises(ValueError) as err:
+        dataclasses.replace(good, colors=np.zeros((1, 3), np.uint8))
+    assert str(err.value) == (
+        "points, colors, pixels: expected one row per point in each, got 2, 1 and 2 rows"
+    )
+    with pytest.raises(ValueError) as err:
+        dataclasses.replace(good, pixels=np.zeros((2, 3), np.int32))
+    assert str(err.value) == "pixels: expected an (N, 2) array, one row per point, got shape (2, 3)"
+    assert len(good.filtered(max_depth=1.5).points) == 2  # agreeing arrays are taken as before
+
+
 def test_depth_counts_say_why_a_pixel_with_a_disparity_has_no_depth() -> None:
     """The demo's depth panel had holes on 16 % of the pixels where the disparity map had none,
     with no count or reason given: depth_counts() splits them into filled pixels (confidence 0,

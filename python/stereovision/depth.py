@@ -575,6 +575,9 @@ def _in_unit(metres: npt.NDArray[np.float32], unit: str) -> npt.NDArray[np.float
 class DepthResult:
     """Output of :func:`depth_map`.
 
+    One built by hand needs one row per point in ``points``, ``colors`` and ``pixels`` (a
+    ValueError otherwise).
+
     Attributes
     ----------
     disparity : ndarray, float32 (H, W)
@@ -654,6 +657,25 @@ class DepthResult:
     depth_sigma: npt.NDArray[np.float32] | None = None
     channels: DepthChannels | None = field(default=None, repr=False)
     limits: dict[str, float] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        # one row per point in each: a hand-made result with 5 colours for 6 points was built
+        # without a word, then failed in NumPy's words in filtered() ("boolean index did not
+        # match indexed array along axis 0") or in to_ply's
+        shapes = {name: np.shape(getattr(self, name)) for name in ("points", "colors", "pixels")}
+        widths = {"points": 3, "colors": 3, "pixels": 2}
+        for name, shape in shapes.items():
+            if len(shape) != 2 or shape[1] != widths[name]:
+                raise ValueError(
+                    f"{name}: expected an (N, {widths[name]}) array, one row per point, got "
+                    f"shape {shape}"
+                )
+        rows = [shape[0] for shape in shapes.values()]
+        if len(set(rows)) != 1:
+            raise ValueError(
+                "points, colors, pixels: expected one row per point in each, got "
+                f"{rows[0]}, {rows[1]} and {rows[2]} rows"
+            )
 
     @property
     def valid(self) -> npt.NDArray[np.bool_]:
