@@ -1206,6 +1206,21 @@ def test_matches_refuse_a_boolean_scalar_index() -> None:
     assert m[1].xl.tolist() == [20.0] and m[np.int64(1)].xl.tolist() == [20.0]
 
 
+def test_matches_refuse_a_boolean_mask_of_another_length() -> None:
+    """A mask of other matches (``m[other.score > 0.9]``) was NumPy's "boolean index did not
+    match indexed array along axis 0", naming no Matches; a list of bools is a mask too."""
+    m = _three()
+    for mask in (np.ones(2, bool), [True, False, True, True]):
+        with pytest.raises(IndexError) as err:
+            m[mask]
+        n = len(mask)
+        assert str(err.value) == (
+            f"Matches: a boolean mask of {n} values for 3 matches; give one value per match "
+            "(m[m.score > 0.9])"
+        )
+    assert m[[True, False, True]].xl.tolist() == [10.0, 30.0]
+
+
 def test_matches_rasters_leave_out_non_finite_positions_without_a_warning() -> None:
     """A NaN or infinite left position (a CSV row of ``nan``) is outside the image: left out of
     the rasters as one beyond the edge is, not cast to an integer with NumPy's 'invalid value

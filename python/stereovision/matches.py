@@ -218,6 +218,14 @@ class Matches:
             if not -n <= i < n:
                 raise IndexError(f"Matches: index {i} is out of range for {n} matches")
             index = slice(i, i + 1 or None)
+        mask = np.asarray(index) if isinstance(index, (list, np.ndarray)) else None
+        if mask is not None and mask.dtype == bool and mask.ndim == 1 and len(mask) != len(self):
+            # a mask of other matches (m[other.score > 0.9]) was NumPy's "boolean index did not
+            # match indexed array along axis 0", naming no Matches
+            raise IndexError(
+                f"Matches: a boolean mask of {len(mask)} values for {len(self)} matches; give "
+                "one value per match (m[m.score > 0.9])"
+            )
         pick = np.asarray(np.arange(len(self))[index])
         if pick.ndim != 1:
             raise IndexError(f"Matches: expected a 1-D index or mask, got shape {pick.shape}")
