@@ -986,6 +986,22 @@ def test_a_hand_made_result_whose_cloud_arrays_disagree_is_refused_up_front() ->
     assert len(good.filtered(max_depth=1.5).points) == 2  # agreeing arrays are taken as before
 
 
+def test_a_hand_made_result_whose_maps_disagree_in_shape_is_refused_up_front() -> None:
+    """A (3, 2) depth beside a (2, 2) disparity failed in depth_counts() and filtered() with
+    NumPy's "operands could not be broadcast together", a 1-D disparity in repr()."""
+    good = _known_depth_result(_rect_calib(2, 2))
+    with pytest.raises(ValueError) as err:
+        dataclasses.replace(good, depth=np.ones((3, 2), np.float32))
+    assert str(err.value) == "depth: expected the disparity's shape (2, 2), got (3, 2)"
+    with pytest.raises(ValueError) as err:
+        dataclasses.replace(good, confidence=None)
+    assert str(err.value) == "confidence: expected the disparity's shape (2, 2), got ()"
+    with pytest.raises(ValueError) as err:
+        dataclasses.replace(good, disparity=np.ones(4, np.float32))
+    assert str(err.value) == "disparity: expected an (H, W) map, got shape (4,)"
+    assert _known_depth_result(None).depth is None  # no depth, no depth_sigma: as before
+
+
 def test_depth_counts_say_why_a_pixel_with_a_disparity_has_no_depth() -> None:
     """The demo's depth panel had holes on 16 % of the pixels where the disparity map had none,
     with no count or reason given: depth_counts() splits them into filled pixels (confidence 0,

@@ -575,8 +575,9 @@ def _in_unit(metres: npt.NDArray[np.float32], unit: str) -> npt.NDArray[np.float
 class DepthResult:
     """Output of :func:`depth_map`.
 
-    One built by hand needs one row per point in ``points``, ``colors`` and ``pixels`` (a
-    ValueError otherwise).
+    One built by hand needs ``disparity``'s shape in ``confidence``, ``depth`` and
+    ``depth_sigma`` (each but ``confidence`` may be None), and one row per point in
+    ``points``, ``colors`` and ``pixels`` (a ValueError otherwise).
 
     Attributes
     ----------
@@ -659,6 +660,18 @@ class DepthResult:
     limits: dict[str, float] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
+        # one shape for the maps: a hand-made result with a (3, 3) depth beside a (2, 3)
+        # disparity failed in NumPy's words in depth_counts() and filtered() ("operands could
+        # not be broadcast together"), and a 1-D disparity in repr ("not enough values to unpack")
+        shape = np.shape(self.disparity)
+        if len(shape) != 2:
+            raise ValueError(f"disparity: expected an (H, W) map, got shape {shape}")
+        for name in ("confidence", "depth", "depth_sigma"):
+            value = getattr(self, name)
+            if (value is not None or name == "confidence") and np.shape(value) != shape:
+                raise ValueError(
+                    f"{name}: expected the disparity's shape {shape}, got {np.shape(value)}"
+                )
         # one row per point in each: a hand-made result with 5 colours for 6 points was built
         # without a word, then failed in NumPy's words in filtered() ("boolean index did not
         # match indexed array along axis 0") or in to_ply's
