@@ -1002,6 +1002,22 @@ def test_a_hand_made_result_whose_maps_disagree_in_shape_is_refused_up_front() -
     assert _known_depth_result(None).depth is None  # no depth, no depth_sigma: as before
 
 
+def test_filtered_refuses_a_hand_made_result_whose_pixels_leave_the_map() -> None:
+    """A point at x = -1 was kept or dropped by the map's last column without a word, one at
+    y = 2 of a 2-row map was NumPy's "index 2 is out of bounds for axis 0 with size 2"."""
+    good = _known_depth_result(_rect_calib(2, 2))
+    cases = [([[0, 0], [-1, 1]], "x -1 to 0, y 0 to 1"), ([[0, 0], [1, 2]], "x 0 to 1, y 0 to 2")]
+    for pixels, said in cases:
+        bad = dataclasses.replace(good, pixels=np.array(pixels, np.int32))
+        with pytest.raises(ValueError) as err:
+            bad.filtered(max_depth=1.5)
+        assert str(err.value) == f"pixels: each point's (x, y) must lie in the 2x2 map, got {said}"
+    bad = dataclasses.replace(good, pixels=np.array([[0.0, 0.0], [1.0, 1.0]]))
+    with pytest.raises(ValueError) as err:
+        bad.filtered(max_depth=1.5)
+    assert str(err.value) == "pixels: expected integer (x, y) pixels, got dtype float64"
+
+
 def test_depth_counts_say_why_a_pixel_with_a_disparity_has_no_depth() -> None:
     """The demo's depth panel had holes on 16 % of the pixels where the disparity map had none,
     with no count or reason given: depth_counts() splits them into filled pixels (confidence 0,

@@ -972,6 +972,7 @@ class DepthResult:
             number (``min_depth`` may be 0), or a ``min_depth`` above ``max_depth``, one of
             them given to an earlier call (``filtered(max_depth=2.5).filtered(min_depth=3)``
             is refused as ``filtered(min_depth=3, max_depth=2.5)`` is).
+            A hand-made result whose ``pixels`` are not integers inside the map.
         """
         if self.depth is None:
             raise ValueError(NO_DEPTH.format(what="depth to filter"))
@@ -1024,6 +1025,7 @@ class DepthResult:
         nan = np.float32(np.nan)
         sigma = None if self.depth_sigma is None else np.where(keep, self.depth_sigma, nan)
         if len(self.points):
+            _check_pixels(self.pixels, z.shape)
             on = keep[self.pixels[:, 1], self.pixels[:, 0]]
             points, colors, pixels = self.points[on], self.colors[on], self.pixels[on]
         else:
@@ -1094,6 +1096,22 @@ class DepthResult:
                 left = np.zeros((*depth.shape, 3), np.uint8)
             points, colors, _ = _cloud(depth, cal, left)
         return points, colors
+
+
+def _check_pixels(pixels: npt.NDArray[np.int32], shape: tuple[int, ...]) -> None:
+    """Refuse ``(x, y)`` pixels that are not integers inside a map of ``shape``: a hand-made
+    result's x of -1 read the map's last column without a word, an x past it was NumPy's
+    "index 2 is out of bounds for axis 0 with size 2"."""
+    px = np.asarray(pixels)
+    h, w = shape[:2]
+    if px.dtype.kind not in "iu":
+        raise ValueError(f"pixels: expected integer (x, y) pixels, got dtype {px.dtype}")
+    xs, ys = px[:, 0], px[:, 1]
+    if xs.min() < 0 or ys.min() < 0 or xs.max() >= w or ys.max() >= h:
+        raise ValueError(
+            f"pixels: each point's (x, y) must lie in the {w}x{h} map, got x "
+            f"{xs.min()} to {xs.max()}, y {ys.min()} to {ys.max()}"
+        )
 
 
 def disparity_sigma(
