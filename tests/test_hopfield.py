@@ -835,6 +835,24 @@ def test_a_bool_or_a_time_in_a_size_1_array_is_no_number(name: str, value: objec
     assert str(exc.value) == f"{name}: expected a number, got {value!r}"
 
 
+def test_a_text_none_or_list_parameter_is_named_as_gabor_names_it() -> None:
+    """s_min='0.5' was the binding's "parameter `s_min`: TypeError: must be real number, not
+    str" (k_cand=None "... 'NoneType' object cannot be interpreted as an integer", MCGM's
+    knn='6' likewise), where gabor_disparity says "s_min: expected a number, got '0.5'"."""
+    from stereovision.matching import mcgm
+
+    left = np.zeros((8, 12), np.float32)  # refused before any matching
+    for call, name, value in [
+        (hp.hopfield_match, "s_min", "0.5"),
+        (hp.best_match, "k_cand", None),
+        (hp.hopfield_match, "A", [3.0]),
+        (mcgm.mcgm_match, "knn", "6"),
+    ]:
+        with pytest.raises(ValueError) as exc:
+            call(left, left, max_disparity=4, **{name: value})
+        assert str(exc.value) == f"{name}: expected a number, got {value!r}"
+
+
 @pytest.mark.parametrize("method", ["hopfield", "best", "mcgm", "gabor", "fused"])
 def test_a_float16_range_gives_the_floats_matches_without_a_warning(method: str) -> None:
     """A range given as np.float16 (read from a half-precision map) was clipped against

@@ -891,16 +891,18 @@ def refuse_not_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> None
     and whose value is one of :data:`NOT_NUMBERS`: a matcher's kernel read True as 1 and 3 ns
     as 3 (``A=True``, ``k_cand=np.timedelta64(3)``). A switch's True is its own. A size-1 array
     is judged by its value, as :func:`read_numbers` reads one: ``A=np.array(True)`` ran as 1,
-    and one of a string or a datetime (``np.array('3')``, of dtype object too) as 3, though
-    ``A='3'`` is refused."""
+    and one of a string or a datetime (``np.array('3')``, of dtype object too) as 3. Nor is
+    anything else but a real number (a Fraction and a Decimal are) one: ``s_min='0.5'``, None
+    or ``[0.5]`` was the binding's "parameter `s_min`: TypeError: must be real number, not
+    str", where the Gabor channel says "s_min: expected a number, got '0.5'"."""
     for name, v in params.items():
         d = defaults.get(name)
         array = isinstance(v, np.ndarray) and v.size == 1
         scalar = v.reshape(())[()] if array else v
         number = isinstance(d, (int, float)) and not isinstance(d, bool)
-        text = array and isinstance(scalar, (str, bytes, np.datetime64))
-        if number and (isinstance(scalar, NOT_NUMBERS) or text):
-            raise ValueError(f"{name}: expected a number, got {v!r}")
+        real = isinstance(scalar, (numbers.Real, decimal.Decimal))
+        if number and (isinstance(scalar, NOT_NUMBERS) or not real):
+            raise ValueError(f"{name}: expected a number, got {_shown(v)}")
 
 
 def read_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> dict[str, Any]:
