@@ -357,6 +357,30 @@ def test_unknown_parameter_names_the_valid_ones() -> None:
         sv.match(ok, ok, method="hopfield", max_disparity=8, k_cnd=3)
 
 
+def test_a_misspelt_keyword_of_match_names_the_keyword() -> None:
+    """A misspelling of match()'s own keyword landed in **params, where the matcher named its
+    parameters only: max_disparty=8 was "unknown Hopfield parameter(s) ['max_disparty']" with
+    no hint ("did you mean 'min_disparity'?" with "fused"), calibration= likewise. Keys near a
+    parameter of the method are still the matcher's to name."""
+    ok = np.zeros((8, 12), np.float32)  # refused before any matching
+    for method, key, meant in [
+        ("hopfield", "max_disparty", "max_disparity"),
+        ("fused", "max_disparty", "max_disparity"),
+        ("mcgm", "calibration", "calib"),
+        ("gabor", "min_disp", "min_disparity"),
+        ("best", "methods", "method"),
+    ]:
+        with pytest.raises(ValueError) as err:
+            sv.match(ok, ok, method=method, **{key: 8})
+        assert (
+            str(err.value) == f"match: unknown keyword argument {key!r} (did you mean {meant!r}?)"
+        )
+    with pytest.raises(
+        ValueError, match=r"^unknown fusion option\(s\) \['mod'\] \(did you mean 'mode'"
+    ):
+        sv.match(ok, ok, method="fused", max_disparity=8, mod="vote")
+
+
 _NON_NEGATIVE = ["A", "B", "D", "theta", "compat_theta", "compat_slope", "compat_grad",
                  "tau_y", "edge_penalty", "rescue_med", "agree_tol"]  # fmt: skip
 

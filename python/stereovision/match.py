@@ -108,7 +108,8 @@ def match(
         string, an array), as :func:`~stereovision.depth_map` refuses it.
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration or rectification
-        for another image size, a ``calib`` of another type, an unknown method or parameter, a
+        for another image size, a ``calib`` of another type, an unknown method or parameter (a
+        misspelling of this function's own keyword, ``max_disparty=``, named as such), a
         ``max_disparity`` that is not a finite number >= 0 (or below ``min_disparity``; equal
         to it, ``"gabor"`` and ``"fused"`` refuse it, the others search that one level), a
         ``min_disparity`` not below the image width (no pixel has a match that far: a pair with
@@ -121,6 +122,7 @@ def match(
     # a str first: an array as the method failed in the test ("truth value ... ambiguous")
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
+    _refuse_own_typos(method, params)
     # the range's type first, in depth_map's words: a 0-d array, True or None passed "gabor"'s
     # check (or failed in another class) and was refused by the others as not "non-negative"
     _refuse_range_types(max_disparity, params.get("min_disparity", 0))
@@ -191,6 +193,35 @@ def match(
         run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
         m = run(gl, gr, max_disparity=max_disparity, **params)
     return _keep(m, _in_range(m, params.get("min_disparity", 0), max_disparity))
+
+
+#: :func:`match`'s own keywords, which a misspelling sends to ``**params``.
+_OWN_KEYWORDS = ("calib", "method", "max_disparity", "min_disparity")
+
+
+def _refuse_own_typos(method: str, params: dict[str, Any]) -> None:
+    """Refuse a ``**params`` key that is no parameter of ``method`` and nearest to one of
+    :func:`match`'s own keywords, naming that keyword: the matcher's check named its own
+    parameters only (``max_disparty=8`` was "unknown Hopfield parameter(s) ['max_disparty']"
+    with no hint, and with ``"fused"`` "did you mean 'min_disparity'?"). Any other unknown
+    key is left to the matcher, which lists its parameters."""
+    import difflib
+
+    from stereovision.matching import fusion, gabor
+
+    # fuse_pair's own keywords too, as it takes them
+    own = ["channels", "remeasure_gabor", "check_members", "edge_members", "census_members"]
+    valid: list[str] = {
+        "mcgm": list(_mcgm.DEFAULTS),
+        "gabor": list(gabor.DEFAULTS),
+        "fused": [*fusion.DEFAULTS, *own, "dense_sgm"],
+    }.get(method, list(_hopfield.DEFAULTS))
+    for key in params:
+        if key in valid or key == "min_disparity":
+            continue
+        near = difflib.get_close_matches(key, [*valid, *_OWN_KEYWORDS], n=1, cutoff=0.6)
+        if near and near[0] in _OWN_KEYWORDS:
+            raise ValueError(f"match: unknown keyword argument {key!r} (did you mean {near[0]!r}?)")
 
 
 def _refuse_unreachable(
