@@ -113,6 +113,12 @@ def test_bad_input() -> None:
         sgm_disparity(img, img, max_disparity=2, min_disparity=5)
     with pytest.raises(ValueError, match="unknown SGM option"):
         sgm_disparity(img, img, max_disparity=8, p3=4)
+    # a misspelling named its nearest option, as the other matchers do (it named none)
+    with pytest.raises(ValueError) as err:
+        sgm_disparity(img, img, max_disparity=8, uniquenes=5)
+    assert str(err.value).startswith(
+        "unknown SGM option(s) ['uniquenes'] (did you mean 'uniqueness'?): expected one of "
+    )
     with pytest.raises(ValueError, match="p1"):
         sgm_disparity(img, img, max_disparity=8, p1=100, p2=50)
     with pytest.raises(ValueError, match="p2"):

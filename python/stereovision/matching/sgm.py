@@ -27,6 +27,7 @@ from stereovision._validate import (
     check_pair,
     finite_number,
     float_sized,
+    refuse_unknown,
     refuse_unreachable_range,
     whole_value,
 )
@@ -173,9 +174,8 @@ def sgm_disparity(
         available (Linux's MemAvailable, a container's cgroup limit, or the address space left
         under ``ulimit -v``), before allocating it; or when an allocation fails anyway.
     """
-    unknown = sorted(set(params) - set(DEFAULTS))
-    if unknown:
-        raise ValueError(f"unknown SGM option(s) {unknown}: expected {sorted(DEFAULTS)}")
+    # with the nearest spelling, as the other matchers say it: uniquenes=5 named none
+    refuse_unknown("SGM option", params, DEFAULTS, "stereovision.matching.sgm.DEFAULTS")
     p = {**DEFAULTS, **params}
     bounds: list[float] = []
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
