@@ -532,6 +532,36 @@ def test_edge_check_drops_members_on_fattened_edges(data_dir: Path) -> None:
     assert kept == {(x, y) for x, y in all_ if not fat[int(y), int(x)]} != all_
 
 
+def test_channel_results_repr_is_a_summary_not_their_arrays() -> None:
+    """The dataclass reprs printed every array: 3.4 kB for a 150x100 pair's FusionResult
+    (its channel outputs' maps, 1.2 kB of them the GaborResult's), 9 kB of InterestPoints."""
+    from stereovision.matching.hopfield import InterestPoints
+
+    nan = np.nan
+    disp = np.array([[1.0, nan, 2.5], [nan, nan, 2.0]], np.float32)
+    g = GaborResult(disparity=disp, confidence=np.isfinite(disp).astype(np.float32))
+    assert repr(g) == "GaborResult(3x2; disparity 1.00-2.50 px on 50.0 % of pixels)"
+    assert repr(GaborResult(disp * nan, disp * 0)) == "GaborResult(3x2; no disparity)"
+    ip = InterestPoints(np.zeros((4, 2), np.float32), np.zeros(4, np.float32), np.zeros((5, 6)))
+    assert repr(ip) == "InterestPoints(4 points in 6x5)"
+    m = Matches([0, 2, 2], [0, 0, 1], [-1, -0.5, 0], [0, 0, 1], [1, 1, 2 / 3], image_shape=(2, 3))
+    fr = FusionResult(
+        matches=m,
+        count=np.array([3, 3, 2], np.uint8),
+        sources=np.array([7, 7, 3], np.uint8),
+        dispx=disp,
+        dispy=disp * 0,
+        count_map=np.zeros((2, 3), np.uint8),
+        sources_map=np.zeros((2, 3), np.uint8),
+        channels=("gabor", "mcgm", "hopfield"),
+        channel_outputs={"gabor": g},
+    )
+    assert repr(fr) == (
+        "FusionResult(3 members in 3x2 of gabor, mcgm, hopfield; count 2: 1, 3: 2; channel "
+        "outputs: gabor)"
+    )
+
+
 def test_census_clear_drops_members_near_a_lower_census_region() -> None:
     """A member is dropped where the census map has a value more than ``jump`` below it within
     ``radius`` px; NaN census pixels do not count."""

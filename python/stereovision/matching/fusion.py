@@ -145,6 +145,20 @@ class FusionResult:
     def __len__(self) -> int:
         return len(self.matches)
 
+    def __repr__(self) -> str:
+        # A summary: the dataclass repr printed six arrays and every channel's output (3.4 kB
+        # for a 150x100 pair)
+        h, w = self.matches.image_shape
+        values, times = np.unique(np.asarray(self.count).reshape(-1), return_counts=True)
+        counts = ", ".join(
+            f"{k}: {n}" for k, n in zip(values.tolist(), times.tolist(), strict=True)
+        )
+        outputs = ", ".join(self.channel_outputs) or "none"
+        return (
+            f"FusionResult({len(self)} members in {w}x{h} of {', '.join(self.channels)}"
+            f"{'; count ' + counts if counts else ''}; channel outputs: {outputs})"
+        )
+
 
 #: px: the largest ``r_spatial`` :func:`fuse` takes (12853 offsets; the default is 1.5).
 MAX_R_SPATIAL = 64.0

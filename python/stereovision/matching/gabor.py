@@ -83,6 +83,19 @@ class GaborResult:
     disparity: npt.NDArray[np.float32]
     confidence: npt.NDArray[np.float32]
 
+    def __repr__(self) -> str:
+        # A summary, as Matches and DepthResult give: the dataclass repr printed both maps'
+        # values (1.2 kB for a 150x100 pair, 2 kB of fuse_pair's channel outputs)
+        d = np.asarray(self.disparity)
+        if d.ndim != 2:
+            return f"GaborResult(disparity of shape {d.shape})"
+        h, w = d.shape
+        ok = d[np.isfinite(d)]
+        if not ok.size:
+            return f"GaborResult({w}x{h}; no disparity)"
+        lo, hi, share = float(ok.min()), float(ok.max()), 100 * ok.size / d.size
+        return f"GaborResult({w}x{h}; disparity {lo:.2f}-{hi:.2f} px on {share:.1f} % of pixels)"
+
 
 #: Widest search range ``max_disparity - min_disparity`` (px) of the kernel.
 MAX_RANGE = 8192

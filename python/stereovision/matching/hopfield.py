@@ -113,6 +113,12 @@ class InterestPoints:
     def __len__(self) -> int:
         return int(self.xy.shape[0])
 
+    def __repr__(self) -> str:
+        # A summary: the dataclass repr printed every point and value (9 kB for a 150x100 image)
+        shape = np.shape(self.response)
+        size = f"{shape[1]}x{shape[0]}" if len(shape) == 2 else f"a map of shape {shape}"
+        return f"InterestPoints({len(self)} points in {size})"
+
 
 def interest_points(
     image: npt.ArrayLike,
