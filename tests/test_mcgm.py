@@ -147,6 +147,13 @@ def _three_segments() -> mcgm.ChannelCurves:
     )  # fmt: skip
 
 
+def test_channel_curves_repr_is_a_summary_not_its_arrays() -> None:
+    """The dataclass repr printed its twelve arrays: curves() of a 150x100 image, 5.8, 12.6
+    and 15.4 kB for its three channels."""
+    c = _three_segments()
+    assert repr(c) == "ChannelCurves(sigma 1, scale 1; 3 segments in 2x2; t_high 1, t_low 0.5)"
+
+
 def test_segment_index_is_checked_and_negative_counts_from_the_end() -> None:
     """k past the end was a bare IndexError from numpy; k = -1 gave an empty array and -2 the
     last segment (off by one). Negative k now counts from the end, as in a list."""

@@ -159,6 +159,16 @@ class ChannelCurves:
         """Number of segments."""
         return int(self.centroids.shape[0])
 
+    def __repr__(self) -> str:
+        # A summary: the dataclass repr printed its twelve arrays (curves() of a 150x100 image:
+        # 3 channels, about 11 kB each)
+        shape = np.shape(self.log)
+        size = f"{shape[1]}x{shape[0]}" if len(shape) == 2 else f"a map of shape {shape}"
+        return (
+            f"ChannelCurves(sigma {self.sigma:g}, scale {self.scale}; {self.n_segments} "
+            f"segments in {size}; t_high {self.t_high:.3g}, t_low {self.t_low:.3g})"
+        )
+
     def segment(self, k: int) -> npt.NDArray[np.int32]:
         """The pixels of one segment.
 
