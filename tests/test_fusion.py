@@ -78,6 +78,12 @@ def test_fuse_takes_a_gabor_result_and_names_what_is_no_channel() -> None:
         fuse(d, {"hopfield": hop})  # type: ignore[arg-type]
     with pytest.raises(TypeError, match=r"sparse\['hopfield'\]: expected a stereovision.Matches"):
         fuse(None, {"hopfield": hop.to_array()})  # type: ignore[dict-item]
+    # a list of the channels' Matches was "unknown sparse channel Matches(3 matches ...)"
+    with pytest.raises(TypeError) as err:
+        fuse((d, c), [hop])  # type: ignore[arg-type]
+    assert str(err.value) == (
+        "sparse: expected the sparse channels by name, {'mcgm': ..., 'hopfield': ...}, got list"
+    )
 
 
 def test_sparse_channels_meet_within_radius() -> None:

@@ -371,8 +371,9 @@ def fuse(
         the channels given.
     TypeError
         A ``gabor`` that is neither a ``(dispx, conf)`` pair nor a
-        :class:`~stereovision.matching.gabor.GaborResult` (one map alone), or a sparse
-        channel that is no :class:`~stereovision.Matches` (its ``to_array()``).
+        :class:`~stereovision.matching.gabor.GaborResult` (one map alone), a ``sparse`` that
+        is no mapping (a list of the channels' matches), or a sparse channel that is no
+        :class:`~stereovision.Matches` (its ``to_array()``).
     """
     if isinstance(gabor, GaborResult):
         # gabor_disparity's own result (FusionResult.channel_outputs["gabor"]) was Python's
@@ -387,6 +388,12 @@ def fuse(
             raise TypeError(f"gabor: expected the (dispx, conf) maps or a GaborResult, got {got}")
     if mode not in ("vote", "intersection"):
         raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
+    if not isinstance(sparse, Mapping):
+        # a list of Matches was "unknown sparse channel Matches(...)", naming a channel's matches
+        raise TypeError(
+            "sparse: expected the sparse channels by name, {'mcgm': ..., 'hopfield': ...}, "
+            f"got {type(sparse).__name__}"
+        )
     if not sparse:
         raise ValueError("fuse needs at least one sparse channel (mcgm or hopfield)")
     for name in sparse:
