@@ -1228,6 +1228,22 @@ def test_matches_refuse_a_boolean_mask_of_another_length() -> None:
     assert m[[True, False, True]].xl.tolist() == [10.0, 30.0]
 
 
+def test_matches_refuse_an_index_that_is_no_integer_naming_it() -> None:
+    """m[1.5], m["score"] and m[np.round(x)] were NumPy's "only integers, slices (`:`),
+    ellipsis (`...`), numpy.newaxis (`None`) ..." or "arrays used as indices must be of
+    integer (or boolean) type", naming no Matches; an empty list still picks none."""
+    m = _three()
+    cases = [(1.5, "1.5"), ("score", "'score'"), (np.array([0.0, 2.0]), "array([0., 2.])")]
+    for index, shown in cases:
+        with pytest.raises(IndexError) as err:
+            m[index]
+        assert str(err.value) == (
+            "Matches: expected an integer, a slice, an integer array or a boolean mask with one "
+            f"value per match, got {shown}"
+        )
+    assert len(m[[]]) == 0 and m[np.array([0, 2])].xl.tolist() == [10.0, 30.0]
+
+
 def test_matches_rasters_leave_out_non_finite_positions_without_a_warning() -> None:
     """A NaN or infinite left position (a CSV row of ``nan``) is outside the image: left out of
     the rasters as one beyond the edge is, not cast to an integer with NumPy's 'invalid value

@@ -19,7 +19,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import NOT_NUMBERS, as_path, refuse_beyond_float32, user_stacklevel
+from stereovision._validate import (
+    NOT_NUMBERS,
+    _shown,
+    as_path,
+    refuse_beyond_float32,
+    user_stacklevel,
+)
 from stereovision.calibration import Calibration
 from stereovision.io import atomic_write
 
@@ -225,6 +231,15 @@ class Matches:
             raise IndexError(
                 f"Matches: a boolean mask of {len(mask)} values for {len(self)} matches; give "
                 "one value per match (m[m.score > 0.9])"
+            )
+        kind = mask.dtype.kind if mask is not None and mask.size else "i"
+        if isinstance(index, (float, np.floating, str, bytes)) or kind not in "biu":
+            # NumPy's "only integers, slices (`:`), ellipsis (`...`), numpy.newaxis (`None`)
+            # ..." (m[1.5], m["score"]) or "arrays used as indices must be of integer (or
+            # boolean) type" (m[np.round(x)]) named no Matches, and offered a new axis
+            raise IndexError(
+                "Matches: expected an integer, a slice, an integer array or a boolean mask "
+                f"with one value per match, got {_shown(index)}"
             )
         pick = np.asarray(np.arange(len(self))[index])
         if pick.ndim != 1:
