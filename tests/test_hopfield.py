@@ -877,6 +877,23 @@ def test_a_text_none_or_list_parameter_is_named_as_gabor_names_it() -> None:
         assert str(exc.value) == f"{name}: expected a number, got {value!r}"
 
 
+def test_a_switch_that_is_no_bool_is_named() -> None:
+    """edge_test="no" was the binding's "parameter `edge_test`: TypeError: 'str' object is not
+    an instance of 'bool'" (MCGM's sides=1 likewise), where MCGM's debug says "debug: expected
+    True or False"; a NumPy bool is one."""
+    from stereovision.matching import mcgm
+
+    left = np.zeros((8, 12), np.float32)  # refused before any matching
+    for call, name, value in [
+        (hp.hopfield_match, "edge_test", "no"),
+        (mcgm.mcgm_match, "sides", 1),
+    ]:
+        with pytest.raises(ValueError) as exc:
+            call(left, left, max_disparity=4, **{name: value})
+        assert str(exc.value) == f"{name}: expected True or False, got {value!r}"
+    assert len(hp.best_match(left, left, max_disparity=4, subpixel=np.False_)) == 0
+
+
 @pytest.mark.parametrize("method", ["hopfield", "best", "mcgm", "gabor", "fused"])
 def test_a_float16_range_gives_the_floats_matches_without_a_warning(method: str) -> None:
     """A range given as np.float16 (read from a half-precision map) was clipped against

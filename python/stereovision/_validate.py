@@ -894,7 +894,8 @@ def refuse_not_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> None
     and one of a string or a datetime (``np.array('3')``, of dtype object too) as 3. Nor is
     anything else but a real number (a Fraction and a Decimal are) one: ``s_min='0.5'``, None
     or ``[0.5]`` was the binding's "parameter `s_min`: TypeError: must be real number, not
-    str", where the Gabor channel says "s_min: expected a number, got '0.5'"."""
+    str", where the Gabor channel says "s_min: expected a number, got '0.5'". A switch (a
+    bool default) is True or False (a NumPy bool too)."""
     for name, v in params.items():
         d = defaults.get(name)
         array = isinstance(v, np.ndarray) and v.size == 1
@@ -903,6 +904,10 @@ def refuse_not_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> None
         real = isinstance(scalar, (numbers.Real, decimal.Decimal))
         if number and (isinstance(scalar, NOT_NUMBERS) or not real):
             raise ValueError(f"{name}: expected a number, got {_shown(v)}")
+        # a switch is True or False: edge_test='no' was the binding's "parameter `edge_test`:
+        # TypeError: 'str' object is not an instance of 'bool'" (MCGM's debug says it so)
+        if isinstance(d, bool) and not isinstance(v, (bool, np.bool_)):
+            raise ValueError(f"{name}: expected True or False, got {_shown(v)}")
 
 
 def read_numbers(params: dict[str, Any], defaults: dict[str, Any]) -> dict[str, Any]:
