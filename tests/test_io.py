@@ -3128,3 +3128,27 @@ def test_a_path_holding_a_null_byte_is_refused_in_the_arguments_name(tmp_path: P
     with pytest.raises(ValueError, match=said.replace("pfm", "csv")):
         Matches(z, z, z, z, z, (8, 10)).save_csv(bad[:-3] + "csv")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_read_pfm_cut_within_its_header_is_truncated(tmp_path: Path) -> None:
+    """A PFM cut within its header (an interrupted save; 0 bytes when cut at once) was "not a
+    PFM file (bad header)", the words of another format's file; it is truncated, as one cut in
+    its data is. Another format's header is still "bad header"."""
+    path = tmp_path / "d.pfm"
+    path.write_bytes(b"")
+    with pytest.raises(ValueError) as info:
+        read_pfm(path)
+    assert str(info.value) == f"truncated PFM file {path}: the file is empty (0 bytes)"
+    for cut in (b"Pf", b"PF\n", b"Pf\n3", b"Pf\n3 2", b"Pf\r\n3 2\r\n-"):
+        path.write_bytes(cut)
+        with pytest.raises(ValueError) as info:
+            read_pfm(path)
+        assert str(info.value) == (
+            f"truncated PFM file {path}: it ends within its header ({len(cut)} bytes: "
+            f"{cut.decode()!r})"
+        )
+    for other in (b"P5\n2 2", b"Pf\n3 2\nabc", b"Pfx", b"P"):
+        path.write_bytes(other)
+        with pytest.raises(ValueError) as info:
+            read_pfm(path)
+        assert str(info.value) == f"not a PFM file (bad header): {path}"

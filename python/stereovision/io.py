@@ -1358,6 +1358,8 @@ def _decode_8_or_16bit(
 _PFM_HEADER = re.compile(rb"^(P[Ff])\s+(\d+)\s+(\d+)\s+([-+]?[0-9.]+(?:[eE][-+]?\d+)?)(?=\s|\Z)")
 # the scale line's end as Windows tools (CRLF) and others (trailing spaces) write it
 _PFM_LINE_END = re.compile(rb"[ \t]*\r?\n")
+# a whole file that is the start of a header and no more (an interrupted save): 'Pf', 'Pf\n3 2'
+_PFM_HEADER_CUT = re.compile(rb"P[Ff](?:\s+(?:\d+(?:\s+(?:\d+(?:\s+[-+]?)?)?)?)?)?\s*\Z")
 
 
 def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
@@ -1386,8 +1388,8 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     FileNotFoundError
         If ``path`` does not exist.
     ValueError
-        If the header is not a PFM header (a scale that is no number or zero) or the data is
-        truncated, naming the file.
+        If the header is not a PFM header (a scale that is no number or zero) or the file is
+        truncated (in its data, within its header, or empty), naming the file.
     """
     p = _existing_file(path, "PFM file")
     raw = p.read_bytes()
@@ -1397,6 +1399,15 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     if m is not None and m.end() == 256 < len(raw):
         m = None
     if m is None:
+        # a file cut within its header (0 bytes: a save interrupted at once) was "bad header",
+        # the words of another format's file, where one cut in its data is "truncated"
+        if not raw:
+            raise ValueError(f"truncated PFM file {p}: the file is empty (0 bytes)")
+        if _PFM_HEADER_CUT.match(raw):
+            raise ValueError(
+                f"truncated PFM file {p}: it ends within its header ({len(raw)} bytes: "
+                f"{raw.decode('ascii')!r})"
+            )
         raise ValueError(f"not a PFM file (bad header): {p}")
     channels = 3 if m.group(1) == b"PF" else 1
     width, height = int(m.group(2)), int(m.group(3))
