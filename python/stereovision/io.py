@@ -1232,6 +1232,13 @@ def _not_an_image_hint(path: Path, data: npt.NDArray[np.uint8]) -> str:
             ": it is a PFM file of floating-point values (a disparity map?), not an 8- or "
             "16-bit image"
         )
+    if _png_cut_short(data):
+        # "cannot decode" alone read as a damaged or unknown format, of a PNG whose end is gone
+        # (said from its chunks' lengths: a damaged length reads as a file cut short too)
+        return (
+            f": the PNG file ends before its last chunk ({data.size} bytes: cut short by an "
+            "interrupted copy?)"
+        )
     if data[:4].tobytes() in (b"II*\x00", b"MM\x00*"):
         # a TIFF of float32 or int32 pixels decodes, but not as 8 or 16 bits: "cannot decode"
         # alone read as a damaged file
