@@ -271,6 +271,9 @@ def test_pfm_colour_round_trip(tmp_path: Path) -> None:
     np.testing.assert_array_equal(read_pfm(tmp_path / "c.pfm"), arr)
 
 
+# any float32 bits: values mostly of extreme magnitudes (1e-40, 1e38) are warned of as maybe
+# read in the wrong byte order, as read_pfm warns of such a file
+@pytest.mark.filterwarnings("ignore:PFM file")
 @settings(max_examples=30, deadline=None)
 @given(
     arr=hnp.arrays(
@@ -3158,3 +3161,29 @@ def test_read_pfm_cut_within_its_header_is_truncated(tmp_path: Path) -> None:
         with pytest.raises(ValueError) as info:
             read_pfm(path)
         assert str(info.value) == f"not a PFM file (bad header): {path}"
+
+
+@pytest.mark.parametrize("little", [True, False], ids=["little-data", "big-data"])
+def test_read_pfm_warns_of_a_scale_of_the_wrong_sign(tmp_path: Path, little: bool) -> None:
+    """A PFM whose writer gave the scale the wrong sign (1.0 before little-endian data) was
+    read as garbage without a word (a GT's 14 px as 3.4e-41, inf as 4.6e-41). It warns, naming
+    the file; the values are still read in the order the scale says (not guessed). Files of
+    the right sign, NaN as unknown included, read without a warning."""
+    gt = np.array([[14.0, np.inf, 3.5], [0.0, 7.25, np.nan]], np.float32)
+    path = tmp_path / "gt_disp.pfm"
+    magic, sizes, _, data = _pfm_bytes(gt, little).split(b"\n", 3)
+    path.write_bytes(b"\n".join([magic, sizes, b"1.0" if little else b"-1.0", data]))
+    with pytest.warns(UserWarning) as record:
+        got = read_pfm(path)
+    said, other = ("big", "little") if little else ("little", "big")
+    assert [str(w.message) for w in record] == [
+        f"PFM file {path}: its scale {1 if little else -1} says {said}-endian, but 83% of its "
+        f"finite values read so are below 1e-30 or beyond 1e30, where read {other}-endian they "
+        "are plausible: its writer may have given the scale the wrong sign (negative: "
+        "little-endian)"
+    ]
+    assert got.tobytes() == gt.byteswap().tobytes()  # as the scale says, as before
+    path.write_bytes(_pfm_bytes(gt, little))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(read_pfm(path), gt)

@@ -1397,6 +1397,13 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     ValueError
         If the header is not a PFM header (a scale that is no number or zero) or the file is
         truncated (in its data, within its header, or empty), naming the file.
+
+    Warns
+    -----
+    UserWarning
+        When the finite values read in the scale's byte order are mostly of magnitudes below
+        ``1e-30`` or beyond ``1e30`` and read in the other order are plausible (a scale of the
+        wrong sign); they are returned as the scale says all the same.
     """
     p = _existing_file(path, "PFM file")
     raw = p.read_bytes()
@@ -1449,10 +1456,49 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
             f"{channels}, got {nbytes}"
         )
     data = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
+    _warn_if_byte_order_wrong(data, p, scale)
     shape = (height, width, 3) if channels == 3 else (height, width)
     # a copy, always: of a single row, ascontiguousarray kept the read-only view of ``raw``
     # (load_scene's ``gt[...] = nan`` was "assignment destination is read-only")
     return np.array(data.reshape(shape)[::-1], dtype=np.float32, order="C")
+
+
+def _out_of_range(values: npt.NDArray[Any]) -> npt.NDArray[np.bool_]:
+    """Where ``values`` are finite, non-zero and below ``1e-30`` or beyond ``1e30`` in
+    magnitude: what floats read in the wrong byte order mostly are (14.0 -> 3.4e-41, inf ->
+    4.6e-41), and a map's or an image's are not."""
+    with np.errstate(invalid="ignore"):
+        size = np.abs(values)
+        return np.isfinite(values) & (values != 0) & ((size < 1e-30) | (size > 1e30))
+
+
+def _warn_if_byte_order_wrong(data: npt.NDArray[Any], path: Path, scale: float) -> None:
+    """Warn when ``data``, read in the byte order its scale's sign gives, is mostly out of range
+    (:func:`_out_of_range`) where the other order reads plausibly throughout: a writer that
+    gave the scale the wrong sign (``1.0`` before little-endian data). Such a GT was read as
+    garbage (tsukuba's 14 px as 3.4e-41) without a word; the values are still returned as the
+    header says, the order is not guessed."""
+    from stereovision._validate import source_warning
+
+    read = data[:: max(1, data.size // 65536)]  # a bounded look: a large map's cost is one read
+    finite = int(np.count_nonzero(np.isfinite(read)))
+    wrong = int(np.count_nonzero(_out_of_range(read))) / max(finite, 1)
+    if wrong < 0.1:
+        return
+    other = read.view(read.dtype.newbyteorder())
+    # a NaN the other order makes of a large value (float32's largest: 0xffff7f7f) is no
+    # plausible reading; one made of a tiny value is a GT's NaN (unknown) read here swapped
+    with np.errstate(invalid="ignore"):
+        made_nan = np.isnan(other) & ~(np.abs(read) < 1e-30)
+    if np.count_nonzero(_out_of_range(other) | made_nan) > 0.001 * read.size:
+        return
+    said, other_order = ("little", "big") if scale < 0 else ("big", "little")
+    source_warning(
+        f"PFM file {path}: its scale {scale:g} says {said}-endian, but {wrong:.0%} of its "
+        f"finite values read so are below 1e-30 or beyond 1e30, where read {other_order}-endian "
+        "they are plausible: its writer may have given the scale the wrong sign (negative: "
+        "little-endian)"
+    )
 
 
 def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) -> Path:
