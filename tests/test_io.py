@@ -1820,6 +1820,29 @@ def test_scene_range_of_an_ndisp_the_images_have_no_room_for(tmp_path: Path) -> 
     assert (s.max_disparity, scene_too_narrow(s)) == (32, None)  # 70 // 4 = 17 -> 32
 
 
+def test_load_scene_refuses_a_calib_txt_of_another_image_size(tmp_path: Path) -> None:
+    """A calib.txt whose width and height are not the images' (a scene cropped or resized,
+    its calib.txt copied as it was) was loaded, and eval and view failed at the first depth
+    with depth_map's "calibration is for 80x8 images, got 70x8", naming neither scene nor
+    file. load_scene refuses it, naming both; a calib.txt of the images' size loads."""
+    d = _scene(tmp_path / "fam" / "s", 70, 8)
+    text = (
+        "cam0=[100 0 35; 0 100 4; 0 0 1]\ncam1=[100 0 35; 0 100 4; 0 0 1]\ndoffs=0\n"
+        "baseline=60\nwidth={}\nheight={}\nndisp=16\n"
+    )
+    for size in ((80, 8), (70, 20)):
+        (d / "calib.txt").write_text(text.format(*size))
+        with pytest.raises(ValueError) as info:
+            load_scene(d)
+        assert str(info.value) == (
+            f"scene {d}: calib.txt is for {size[0]}x{size[1]} images (its width and height), "
+            "left.png is 70x8"
+        )
+    (d / "calib.txt").write_text(text.format(70, 8))
+    calib = load_scene(d).calib
+    assert calib is not None and tuple(calib.image_size) == (70, 8)
+
+
 def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:
     (tmp_path / "left.png").write_bytes(b"")
     with pytest.raises(FileNotFoundError, match=r"^scene root not found: .*left\.png$"):

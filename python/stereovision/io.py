@@ -2225,7 +2225,8 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
         its size differs from the left image, or the calibration file is invalid (an
-        ``ndisp`` of NaN, 0 or below included).
+        ``ndisp`` of NaN, 0 or below included) or ``calib.txt``'s ``width`` and ``height`` are
+        not the left image's.
     """
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
@@ -2284,6 +2285,14 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
     calib_path = d / "calib.txt"
     if _present(calib_path):
         calib = Calibration.from_middlebury(calib_path)
+        if tuple(calib.image_size) != (left.shape[1], left.shape[0]):
+            # loaded as it was, eval and view failed at the first depth with depth_map's
+            # "calibration is for 80x40 images, got 40x20", naming neither scene nor file
+            cw, ch = calib.image_size
+            raise ValueError(
+                f"scene {d}: calib.txt is for {cw}x{ch} images (its width and height), left.png "
+                f"is {left.shape[1]}x{left.shape[0]}"
+            )
         ndisp = parse_middlebury_calib(calib_path).get("ndisp")
         if ndisp is not None and not (math.isfinite(ndisp) and ndisp > 0):
             # NaN, -5 or 0 were taken as no ndisp (the width's range), without a word
