@@ -1706,6 +1706,39 @@ def test_a_folder_or_a_float_file_is_no_image(tmp_path: Path) -> None:
         read_image(cut)
 
 
+def test_a_signed_16_bit_tiff_is_read_by_its_values_or_refused(tmp_path: Path) -> None:
+    """A TIFF of int16 pixels: OpenCV's IMREAD_COLOR keeps the top 8 of the bits taken as
+    unsigned, so -5 read as 255 (white) and -32768 as 128, without a word; read_image (depth's)
+    kept those 8 bits of one of values >= 0 too (1000 -> 3), where the same frame unsigned
+    keeps 16. Negative pixels are refused, saying so (imread, read_image, decode_image, batch's
+    worker); values >= 0 read as the unsigned file reads."""
+    from stereovision.batch import _decode
+    from stereovision.io import decode_image
+
+    signed = np.array([[-5, 0, 1000], [32767, -32768, 256]], np.int16)
+    path = tmp_path / "s.tiff"
+    assert cv2.imwrite(str(path), signed)
+    for read in (imread, read_image):
+        with pytest.raises(ValueError) as info:
+            read(path)
+        assert str(info.value) == (
+            f"cannot decode {path} as an image: its pixels are signed 16-bit values, some "
+            "negative, not unsigned 8- or 16-bit ones (save it as an unsigned 8- or 16-bit PNG "
+            "or TIFF)"
+        )
+    assert decode_image(path.read_bytes()) is None
+    with pytest.raises(ValueError, match=r"^cannot decode s\.tiff as an image: its pixels are si"):
+        _decode("s.tiff", path.read_bytes())
+    frame = np.array([[5, 0, 1000], [32767, 4095, 256]], np.int16)  # none negative
+    unsigned = tmp_path / "u.tiff"
+    assert cv2.imwrite(str(unsigned), frame.astype(np.uint16))
+    assert cv2.imwrite(str(path), frame)
+    got = read_image(path)
+    assert got.dtype == np.uint16 and got[..., 0].tolist() == frame.tolist()
+    np.testing.assert_array_equal(got, read_image(unsigned))
+    np.testing.assert_array_equal(imread(path), imread(unsigned))  # top 8 bits, as before
+
+
 @pytest.mark.parametrize("channels", [1, 3], ids=["Pf", "PF"])
 def test_a_pfm_is_no_image(tmp_path: Path, channels: int) -> None:
     """OpenCV decodes a PFM under IMREAD_COLOR, its floats rounded and clipped to 0-255: a

@@ -1134,8 +1134,35 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
         raise TypeError(f"data: expected the file's bytes or a 1-D uint8 array, got {what}")
     if buf.size == 0 or _is_pfm(buf):
         return None
+    if buf[:4].tobytes() in _TIFF_MAGIC:
+        # a TIFF's depth seen in the one decode of an 8-bit file (ANYDEPTH gives it
+        # IMREAD_COLOR's very pixels): one of negative int16 pixels is refused
+        # (_negative_int16_tiff), others of 16 bits or more decoded as before
+        img = _imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+        if img is None or img.dtype == np.uint8:
+            return img
+        if img.dtype == np.int16 and int(img.min()) < 0:
+            return None
     img = _imdecode(buf, cv2.IMREAD_COLOR)
     return None if img is None else np.asarray(img, dtype=np.uint8)
+
+
+_TIFF_MAGIC = (b"II*\x00", b"MM\x00*")
+
+
+def _negative_int16_tiff(buf: npt.NDArray[np.uint8]) -> bool:
+    """Whether ``buf`` is a TIFF of signed 16-bit pixels, some negative.
+
+    ``IMREAD_COLOR`` takes an ``int16`` pixel's bits as unsigned ones and keeps the top 8: -5
+    read as 255 (white), -32768 as 128, a dark pixel the brightest, without a word. Such a file
+    is no 8- or 16-bit image (:func:`decode_image` refuses it, :func:`_not_an_image_hint`
+    says why); one of values >= 0 reads as its unsigned twin does. Other formats hold no
+    signed pixels.
+    """
+    if buf[:4].tobytes() not in _TIFF_MAGIC:
+        return False
+    pixels = _imdecode(buf, cv2.IMREAD_UNCHANGED)
+    return pixels is not None and pixels.dtype == np.int16 and int(pixels.min()) < 0
 
 
 def _is_pfm(buf: npt.NDArray[np.uint8]) -> bool:
@@ -1239,7 +1266,12 @@ def _not_an_image_hint(path: Path, data: npt.NDArray[np.uint8]) -> str:
             f": the PNG file ends before its last chunk ({data.size} bytes: cut short by an "
             "interrupted copy?)"
         )
-    if data[:4].tobytes() in (b"II*\x00", b"MM\x00*"):
+    if _negative_int16_tiff(data):
+        return (
+            ": its pixels are signed 16-bit values, some negative, not unsigned 8- or 16-bit "
+            "ones (save it as an unsigned 8- or 16-bit PNG or TIFF)"
+        )
+    if data[:4].tobytes() in _TIFF_MAGIC:
         # a TIFF of float32 or int32 pixels decodes, but not as 8 or 16 bits: "cannot decode"
         # alone read as a damaged file
         pixels = _imdecode(data, cv2.IMREAD_UNCHANGED)
@@ -1284,7 +1316,8 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
     FileNotFoundError
         If ``path`` does not exist.
     ValueError
-        If the file cannot be decoded as an image.
+        If the file cannot be decoded as an image (or is a TIFF of signed 16-bit pixels, some
+        negative: OpenCV read -5 as 255).
     TypeError
         If ``gray`` is not True or False.
     """
@@ -1314,8 +1347,9 @@ def read_image(path: PathLike) -> npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
     A 16-bit PNG or TIFF (a machine-vision camera's 12- or 16-bit frames) comes back as
     ``uint16`` BGR, which :func:`stereovision.depth_map` scales by 65535 (and warns about when
     only the low 12 bits are used); :func:`imread` keeps its top 8 bits (OpenCV's
-    ``IMREAD_COLOR``: a 12-bit frame's 0-4095 became 0-15). Any other file is read as
-    :func:`imread` reads it.
+    ``IMREAD_COLOR``: a 12-bit frame's 0-4095 became 0-15). A signed 16-bit TIFF of values
+    >= 0 reads as its unsigned twin (one with negative values is refused). Any other file is
+    read as :func:`imread` reads it.
 
     Parameters
     ----------
@@ -1353,6 +1387,10 @@ def _decode_8_or_16bit(
     if buf.size == 0 or _is_pfm(buf):
         return None
     img = _imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    if img is not None and img.dtype == np.int16 and int(img.min()) >= 0:
+        # a signed 16-bit TIFF of values >= 0 (a 12-bit frame): imread's top 8 bits (0-4095 as
+        # 0-15) where the same frame unsigned keeps 16; its values, unsigned. Negative: refused
+        return img.astype(np.uint16)
     if img is None or img.dtype not in (np.uint8, np.uint16):
         return None
     return np.asarray(img)
