@@ -3243,3 +3243,33 @@ def test_read_pfm_warns_of_a_scale_of_the_wrong_sign(tmp_path: Path, little: boo
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         np.testing.assert_array_equal(read_pfm(path), gt)
+
+
+def test_read_pfm_says_a_magic_of_the_other_kind(tmp_path: Path) -> None:
+    """A writer's PF (colour) before a grey map was "truncated PFM file: expected 72 data bytes
+    ..., got 24" of a whole file; Pf before colour data read its first third as a grey map of
+    interleaved R, G, B values without a word. Both are a bad header, saying which magic the
+    data takes; a magic that fits its data reads as before."""
+    grey = np.arange(6, dtype=np.float32).reshape(2, 3)
+    colour = np.arange(18, dtype=np.float32).reshape(2, 3, 3)
+    path = tmp_path / "d.pfm"
+    for data, magic, says in (
+        (
+            grey,
+            b"PF",
+            "PF says a colour map (3 values a pixel), but its 24 data bytes hold 3x2 "
+            "grey values: a grey map's is Pf",
+        ),
+        (
+            colour,
+            b"Pf",
+            "Pf says a grey map (1 value a pixel), but its 72 data bytes hold 3x2x3 "
+            "values: a colour map's is PF",
+        ),
+    ):
+        path.write_bytes(magic + _pfm_bytes(data, True)[2:])
+        with pytest.raises(ValueError) as info:
+            read_pfm(path)
+        assert str(info.value) == f"bad PFM header in {path}: {says}"
+        path.write_bytes(_pfm_bytes(data, True))
+        np.testing.assert_array_equal(read_pfm(path), data)

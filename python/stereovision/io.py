@@ -1433,8 +1433,9 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     FileNotFoundError
         If ``path`` does not exist.
     ValueError
-        If the header is not a PFM header (a scale that is no number or zero) or the file is
-        truncated (in its data, within its header, or empty), naming the file.
+        If the header is not a PFM header (a scale that is no number or zero, a grey ``Pf`` of
+        a colour map's data or a colour ``PF`` of a grey one's) or the file is truncated (in
+        its data, within its header, or empty), naming the file.
 
     Warns
     -----
@@ -1488,6 +1489,24 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     if line_end is not None and len(raw) - count * 4 == m.end() + 1 and raw[m.end()] in b" \t":
         start = m.end() + 1
     nbytes = max(len(raw) - start, 0)
+    # a magic of the other kind (a writer's "PF" before a grey map: PF is colour) was
+    # "truncated" of a whole file, or, Pf before colour data, its first third read as a grey
+    # map of interleaved R, G, B values without a word
+    grey = width * height * 4
+    if nbytes == (grey if channels == 3 else 3 * grey):
+        held, kind, other = (
+            (f"{width}x{height} grey values", "colour map (3 values a pixel)", "a grey map's is Pf")
+            if channels == 3
+            else (
+                f"{width}x{height}x3 values",
+                "grey map (1 value a pixel)",
+                "a colour map's is PF",
+            )
+        )
+        raise ValueError(
+            f"bad PFM header in {p}: {m.group(1).decode()} says a {kind}, but its {nbytes} data "
+            f"bytes hold {held}: {other}"
+        )
     if nbytes < count * 4:
         raise ValueError(
             f"truncated PFM file {p}: expected {count * 4} data bytes for {width}x{height}x"
