@@ -1622,6 +1622,15 @@ def test_read_ply_first_line_is_ply_alone(tmp_path: Path) -> None:
     for magic in (b"ply\r", b"ply "):
         path.write_bytes(_ply("ascii", xyz, 1).replace(b"ply", magic, 1) + b"1 2 3\n")
         np.testing.assert_array_equal(read_ply(path)[0], [[1.0, 2.0, 3.0]])
+    # 0 bytes (an interrupted copy) was "not a PLY file" alone, another format's words
+    path.write_bytes(b"")
+    with pytest.raises(ValueError) as err:
+        read_ply(path)
+    assert str(err.value) == f"not a PLY file (the file is empty, 0 bytes): {path}"
+    path.write_bytes(b"\xef\xbb\xbf")  # a byte-order mark alone is no empty file
+    with pytest.raises(ValueError) as err:
+        read_ply(path)
+    assert str(err.value) == f"not a PLY file: {path}"
 
 
 # ------------------------------------------------- mutation audit 2: scenes, images, path helpers

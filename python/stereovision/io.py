@@ -1790,7 +1790,10 @@ def read_ply(
     p = _existing_file(path, "PLY file")
     # an ASCII cloud saved by a Windows editor opens with a UTF-8 byte-order mark: it was "not a
     # PLY file"
-    raw = p.read_bytes().removeprefix(_UTF8_BOM)
+    raw = p.read_bytes()
+    if not raw:  # "not a PLY file" alone read as another format's file (imread says this)
+        raise ValueError(f"not a PLY file (the file is empty, 0 bytes): {p}")
+    raw = raw.removeprefix(_UTF8_BOM)
     # the first line is "ply" (a CR, trailing blanks kept): "plyfoo" was read as a PLY file
     magic = re.match(rb"ply[ \t\r]*\n", raw) is not None
     # the line that is "end_header", not the first "end_header" (a comment may hold one)
