@@ -2068,6 +2068,29 @@ def test_scene_too_narrow_of_none_is_a_type_error_naming_scene() -> None:
     assert str(info.value) == "scene: expected a scene (stereovision.io.load_scene(path)), got None"
 
 
+def test_load_scene_refuses_a_gt_of_the_other_sign(tmp_path: Path) -> None:
+    """A GT whose known disparities are all negative (the other sign convention, x_right -
+    x_left) was evaluated as it was: a tsukuba crop's every method 100 % bad on every
+    threshold, without a word. It is refused, saying so; a GT with positive values beside
+    negative ones, all 0 or all unknown loads as before."""
+    d = _scene(tmp_path / "fam" / "s", 3, 2)
+    for gt in ([[-5.0, -14.0, np.inf], [np.nan, -7.5, -5.0]], [[-2.5, 0.0, 0.0]] * 2):
+        write_pfm(d / "gt_disp.pfm", np.array(gt, np.float32))
+        with pytest.raises(ValueError) as info:
+            load_scene(d)
+        low, high = ("-14", "-5") if gt[0][0] == -5.0 else ("-2.5", "0")
+        assert str(info.value) == (
+            f"scene {d}: gt_disp.pfm's disparities are all negative ({high} to {low} px), where "
+            "a left image's are >= 0 (x_left - x_right): a GT of the other sign (negate it), or "
+            "the right image's?"
+        )
+    for gt in ([[-0.5, 3.0, 2.0]] * 2, [[0.0] * 3] * 2, [[np.inf] * 3] * 2):
+        write_pfm(d / "gt_disp.pfm", np.array(gt, np.float32))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert load_scene(d).gt is not None
+
+
 def test_load_scene_keeps_gt_zero_and_large_values_as_disparities(tmp_path: Path) -> None:
     """evaluation.md: only inf or NaN is unknown. A GT of 0 (a point at infinity, TartanAir's
     sky) is a known disparity, not KITTI's raw 'no LiDAR' 0 (its SOURCE conversion made those

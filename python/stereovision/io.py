@@ -2283,11 +2283,13 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
         If ``directory`` is a file (``cones/left.png``: the scene is its folder) or another
         thing that is no folder (``/dev/null``, a pipe).
     ValueError
-        If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
-        its size differs from the left image, or the calibration file is invalid (an
+        If an image cannot be decoded, the pair sizes differ, the GT is not one channel, its
+        size differs from the left image or its known disparities are all negative (the other
+        sign convention), or the calibration file is invalid (an
         ``ndisp`` of NaN, 0 or below included) or ``calib.txt``'s ``width`` and ``height`` are
         not the left image's.
     """
+    from stereovision._validate import figure_shown
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
     d = as_path(directory, "directory")
@@ -2340,6 +2342,15 @@ def load_scene(directory: PathLike, *, full_bits: bool = False) -> Scene:
                 f"{left.shape[1]}x{left.shape[0]}"
             )
         gt[~np.isfinite(gt)] = np.nan
+        low, high = float(np.nanmin(gt, initial=np.inf)), float(np.nanmax(gt, initial=-np.inf))
+        if low < 0 and high <= 0:
+            # a GT of the other sign convention (x_right - x_left) was evaluated as it was:
+            # every method 100 % bad on every threshold, without a word
+            raise ValueError(
+                f"scene {d}: gt_disp.pfm's disparities are all negative ({figure_shown(high)} "
+                f"to {figure_shown(low)} px), where a left image's are >= 0 (x_left - x_right): "
+                "a GT of the other sign (negate it), or the right image's?"
+            )
     calib: Calibration | None = None
     ndisp: float | None = None
     calib_path = d / "calib.txt"
