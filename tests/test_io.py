@@ -1392,6 +1392,29 @@ def test_pfm_sizes_and_range_limits(tmp_path: Path) -> None:
     assert read_pfm(tmp_path / "top.pfm").tolist() == [[top, -top]]
 
 
+def test_write_pfm_and_write_ply_refuse_masked_values(tmp_path: Path) -> None:
+    """A numpy.ma map or cloud: asarray read its data, so write_pfm wrote a masked pixel's
+    value (2.0) as a real one and write_ply kept a masked point, nothing said. Both refuse it
+    as depth_from_disparity does, nothing written; a mask of nothing writes as before."""
+    disparity = np.ma.masked_array([[1.0, 2.0], [3.0, 4.0]], mask=[[0, 1], [0, 0]])
+    points = np.ma.masked_array(np.arange(6.0).reshape(2, 3), mask=[[0, 0, 0], [1, 1, 1]])
+    for write, name, value, says in (
+        (write_pfm, "d.pfm", disparity, "arr: a masked array (numpy.ma) with 1 masked pixel"),
+        (write_ply, "c.ply", points, "points: a masked array (numpy.ma) with 3 masked pixels"),
+    ):
+        with pytest.raises(ValueError) as info:
+            write(tmp_path / name, value)
+        arg = says.split(":")[0]
+        assert str(info.value) == (
+            f"{says}, whose values would be read as real ones; pass {arg}.filled(np.nan)"
+        )
+        assert not (tmp_path / name).exists()
+    disparity.mask = False
+    np.testing.assert_array_equal(read_pfm(write_pfm(tmp_path / "d.pfm", disparity)), disparity)
+    points.mask = False
+    np.testing.assert_array_equal(read_ply(write_ply(tmp_path / "c.ply", points))[0], points)
+
+
 def test_write_ply_drops_a_point_with_one_nan_coordinate(tmp_path: Path) -> None:
     pts = np.array([[1, 2, 3], [1, np.nan, 2], [np.inf, 0, 1], [4, 5, 6]], np.float32)
     cols = np.array([[1, 1, 1], [2, 2, 2], [3, 3, 3], [4, 4, 4]], np.uint8)

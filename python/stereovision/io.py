@@ -1581,8 +1581,9 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     Raises
     ------
     ValueError
-        If ``arr`` has the wrong shape or a non-real dtype, or finite values beyond float32's
-        range (they would be written as inf).
+        If ``arr`` has the wrong shape or a non-real dtype, finite values beyond float32's
+        range (they would be written as inf), or masked pixels (a ``numpy.ma`` array: pass
+        ``arr.filled(np.nan)``).
     TypeError
         If ``little_endian`` is not True or False.
     """
@@ -1590,13 +1591,15 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     if not isinstance(little_endian, (bool, np.bool_)):
         # "no" was true: a little-endian file where the caller asked for the other order
         raise TypeError(f"little_endian: expected True or False, got {little_endian!r}")
+    from stereovision._validate import _refuse_masked, check_index_range, refuse_beyond_float32
+
+    # asarray reads a masked array's data: its masked pixels were written as real values
+    _refuse_masked(arr, "arr", "np.nan")
     a = np.asarray(arr)
     if a.dtype.kind not in "iuf" or a.size == 0:
         raise ValueError(f"arr: expected a non-empty real array, got {_describe(a)}")
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] == 3)):
         raise ValueError(f"arr: expected shape (H, W) or (H, W, 3), got {a.shape}")
-    from stereovision._validate import check_index_range, refuse_beyond_float32
-
     check_index_range(a.shape, "arr", "map")  # before the float32 copy and the file's bytes
     refuse_beyond_float32(a, "arr", "would be written as inf")
     height, width = a.shape[:2]
@@ -1679,8 +1682,9 @@ def write_ply(
     Raises
     ------
     ValueError
-        If ``points`` is not ``(..., 3)`` real or holds finite values beyond float32's range
-        (they would become inf), ``colors`` does not match it or is not ``uint8``, or
+        If ``points`` is not ``(..., 3)`` real, holds finite values beyond float32's range
+        (they would become inf) or masked values (``numpy.ma``: pass
+        ``points.filled(np.nan)``), ``colors`` does not match it or is not ``uint8``, or
         ``comment`` is not one line of printable ASCII.
     FileNotFoundError
         If the folder of ``path`` does not exist.
@@ -1695,10 +1699,14 @@ def write_ply(
         comment = PLY_CLOUD_COMMENT
     if not (isinstance(comment, str) and comment.isascii() and comment.isprintable()):
         raise ValueError(f"comment: expected one line of printable ASCII, got {comment!r}")
+    from stereovision._validate import _refuse_masked, refuse_beyond_float32
+
+    # asarray reads a masked array's data: its masked points were written as real ones (NaN
+    # points are dropped, as drop_invalid says)
+    _refuse_masked(points, "points", "np.nan")
     pts = np.asarray(points)
     if pts.dtype.kind not in "iuf" or pts.ndim < 2 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected a real (N, 3) array, got {_describe(pts)}")
-    from stereovision._validate import refuse_beyond_float32
 
     # a float64 point past float32's range became inf in the cast: dropped without a word
     # (drop_invalid), else written as inf, with NumPy's overflow warning alone
