@@ -1908,10 +1908,26 @@ def test_load_scene_refuses_a_calib_txt_of_another_image_size(tmp_path: Path) ->
     assert calib is not None and tuple(calib.image_size) == (70, 8)
 
 
-def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:
+def test_find_scenes_of_a_file_says_it_is_a_file(tmp_path: Path) -> None:
+    """find_scenes / scan_scenes of a file (a scene's left.png) or a device said "scene root
+    not found" of a path that is there (eval and bench say it in their own words first); it is
+    a NotADirectoryError saying what it is, as load_scene's; a missing path is not found."""
+    from stereovision.io import scan_scenes
+
     (tmp_path / "left.png").write_bytes(b"")
-    with pytest.raises(FileNotFoundError, match=r"^scene root not found: .*left\.png$"):
-        find_scenes(tmp_path / "left.png")
+    for path, kind in (
+        (tmp_path / "left.png", "a file"),
+        (Path("/dev/null"), "not a folder (a device or a pipe)"),
+    ):
+        for find in (find_scenes, scan_scenes):
+            with pytest.raises(NotADirectoryError) as info:
+                find(path)
+            assert str(info.value) == (
+                f"{path} is {kind}, not a scene root: give the folder holding the scene folders "
+                "(or one scene folder, holding left.png and right.png)"
+            )
+    with pytest.raises(FileNotFoundError, match=r"^scene root not found: .*none$"):
+        find_scenes(tmp_path / "none")
 
 
 def test_scan_scenes_of_a_root_that_cannot_be_listed_is_an_error(

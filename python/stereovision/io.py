@@ -2466,7 +2466,9 @@ def find_scenes(root: PathLike) -> list[Path]:
     Raises
     ------
     FileNotFoundError
-        If ``root`` is not a directory.
+        If ``root`` does not exist.
+    NotADirectoryError
+        If ``root`` is a file (``cones/left.png``) or another thing that is no folder.
     PermissionError
         If ``root`` cannot be listed (an :class:`OSError` of its kind for another reason).
     """
@@ -2510,11 +2512,20 @@ def scan_scenes(root: PathLike) -> tuple[list[Path], list[tuple[Path, str]]]:
     Raises
     ------
     FileNotFoundError
-        If ``root`` is not a directory.
+        If ``root`` does not exist.
+    NotADirectoryError
+        If ``root`` is a file (``cones/left.png``) or another thing that is no folder.
     PermissionError
         If ``root`` cannot be listed (an :class:`OSError` of its kind for another reason).
     """
     r = as_path(root, "root")
+    if r.exists() and not r.is_dir():
+        # "scene root not found" of a file that is there (load_scene says this since e412c27)
+        kind = "a file" if r.is_file() else "not a folder (a device or a pipe)"
+        raise NotADirectoryError(
+            f"{r} is {kind}, not a scene root: give the folder holding the scene folders (or "
+            "one scene folder, holding left.png and right.png)"
+        )
     if not r.is_dir():
         # a link whose target moved: its target named, as load_scene's words name it
         gone = f" ({_broken_link(r)})" if r.is_symlink() and not r.exists() else ""
