@@ -389,6 +389,23 @@ def test_atomic_write_leaves_old_file_on_error(tmp_path: Path) -> None:
         write_pfm(tmp_path / "missing_dir" / "x.pfm", np.zeros((1, 1), np.float32))
 
 
+def test_writing_into_a_folder_link_to_nothing_names_the_link(tmp_path: Path) -> None:
+    """A folder given as a link whose target moved (out -> a disk since unmounted), or one of a
+    loop of links: "cannot write out/d.pfm: directory out does not exist" of a name ls lists.
+    It says what the link reaches, as the readers' "not found" does; nothing is written."""
+    out, loop = tmp_path / "out", tmp_path / "loop"
+    out.symlink_to(tmp_path / "moved")
+    loop.symlink_to(loop)
+    for folder, said in (
+        (out, f"a link to {tmp_path / 'moved'}, which does not exist"),
+        (loop, f"a link to {loop}, one of a loop of links that never reaches a file"),
+    ):
+        with pytest.raises(FileNotFoundError) as info:
+            write_pfm(folder / "d.pfm", np.zeros((1, 1), np.float32))
+        assert str(info.value) == f"cannot write {folder / 'd.pfm'}: directory {folder} is {said}"
+    assert sorted(os.listdir(tmp_path)) == ["loop", "out"]
+
+
 def test_writing_onto_a_folder_or_under_a_file_names_it(tmp_path: Path) -> None:
     """A folder where a file goes, or a file where a folder goes: the error says which (it
     showed the temporary file's name, or mkdir's bare "[Errno 17] File exists")."""

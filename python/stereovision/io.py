@@ -568,6 +568,12 @@ def _writable_destination(dest: Path, given: Path | None = None) -> Path:
     if directory.exists() and not directory.is_dir():
         raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
     if not directory.is_dir():
+        # a link whose target moved (or a loop) was "directory out does not exist" alone, of
+        # a name ls lists: what the link reaches is said, as the readers' "not found" says it
+        if directory.is_symlink():
+            raise FileNotFoundError(
+                f"cannot write {dest}: directory {directory} is {_broken_link(directory)}"
+            )
         raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
     return directory
 
