@@ -1952,6 +1952,41 @@ def test_a_camera_mounted_upside_down_or_on_its_side_is_named(
     assert f"turn it back first (cv2.rotate(right, cv2.{undo}))" in str(err.value)
 
 
+@pytest.mark.parametrize(
+    ("turn", "said"),
+    [
+        (
+            cv2.ROTATE_90_CLOCKWISE,
+            "below the left one (things appear 8.1 px higher in its image, median); turn both "
+            "images 90 degrees counter-clockwise to put it on the right (cv2.rotate(image, "
+            "cv2.ROTATE_90_COUNTERCLOCKWISE))",
+        ),
+        (
+            cv2.ROTATE_90_COUNTERCLOCKWISE,
+            "above the left one (things appear 7.4 px lower in its image, median); turn both "
+            "images 90 degrees clockwise to put it on the right (cv2.rotate(image, "
+            "cv2.ROTATE_90_CLOCKWISE))",
+        ),
+    ],
+)
+def test_cameras_one_above_the_other_are_told_to_turn_both_images(
+    data_dir: Path, turn: int, said: str
+) -> None:
+    """A rig whose cameras sit one above the other (cones with both images turned 90 degrees):
+    Hartley's homographies turn the images, and the orientation read the sense of x from a
+    component near 0. By the pair's size: refused as 'the rectified right image would be
+    mirrored: are left and right swapped?', which does not help (this 100x125 crop, and
+    450x375), or, at 150x125, the pair turned counter-clockwise rectified with its disparities
+    inverted (the near cones the smallest, its check "ok"). The layout is said, with the turn
+    that puts the cameras side by side (the pair then rectifies, quasi-Euclidean)."""
+    left, right = (cv2.rotate(img[:, :100], turn) for img in _small_cones(data_dir))
+    with pytest.raises(ValueError) as err:
+        rectify_uncalibrated(left, right, model="projective")
+    assert str(err.value) == (
+        "the matches lie along the columns, not the rows: the right camera sits " + said
+    )
+
+
 def test_a_right_image_of_the_left_ones_size_turned_is_not_told_to_be_resized() -> None:
     """A camera mounted on its side gives a 40x30 image beside a 30x40 one: refused with 'needs
     one size (resize one first)', which would squash the view; the turn is said instead. Other

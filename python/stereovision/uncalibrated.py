@@ -158,6 +158,27 @@ def _turn_deg(p1: F64, p2: F64) -> float | None:
     return math.degrees(math.atan2(float(sim[1, 0]), float(sim[0, 0])))
 
 
+#: An epipole further than this many image diagonals from the image's centre is of cameras side
+#: by side (or one above the other): 6 to 233 on cones, turned or not; a camera stepped forward
+#: and cut off its epipole's rows, 0.3.
+_FAR_EPIPOLE_DIAGONALS = 2.0
+
+
+#: Matches whose median vertical shift is over this many times their median horizontal one
+#: moved along the columns: 110 to 153 on cones turned 90 degrees; at most 3 (tsukuba with its
+#: right camera bumped) on side-by-side pairs, about 1 for a camera stepped forward.
+_COLUMNS_RATIO = 10.0
+
+
+def _epipole_far(fm: F64, w: int, h: int) -> bool:
+    """Whether the left image's epipole (``fm @ e = 0``) lies further than
+    :data:`_FAR_EPIPOLE_DIAGONALS` image diagonals from its centre (or at infinity)."""
+    e = np.linalg.svd(fm)[2][-1]
+    centre = np.array([(w - 1) / 2, (h - 1) / 2]) * e[2]
+    reach = _FAR_EPIPOLE_DIAGONALS * math.hypot(w, h) * abs(e[2])
+    return bool(np.linalg.norm(e[:2] - centre) > reach)
+
+
 def _midpoints(w: int, h: int) -> F64:
     """The middles of the top, right, bottom and left edges."""
     return np.array(
@@ -862,8 +883,10 @@ def rectify_uncalibrated(
         epipole inside the image (the cameras look along their baseline), homographies that
         would stretch an image more than :data:`MAX_STRETCH` times, left and right given the
         wrong way round (two cameras side by side, at most a fifth of whose matches lie further
-        right in the left image than in the right one), or the right image turned upside down
-        or on its side against the left one (a camera mounted so: the turn is named).
+        right in the left image than in the right one), the right image turned upside down
+        or on its side against the left one (a camera mounted so: the turn is named), or
+        cameras one above the other (the 90-degree turn of both images that puts them side by
+        side is named).
     """
     if model not in MODELS:
         raise ValueError(f"model: expected one of {', '.join(MODELS)}, got {model!r}")
@@ -989,6 +1012,24 @@ def rectify_uncalibrated(
     cx, cy = (w - 1) / 2, (h - 1) / 2
     axes = np.array([[cx, cy], [cx + 1, cy], [cx, cy + 1]])
     o, ex_, ey_ = _apply(h1, axes)
+    dy = float(np.median(p1[:, 1] - p2[:, 1]))  # > 0: the right camera sees things higher
+    along_columns = abs(dy) > _COLUMNS_RATIO * float(np.median(np.abs(p1[:, 0] - p2[:, 0])))
+    if abs(ex_[1] - o[1]) > abs(ex_[0] - o[0]) and (along_columns or _epipole_far(fm, w, h)):
+        # The rows would be the input's columns, the matches moved along them or the epipole
+        # far above or below: cameras one above the other. The flip below then read the sense
+        # of x from a component near 0 (cones turned 90 degrees: by its size, disparities
+        # inverted with the check "ok", or "mirrored: swapped?"). A camera stepped forward,
+        # its epipole near and its matches fanned out, is left to the size's check.
+        way, where, seen = (
+            ("counter-clockwise", "below", "higher") if dy > 0 else ("clockwise", "above", "lower")
+        )
+        undo = "COUNTERCLOCKWISE" if dy > 0 else "CLOCKWISE"
+        raise ValueError(
+            f"the matches lie along the columns, not the rows: the right camera sits {where} "
+            f"the left one (things appear {abs(dy):.1f} px {seen} in its image, median); turn "
+            f"both images 90 degrees {way} to put it on the right (cv2.rotate(image, "
+            f"cv2.ROTATE_90_{undo}))"
+        )
     flip = np.diag([1.0 if ex_[0] > o[0] else -1.0, 1.0 if ey_[1] > o[1] else -1.0, 1.0])
     h1, h2 = flip @ h1, flip @ h2
     o, ex_, _ = _apply(h2, axes)
