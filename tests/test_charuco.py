@@ -1389,6 +1389,31 @@ def test_object_points_names_ids_that_are_not_whole_on_one_line() -> None:
     )
 
 
+def test_markers_too_large_for_their_border_are_warned_of_in_the_packages_words(
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """Markers nearly as large as their squares (0.028 in 0.03) leave a white border OpenCV
+    finds too narrow to place the corners well (a rendered view's corners 0.49 px off on
+    average, against 0.08 px with 0.022 markers): it said so only in its log, "[ WARN:0@1.8]
+    ... Please increase markerSeparation or decrease markerLength", parameters this package
+    has not, and `board` printed such a board with that line. It is a warning now, naming the
+    sizes and the largest marker to print; OpenCV's line is not printed. Sizes of its own
+    (0.0301) so that no other test built this board first (warned once a board)."""
+    board = CharucoBoard("5x4", 0.0301, 0.028, "DICT_5X5_50")
+    with pytest.warns(UserWarning) as rec:
+        board.cv_board()
+    assert [str(w.message) for w in rec] == [
+        "ChArUco markers of 0.028 in squares of 0.0301 leave a white border of 0.001 around "
+        "them, under the 0.0028 (70 % of a marker's cell) that OpenCV needs to place the "
+        "corners well (0.028 in 0.03: a rendered view's corners 0.49 px off on average, 0.08 px "
+        "with 0.022); a board to print needs markers of at most 0.025"
+    ]
+    assert "markerSeparation" not in capfd.readouterr().err
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        CharucoBoard("5x4", 0.0301, 0.025, "DICT_5X5_50").cv_board()  # the largest: no word
+
+
 def test_board_png_of_a_board_whose_dictionary_is_auto_names_the_dictionary() -> None:
     """board_png of CharucoBoard("7x5", ..., dictionary="auto") (its default) looked "auto" up
     in cv2.aruco for its marker check: AttributeError "module 'cv2.aruco' has no attribute
