@@ -1987,6 +1987,24 @@ def test_cameras_one_above_the_other_are_told_to_turn_both_images(
     )
 
 
+def test_an_image_mirrored_against_the_other_is_named(data_dir: Path) -> None:
+    """A camera's mirror setting (webcams' default at times): SIFT matches no mirrored view, so
+    cones with its right image flipped left to right gave 8 matches (at 150x125; 42 at full
+    size, 25 fitting F; this crop flipped upside down, 5) and was told to 'point the cameras at
+    something textured that both see' ('the views share too little, or a moving scene'). The
+    flip is named, with its undoing (here upside down: a half turn of the matches flipped left
+    to right); a textureless pair keeps the old words."""
+    left, right = (img[:, :100] for img in _small_cones(data_dir))
+    with pytest.raises(ValueError) as err:
+        rectify_uncalibrated(left, cv2.flip(right, 0))
+    assert str(err.value) == (
+        "only 5 feature matches between the two images (at least 30 needed): one image is "
+        "mirrored upside down against the other (71 matches with the right one flipped: a "
+        "camera's mirror or flip setting?): flip the mirrored one back first "
+        "(cv2.flip(image, 0))"
+    )
+
+
 def test_a_right_image_of_the_left_ones_size_turned_is_not_told_to_be_resized() -> None:
     """A camera mounted on its side gives a 40x30 image beside a 30x40 one: refused with 'needs
     one size (resize one first)', which would squash the view; the turn is said instead. Other
