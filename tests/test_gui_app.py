@@ -6267,13 +6267,15 @@ def test_a_failed_click_during_a_computation_leaves_its_progress(tmp_path):
     assert (app.state.busy, app.state.status) == (False, "error")
 
 
-def test_the_max_disparity_in_use_typed_again_clears_its_refusal():
+def test_the_max_disparity_in_use_typed_again_clears_its_refusal(tmp_path):
     """A bad max disparity ("abc") corrected back to the value in use computed nothing (the
     same range) and said nothing: the refusal "got 'abc'" and the toolbar's "error" stayed
-    under a field holding a good value. The refusal goes; another error on the page stays."""
+    under a field holding a good value. The refusal goes; another error on the page stays.
+    Another action's success that clears the refusal (a Show, Find floor, Check rows, Save)
+    left the refused value in the field, no error said under it: it shows the range in use."""
     from stereovision.gui import bundled_data_dir
 
-    app = _scene_app("test-max-disp-typed-again", [bundled_data_dir()])
+    app = _scene_app("test-max-disp-typed-again", [bundled_data_dir(), tmp_path])
     spawned: list = []
     app._spawn = spawned.append
     app._load_scene(bundled_data_dir() / "cones")
@@ -6294,6 +6296,17 @@ def test_the_max_disparity_in_use_typed_again_clears_its_refusal():
     app._fail(OSError("cannot open camera 5 (left)"))  # said since: not the field's
     app.apply_max_disparity(text="auto")
     assert app.state.error == "cannot open camera 5 (left)" and spawned == []
+    (tmp_path / "one.ply").write_text(
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n0 0 1\n"
+    )
+    app.state.cloud_path = str(tmp_path / "one.ply")
+    for in_use, said in ((None, ""), (32, "32")):
+        app.chosen_max_disparity = in_use
+        app.apply_max_disparity(text="500")
+        assert app.state.error.startswith("max disparity 500 px is not smaller")
+        app.open_cloud()  # taken: its success clears the refusal, and the refused value
+        assert (app.state.error, app.state.max_disp) == ("", said), in_use
 
 
 def test_an_emptied_slider_is_said_on_the_page(tmp_path):

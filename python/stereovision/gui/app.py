@@ -1864,9 +1864,13 @@ class StereoApp:
 
     def _done(self) -> None:
         """A button's action succeeded: an earlier failure's message and "error" status go (they
-        stayed until the next computed pair)."""
+        stayed until the next computed pair), and a refused max disparity with its message
+        (:meth:`_max_disp_back`)."""
         with self.state:
             self.state.error = ""
+            # a refused max disparity went with the error: the field kept it ("500" after a
+            # Find floor, Check rows, Show or Save) over a result of the range in use
+            self._max_disp_back()
             # without a pair on show too: the toolbar said "error" above a page with no error
             # on it (cameras that failed at start-up, then a point-cloud file opened)
             if self._computing:
