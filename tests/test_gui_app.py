@@ -1537,10 +1537,15 @@ def test_a_computed_pair_hands_its_memory_back():
     assert _core.kept_memory() == ((0, 0), 0)
 
 
-def test_an_opened_cloud_stays_shown_in_both_view_modes(tmp_path):
+def test_an_opened_cloud_stays_shown_in_both_view_modes(tmp_path, monkeypatch):
     """After "Open" of a PLY the points / surface toggle swapped in the scene's points while the
     caption still named the file. The file now stays on show in both modes (it has no surface:
-    the caption says so), until the next computed pair replaces it."""
+    the caption says so), until the next computed pair replaces it. A new pair that computes,
+    then fails, leaves it on show under its own caption: it was said to be "the previous one"
+    meanwhile, and one opened meanwhile lost its caption to the previous pair's."""
+    import asyncio
+
+    from stereovision.gui import app as gui_app
     from stereovision.gui import bundled_data_dir
 
     n = 500
@@ -1573,6 +1578,27 @@ def test_an_opened_cloud_stays_shown_in_both_view_modes(tmp_path):
     _run(app, app.recompute)  # a new pair: its scene replaces the file, drawn as points
     assert shown()[0] > 10 * n and shown()[1] == 0
     assert "blob" not in app.state.message_3d
+    monkeypatch.setattr(gui_app, "compute_view", _fails)
+    during: list[str] = []
+
+    async def a_new_pair_fails(open_before: bool) -> None:
+        app._lock = asyncio.Lock()
+        if open_before:
+            app.open_cloud()
+        app._load_scene(bundled_data_dir() / "cones")  # another pair: computed, then fails
+        task = asyncio.ensure_future(app.recompute())
+        await asyncio.sleep(0)  # it computes
+        if open_before:
+            during.append(app.state.message_3d)
+        else:
+            app.open_cloud()
+        await task
+
+    for open_before in (False, True):
+        asyncio.run(a_new_pair_fails(open_before))
+        assert app.state.error == "boom (the page still shows the previous pair)", open_before
+        assert shown() == (n, 0) and app.state.message_3d == f"{label}: {n} points", open_before
+    assert during == [f"{label}: {n} points"]
 
 
 def test_a_big_cloud_is_shown_as_a_capped_subset_and_says_so(tmp_path, monkeypatch):

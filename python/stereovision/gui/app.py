@@ -2650,7 +2650,12 @@ class StereoApp:
                     st.floor_label = st.stats = ""
                     st.depth_caption = DEPTH_CAPTION
                     st.disparity_caption = DISPARITY_CAPTION
-                    st.message_3d = PENDING_3D if self.view is not None else ""
+                    if self._cloud is not None:
+                        # a point-cloud file is on show until the new pair's result: its
+                        # caption stays (it was said to be "the previous one", or nothing)
+                        st.message_3d = self._cloud_message()
+                    else:
+                        st.message_3d = PENDING_3D if self.view is not None else ""
 
             def progress(pct: int, text: str) -> None:
                 loop.call_soon_threadsafe(self._set_progress, pct, text)
@@ -2704,6 +2709,10 @@ class StereoApp:
                             self.state.depth_caption, self.state.stats = self.view.texts(self._unit)
                             if self.state.floor_label and self.view.floor is not None:
                                 self.state.floor_label = floor_text(self.view.floor, self._unit)
+                        if self._cloud is not None:
+                            # a file opened while the pair computed is still on show: the
+                            # previous pair's caption was put back over it
+                            self.state.message_3d = self._cloud_message()
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
                     for name, value in shown.items():
