@@ -1016,6 +1016,26 @@ def test_folder_pairs_play_in_order_and_again(tmp_path: Path) -> None:
     assert fp.read()[0][0, 0, 0] == 3
 
 
+def test_folder_pairs_say_a_file_gone_since_with_its_pair(tmp_path: Path) -> None:
+    """A pair's file removed (or spoilt) while the folder played was said by its whole path
+    alone ("image file not found: /tmp/.../seq/right_0002.png") under the label of the pair
+    before, the next Capture going on to pair 0003: which pair was skipped went unsaid. It is
+    said with the pair, the path from the folder's name, and the next read goes on."""
+    seq = _pairs_folder(tmp_path, 3)
+    fp = FolderPairs(seq, "data/seq")
+    fp.read()
+    (seq / "right_0002.png").unlink()
+    (seq / "left_0003.png").write_bytes(b"not an image")
+    with pytest.raises(FileNotFoundError) as gone:
+        fp.read()
+    assert str(gone.value) == (
+        "folder data/seq: pair 0002 (2 of 3): image file not found: data/seq/right_0002.png"
+    )
+    with pytest.raises(ValueError, match=r"^folder data/seq: pair 0003 \(3 of 3\): cannot decode "):
+        fp.read()
+    assert fp.read()[0][0, 0, 0] == 1  # the first again
+
+
 def test_folder_pairs_keep_and_no_pairs(tmp_path: Path) -> None:
     seq = _pairs_folder(tmp_path, 2)
     fp = FolderPairs(seq, "s", keep=lambda p: "0002" not in p.name)

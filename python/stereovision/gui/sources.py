@@ -775,6 +775,7 @@ class FolderPairs:
             )
         self.jobs = jobs
         self.name = name
+        self.folder = Path(folder)
         self.index = -1
 
     @property
@@ -784,14 +785,34 @@ class FolderPairs:
 
     def read(self) -> tuple[Frame, Frame]:
         """The next pair (BGR, a 16-bit pair at its 16 bits as ``batch`` reads it: ``uint16``,
-        else ``uint8``), after the last one the first again."""
+        else ``uint8``), after the last one the first again.
+
+        Raises
+        ------
+        FileNotFoundError, OSError, ValueError
+            A file of the pair removed or changed since the folder was played, said with the
+            pair (:meth:`describe`) and the file's path from the folder's ``name``; the next
+            read goes on with the next pair.
+        """
         from stereovision.io import read_image
 
         self.index = (self.index + 1) % len(self.jobs)
         job = self.jobs[self.index]
-        # uint16 for a 16-bit pair, as a 16-bit sequence's frames are (_decode): the page
-        # matches such a pair as it is and shows it at 8 bits
-        return read_image(job.left), read_image(job.right)
+        try:
+            # uint16 for a 16-bit pair, as a 16-bit sequence's frames are (_decode): the page
+            # matches such a pair as it is and shows it at 8 bits
+            return read_image(job.left), read_image(job.right)
+        except (OSError, ValueError) as exc:
+            # the file's whole path alone ("image file not found: /srv/data/seq/right_0002.png")
+            # under the previous pair's label: which pair was skipped went unsaid
+            said = str(exc).replace(str(self.folder) + os.sep, self.name.rstrip("/") + "/")
+            said = f"{self.describe()}: {said}"
+            out: Exception = ValueError(said)
+            if isinstance(exc, FileNotFoundError):
+                out = FileNotFoundError(said)
+            elif isinstance(exc, OSError):
+                out = OSError(said)
+            raise out from exc
 
     def describe(self) -> str:
         """``folder data/seq: pair 0002 (2 of 20)``."""
