@@ -1020,7 +1020,8 @@ def test_folder_pairs_say_a_file_gone_since_with_its_pair(tmp_path: Path) -> Non
     """A pair's file removed (or spoilt) while the folder played was said by its whole path
     alone ("image file not found: /tmp/.../seq/right_0002.png") under the label of the pair
     before, the next Capture going on to pair 0003: which pair was skipped went unsaid. It is
-    said with the pair, the path from the folder's name, and the next read goes on."""
+    said with the pair, the path from the folder's name, and the next read goes on; so is a
+    played scene's calib.txt spoilt or removed."""
     seq = _pairs_folder(tmp_path, 3)
     fp = FolderPairs(seq, "data/seq")
     fp.read()
@@ -1034,6 +1035,24 @@ def test_folder_pairs_say_a_file_gone_since_with_its_pair(tmp_path: Path) -> Non
     with pytest.raises(ValueError, match=r"^folder data/seq: pair 0003 \(3 of 3\): cannot decode "):
         fp.read()
     assert fp.read()[0][0, 0, 0] == 1  # the first again
+    # a played scene's calibration too (the page's _read_pair reads it)
+    from stereovision.gui.app import _read_pair
+
+    for name in ("a", "b"):
+        scene = tmp_path / "sc" / name
+        scene.mkdir(parents=True)
+        for side in ("left", "right"):
+            cv2.imwrite(str(scene / f"{side}.png"), np.zeros((4, 5, 3), np.uint8))
+        (scene / "calib.txt").write_text("not a calibration\n")
+    scenes = FolderPairs(tmp_path / "sc", "data/sc")
+    with pytest.raises(ValueError, match=r"^folder data/sc: pair a \(1 of 2\): unrecognised "):
+        _read_pair(scenes, False)
+    (tmp_path / "sc" / "b" / "calib.txt").unlink()
+    with pytest.raises(FileNotFoundError) as gone:
+        _read_pair(scenes, False)
+    assert str(gone.value) == (
+        "folder data/sc: pair b (2 of 2): calibration file not found: data/sc/b/calib.txt"
+    )
 
 
 def test_folder_pairs_keep_and_no_pairs(tmp_path: Path) -> None:

@@ -1325,7 +1325,10 @@ def _read_pair(source: StereoSource, average: bool) -> _Frames:
         if job.calib is not None:  # a scene's calib.txt
             from stereovision.calibration import Calibration
 
-            got.calib = Calibration.from_file(job.calib)
+            try:
+                got.calib = Calibration.from_file(job.calib)
+            except (OSError, ValueError) as exc:  # changed since played: said with its pair
+                raise folder.said_of_pair(exc) from exc
     elif average:
         from stereovision.capture import _check_8_bit_frames
         from stereovision.temporal import TemporalFilter

@@ -803,16 +803,32 @@ class FolderPairs:
             # matches such a pair as it is and shows it at 8 bits
             return read_image(job.left), read_image(job.right)
         except (OSError, ValueError) as exc:
-            # the file's whole path alone ("image file not found: /srv/data/seq/right_0002.png")
-            # under the previous pair's label: which pair was skipped went unsaid
-            said = str(exc).replace(str(self.folder) + os.sep, self.name.rstrip("/") + "/")
-            said = f"{self.describe()}: {said}"
-            out: Exception = ValueError(said)
-            if isinstance(exc, FileNotFoundError):
-                out = FileNotFoundError(said)
-            elif isinstance(exc, OSError):
-                out = OSError(said)
-            raise out from exc
+            raise self.said_of_pair(exc) from exc
+
+    def said_of_pair(self, exc: OSError | ValueError) -> Exception:
+        """``exc``, raised reading the pair last read (a file of it, its scene's calibration),
+        as the page says it: with the pair (:meth:`describe`) and the file's path from the
+        folder's ``name``.
+
+        The file's whole path alone ("image file not found: /srv/data/seq/right_0002.png")
+        was said under the previous pair's label, the next Capture going on to the pair after
+        it: which pair was skipped went unsaid.
+
+        Parameters
+        ----------
+        exc : OSError or ValueError
+            As the file's reader raised it.
+
+        Returns
+        -------
+        Exception
+            Of the same kind: a FileNotFoundError, another OSError, or a ValueError.
+        """
+        said = str(exc).replace(str(self.folder) + os.sep, self.name.rstrip("/") + "/")
+        said = f"{self.describe()}: {said}"
+        if isinstance(exc, FileNotFoundError):
+            return FileNotFoundError(said)
+        return OSError(said) if isinstance(exc, OSError) else ValueError(said)
 
     def describe(self) -> str:
         """``folder data/seq: pair 0002 (2 of 20)``."""
