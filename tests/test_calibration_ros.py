@@ -402,6 +402,22 @@ def test_kalibr_camera_choice_errors(tmp_path: Path) -> None:
         Calibration.from_file(path)
 
 
+def test_kalibr_chain_with_a_camera_cut_out_is_refused(tmp_path: Path) -> None:
+    """cam1 deleted from a three-camera camchain: cam2's T_cn_cnm1 (its pose from cam1) was
+    taken as its pose from cam0, a rig of silently wrong R and T."""
+    c = raw_calib()
+    cams = [{"K": c.K1, "D": c.D1, "size": c.image_size}]
+    text = _camchain([*cams, {**cams[0], "T": _pose(c.R, c.T)}]).replace("cam1:", "cam2:")
+    path = tmp_path / "camchain.yaml"
+    path.write_text(text)
+    with pytest.raises(
+        ValueError,
+        match=r"camchain\.yaml: no cam1 between 'cam0' and 'cam2'; the T_cn_cnm1 of 'cam2' "
+        r"is its pose from cam1: keep every camera between$",
+    ):
+        Calibration.from_kalibr(path, cameras=("cam0", "cam2"))
+
+
 def test_a_four_coefficient_pinhole_rig_is_written_as_five_plumb_bob_ones() -> None:
     """ROS's plumb_bob model has five coefficients (k1 k2 p1 p2 k3): a rig calibrated with four
     is written with k3 = 0 (a mutation audit found the padding unchecked). Parsed back with

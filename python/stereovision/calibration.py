@@ -2444,10 +2444,10 @@ class Calibration:
         FileNotFoundError
             If the file does not exist.
         ValueError
-            A camera missing or out of order, a camera model other than ``pinhole`` or a
-            distortion other than ``radtan``/``equidistant``/``none``, the two cameras with
-            different distortion models, a malformed field (named), or cameras of different
-            resolutions.
+            A camera missing or out of order (or one between the two missing), a camera model
+            other than ``pinhole`` or a distortion other than ``radtan``/``equidistant``/``none``,
+            the two cameras with different distortion models, a malformed field (named), or
+            cameras of different resolutions.
         """
         import yaml
 
@@ -2473,6 +2473,15 @@ class Calibration:
         i, j = chain.index(left), chain.index(right)
         if j <= i:
             raise ValueError(f"{p}: {right!r} must come after {left!r} in the chain")
+        numbers = [int(k[3:]) for k in chain[i : j + 1]]
+        missing = sorted(set(range(numbers[0], numbers[-1] + 1)) - set(numbers))
+        if missing:
+            # each T_cn_cnm1 is from camera n-1: with cam1 cut out of a three-camera chain,
+            # cam2's pose from cam1 was taken as its pose from cam0 (a silently wrong R, T)
+            raise ValueError(
+                f"{p}: no cam{missing[0]} between {left!r} and {right!r}; the T_cn_cnm1 of "
+                f"{right!r} is its pose from cam{numbers[-1] - 1}: keep every camera between"
+            )
         for name in (left, right):
             cam = doc[name]
             for key, value in cam.items() if isinstance(cam, dict) else [(name, cam)]:
