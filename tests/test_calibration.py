@@ -843,6 +843,22 @@ def test_scaled_to_a_lower_resolution() -> None:
         c.scaled_to((0, 10))
 
 
+def test_scaled_up_keeps_a_doffs_rounded_as_middlebury_prints_it(tmp_path: Path) -> None:
+    """A doffs 1.5e-3 px off cx2 - cx1 (3 printed decimals, within DOFFS_TOL_PX) was refused
+    at twice the size ("doffs: 20.003 differs from cx2 - cx1 = 20.0"): scaled, it is kept,
+    K2's cx takes the rounding, and the scaled rig saved is read back."""
+    from stereovision.calibration import fit_to_frames
+
+    r = rect_calib(K2=np.array([[500.0, 0, 170.0], [0, 500.0, 120.0], [0, 0, 1]]), doffs=10.0015)
+    big = r.scaled_to((640, 480))
+    assert big.doffs == 20.003 and big.Q[3, 3] == pytest.approx(20.003 / 100.0)
+    assert big.K1[0, 2] == 320.5 and big.K2[0, 2] == pytest.approx(340.503, abs=1e-12)
+    assert Calibration.load(big.save(tmp_path / "big.yaml")) == big
+    disp = np.array([[20.0]])
+    np.testing.assert_allclose(big.depth_from_disparity(2 * disp), r.depth_from_disparity(disp))
+    assert fit_to_frames(r, (640, 480))[0].doffs == 20.003
+
+
 def test_fit_to_frames_scales_or_names_a_crop() -> None:
     from stereovision.calibration import fit_to_frames
 

@@ -1209,19 +1209,27 @@ class Calibration:
             out[1, 2] = (k[1, 2] + 0.5) * sy - 0.5
             return out
 
+        k1, k2 = scale(self.K1), scale(self.K2)
+        doffs = None if self.doffs is None else self.doffs * sx
+        if doffs is not None and abs(doffs - (k2[0, 2] - k1[0, 2])) > DOFFS_TOL_PX:
+            # a doffs within DOFFS_TOL_PX of cx2 - cx1 (Middlebury's 3 decimals) is off by more
+            # once enlarged: a quarter-size calib.txt 1.5e-3 px off was refused at twice its size
+            # ("doffs: 20.003 differs from cx2 - cx1 = 20.0"). The right camera's cx takes the
+            # rounding: doffs gives the depths, and the file saved is read back.
+            k2[0, 2] = k1[0, 2] + doffs
         token = _DERIVING.set(True)
         try:
             return Calibration(
-                K1=scale(self.K1),
+                K1=k1,
                 D1=self.D1,
-                K2=scale(self.K2),
+                K2=k2,
                 D2=self.D2,
                 R=self.R,
                 T=self.T,
                 image_size=size,
                 unit=self.unit,
                 rectified=self.rectified,
-                doffs=None if self.doffs is None else self.doffs * sx,
+                doffs=doffs,
                 model=self.model,
             )
         finally:
