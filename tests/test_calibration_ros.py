@@ -397,6 +397,14 @@ def test_kalibr_camera_choice_errors(tmp_path: Path) -> None:
         Calibration.from_kalibr(path, cameras=("cam1", "cam0"))
     with pytest.raises(ValueError, match="'cam0' must come after 'cam0'"):
         Calibration.from_kalibr(path, cameras=("cam0", "cam0"))  # not a zero baseline
+    # "cam0" and ("cam0",) were "too many (not enough) values to unpack", None a TypeError
+    for cameras, shown in (("cam0", "'cam0'"), (("cam0",), r"\('cam0',\)"), (None, "None")):
+        with pytest.raises(
+            ValueError,
+            match=rf"^cameras: expected the left and right camera's keys, \('cam0', 'cam1'\), "
+            rf"got {shown}$",
+        ):
+            Calibration.from_kalibr(path, cameras=cameras)  # type: ignore[arg-type]
     path.write_text(_camchain([*cams, {**cams[0]}]))  # cam1 without its pose
     with pytest.raises(ValueError, match="lacks field 'T_cn_cnm1'"):
         Calibration.from_file(path)

@@ -2452,13 +2452,25 @@ class Calibration:
         FileNotFoundError
             If the file does not exist.
         ValueError
-            A camera missing or out of order (or one between the two missing), a camera model
+            ``cameras`` not two camera keys (str), a camera missing or out of order (or one
+            between the two missing), a camera model
             other than ``pinhole`` or a distortion other than ``radtan``/``equidistant``/``none``,
             the two cameras with different distortion models, a malformed field (named), or
             cameras of different resolutions.
         """
         import yaml
 
+        if not (
+            isinstance(cameras, (tuple, list))
+            and len(cameras) == 2
+            and all(isinstance(c, str) for c in cameras)
+        ):
+            # "cam0" or ("cam0",) was Python's "too many (not enough) values to unpack", None
+            # a TypeError: neither named the argument
+            raise ValueError(
+                f"cameras: expected the left and right camera's keys, ('cam0', 'cam1'), got "
+                f"{text_shown(cameras)}"
+            )
         p, text = cls._read_text(path)
         try:
             # the first document, as the plain YAML and ROS readers take it (a712fb3d): a file
