@@ -603,6 +603,25 @@ def test_from_kitti_refuses_an_image_size_its_s_rect_02_contradicts(tmp_path: Pa
         Calibration.from_kitti(cam, image_size=(1242, 375))
 
 
+def test_a_kitti_value_that_is_no_number_is_named(tmp_path: Path) -> None:
+    """A key with a value that is no number is skipped by the parser: a damaged P_rect_03
+    (or one parted by commas) was "lacks P_rect_02/P_rect_03", a damaged S_rect_02 left the
+    size to the image_size given or an image beside the file."""
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+O1 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    cam = tmp_path / "calib_cam_to_cam.txt"
+    cam.write_text(f"S_rect_02: 1.242000e+03 3.750000e+02\nP_rect_02: {p2}\nP_rect_03: {p3}\n")
+    with pytest.raises(
+        ValueError,
+        match=r"calib_cam_to_cam\.txt: P_rect_03 holds '-3\.6e\+O1', not a number \(its values "
+        r"are numbers parted by spaces\)$",
+    ):
+        Calibration.from_file(cam)
+    cam.write_text(f"S_rect_02: 1242, 375\nP_rect_02: {p2}\nP_rect_03: {p2}\n")
+    with pytest.raises(ValueError, match=r"S_rect_02 holds '1242,', not a number"):
+        Calibration.from_kitti(cam, image_size=(1242, 375))
+
+
 # ------------------------------------------------------------------------------------ Q, rectify
 
 

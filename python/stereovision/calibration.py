@@ -2239,12 +2239,15 @@ class Calibration:
             )
         assert isinstance(given, list)
         a, b = given
-        p, _ = cls._read_text(path)
+        p, text = cls._read_text(path)
         v = parse_kitti_calib(p)
         for k2, k3 in ((f"P_rect_0{a}", f"P_rect_0{b}"), (f"P{a}", f"P{b}")):
             if k2 in v and k3 in v:
                 break
         else:
+            # a key whose values are not all numbers is skipped by the parser: a damaged
+            # P_rect_03 (or one parted by commas) was "lacks P_rect_02/P_rect_03"
+            _kitti_check_numbers(text, p, (f"P_rect_0{a}", f"P_rect_0{b}", f"P{a}", f"P{b}"))
             raise ValueError(f"KITTI calibration {p} lacks P_rect_0{a}/P_rect_0{b} (or P{a}/P{b})")
         mats = []
         for key in (k2, k3):
@@ -2265,6 +2268,7 @@ class Calibration:
         size: tuple[int, int] | None = None
         given = None if image_size is None else cls._check_size(image_size)
         s_rect = f"S_rect_0{a}"
+        _kitti_check_numbers(text, p, () if s_rect in v else (s_rect,))  # not a fallback size
         if s_rect in v:
             if v[s_rect].size != 2:
                 raise ValueError(
@@ -2864,6 +2868,24 @@ def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
             values.append(tok)
     flush()
     return out
+
+
+def _kitti_check_numbers(text: str, path: Path, keys: tuple[str, ...]) -> None:
+    """Refuse the first of ``keys`` given in a KITTI file with a value that is no number, which
+    :func:`parse_kitti_calib` skips (as it skips ``calib_time``), naming the value."""
+    tokens = re.sub(r":", ": ", text).split()
+    for key in keys:
+        for i, tok in enumerate(tokens):
+            if tok != f"{key}:":
+                continue
+            for t in tokens[i + 1 :]:
+                if _KITTI_KEY.match(t):
+                    break
+                if not _is_float(t):
+                    raise ValueError(
+                        f"KITTI calibration {path}: {key} holds {reprlib.repr(t)}, not a number "
+                        "(its values are numbers parted by spaces)"
+                    )
 
 
 # --------------------------------------------------------------------------- ROS camera_info
