@@ -1000,6 +1000,19 @@ def test_a_skewed_camera_matrix_is_named_in_a_warning() -> None:
         raw_calib(K1=np.array([[300.0, 1e-9, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]]))
 
 
+def test_a_transposed_camera_matrix_is_said_transposed(tmp_path: Path) -> None:
+    """A K1 transposed (MATLAB's IntrinsicMatrix, cx and cy in the bottom row) was refused by
+    its form alone, where triangulation's check says the transpose."""
+    k = raw_calib().K1
+    form = "K1: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
+    with pytest.raises(ValueError) as err:
+        raw_calib(K1=k.T)
+    assert str(err.value) == form + f"{k.T.tolist()} (transposed? pass K1.T)"
+    with pytest.raises(ValueError) as err:
+        raw_calib(K1=2 * k)  # a bottom row (0, 0, 2): no transpose to suggest
+    assert str(err.value) == form + f"{(2 * k).tolist()}"
+
+
 def test_a_raw_rig_with_the_right_camera_on_the_left_is_named() -> None:
     """``from_ros(right.yaml, left.yaml)`` built a rig with T[0] > 0 without a word (a rectified
     one is refused)."""

@@ -199,9 +199,12 @@ def _check_camera_matrix(K: F64, name: str) -> None:
             f"{name}: focal lengths must be positive, got fx={float(fx):g}, fy={float(fy):g}"
         )
     if K[1, 0] != 0 or not np.allclose(K[2], (0.0, 0.0, 1.0), rtol=0, atol=1e-12):
+        # MATLAB's IntrinsicMatrix is K.T: said, as triangulation's check says it (a file's or
+        # a script's transposed K1 got the form alone, with cx and cy in its bottom row)
+        transposed = K[0, 1] == 0 and np.allclose(K[:, 2], (0.0, 0.0, 1.0), rtol=0, atol=1e-12)
         raise ValueError(
             f"{name}: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
-            f"{K.tolist()}"
+            f"{K.tolist()}" + (f" (transposed? pass {name}.T)" if transposed else "")
         )
     if abs(K[0, 1]) > SKEW_IGNORED_PX:
         import warnings
