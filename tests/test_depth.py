@@ -1635,6 +1635,23 @@ def test_a_negative_min_disparity_with_fused_names_the_channels_that_run() -> No
         sv.match(left, right, method="fused", channels=("bogus",), chanels=1)
 
 
+def test_a_misspelt_keyword_of_depth_map_names_the_keyword() -> None:
+    """``depth_map(..., max_disparty=8)`` was "unknown fusion option(s) ['max_disparty']" (a
+    list of 22 options without the one meant), and the SGM's or Gabor's list with the others:
+    now named as depth_map's own keyword, as match() names its own, before any work."""
+    img = np.zeros((8, 12), np.uint8)
+    for method in ("fused", "gabor", "census", "fast"):
+        for typo, meant in (("max_disparty", "max_disparity"), ("refin", "refine")):
+            with pytest.raises(ValueError) as err:
+                sv.depth_map(img, img, method=method, max_disparity=4, **{typo: 8})
+            assert str(err.value) == (
+                f"depth_map: unknown keyword argument {typo!r} (did you mean {meant!r}?)"
+            )
+    # a key nearest to an option of the method is still the method's to name
+    with pytest.raises(ValueError, match=r"^unknown SGM option\(s\) \['radius'\] \(did you"):
+        sv.depth_map(img, img, method="census", max_disparity=4, radius=3)
+
+
 def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
     from stereovision.depth import estimate_max_disparity
 

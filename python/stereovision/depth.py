@@ -92,6 +92,46 @@ _CENSUS_REMEASURE_STEP = 1.0
 _FUSED_SET_HERE = {"remeasure_gabor": "refine", "dense_sgm": "semi_global", "census_members": None}
 
 
+#: :func:`depth_map`'s own keywords, which a misspelling sends to ``**params``.
+_OWN_KEYWORDS = (
+    "calib",
+    "method",
+    "max_disparity",
+    "min_disparity",
+    "fill",
+    "refine",
+    "return_channels",
+    "cloud",
+    "progress",
+)
+
+
+def _refuse_own_typos(method: str, params: dict[str, Any]) -> None:
+    """Refuse a ``**params`` key that is no option of ``method`` and nearest to one of
+    :func:`depth_map`'s own keywords, naming that keyword, as :func:`stereovision.match` does:
+    ``max_disparty=8`` was "unknown fusion option(s) ['max_disparty']", a list of 22 options
+    without the one meant. Any other unknown key is left to :func:`_refuse_unknown_params`."""
+    import difflib
+
+    from stereovision.matching import fusion, gabor, sgm
+
+    if method == "gabor":
+        valid = list(gabor.DEFAULTS)
+    elif method == "fused":
+        own = ("channels", "check_members", "edge_members", "semi_global")
+        valid = [*fusion.DEFAULTS, *own, *fusion.DENSE_DEFAULTS, *_FUSED_SET_HERE]
+    else:
+        valid = [*sgm.DEFAULTS, *_CENSUS_DENSE]
+    for key in params:
+        if key in valid:
+            continue
+        near = difflib.get_close_matches(key, [*valid, *_OWN_KEYWORDS], n=1, cutoff=0.6)
+        if near and near[0] in _OWN_KEYWORDS:
+            raise ValueError(
+                f"depth_map: unknown keyword argument {key!r} (did you mean {near[0]!r}?)"
+            )
+
+
 def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
     """Refuse the ``**params`` :func:`depth_map`'s ``method`` does not take, naming the ones it
     does, a ``semi_global`` that is not a bool and a bad value of the fusion's or the dense
@@ -103,6 +143,7 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
     which then failed as ``fuse_pair() got multiple values for keyword argument``."""
     from stereovision.matching import fusion, gabor, sgm
 
+    _refuse_own_typos(method, params)
     if method == "gabor":
         refuse_unknown(
             "Gabor parameter", params, gabor.DEFAULTS, "stereovision.matching.gabor.DEFAULTS"
@@ -1567,8 +1608,9 @@ def depth_map(
     ------
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method,
-        a parameter the method does not take (the message names those it does);
-        a range no pixel can match in (``min_disparity`` not below the image width, or
+        a parameter the method does not take (the message names those it does; a misspelling
+        of this function's own keyword, ``max_disparty=``, named as such); a range no pixel
+        can match in (``min_disparity`` not below the image width, or
         ``max_disparity`` not above minus it) or one float32 cannot tell apart (10 to
         10.0000001), a negative ``min_disparity`` with ``method="fused"``.
     TypeError
