@@ -650,6 +650,25 @@ def test_info_on_paper_refuses_a_baseline_past_1000_km(
     assert "farthest depth, at a disparity of 1 px: 640000000.00 m" in capsys.readouterr().out
 
 
+def test_info_on_paper_refuses_a_baseline_past_any_float_as_typed(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``info --baseline 1e400`` said "got inf" (the parsed float), a value not typed: the
+    value as typed now, by the parser, as ``check --tolerance 1e400``."""
+    for bad, expected in (
+        ("1e400", "at most 1e+06 m (a rig on paper)"),
+        ("-1e400", "a positive number of metres"),
+        ("nan", "a positive number of metres"),
+    ):
+        with pytest.raises(SystemExit) as exit_:
+            main(["info", "--size", "1280x720", "--hfov", "90", f"--baseline={bad}"])
+        assert exit_.value.code == 2
+        assert capsys.readouterr().err == (
+            f"stereovision info: error: argument --baseline: expected {expected}, got '{bad}' "
+            "(see stereovision info --help)\n"
+        )
+
+
 def test_info_on_paper_names_baseline_for_one_too_small_to_compute_with(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

@@ -1624,8 +1624,16 @@ MAX_PAPER_BASELINE_M = 1e6
 
 def paper_baseline(text: str) -> float:
     """argparse type of ``info --baseline``: :func:`metres` (its range is checked with the other
-    options) whose unit hint keeps to :data:`MAX_PAPER_BASELINE_M`."""
-    return metres(text, within=(0.0, MAX_PAPER_BASELINE_M))
+    options) whose unit hint keeps to :data:`MAX_PAPER_BASELINE_M`. A value past any float
+    (``1e400``), or NaN, is refused here, as typed: after the parsing it was said as "got inf"."""
+    value = metres(text, within=(0.0, MAX_PAPER_BASELINE_M))
+    if math.isfinite(value):
+        return value
+    if value > 0:
+        raise argparse.ArgumentTypeError(
+            f"expected at most {MAX_PAPER_BASELINE_M:g} m (a rig on paper), got {text!r}"
+        )
+    raise argparse.ArgumentTypeError(f"expected a positive number of metres, got {text!r}")
 
 
 def _given_size_note(calib: Any, beside: Path | None = None) -> str:
