@@ -3466,6 +3466,12 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
             "stereovision check: error: argument --tolerance: expected a positive number of "
             "pixels without a unit (5 for 5 px), got '-1px' (see stereovision check --help)",
         ),
+        # board --square 1e400: "got inf", after the parsing
+        (
+            ["board", "-o", "b.png", "--square", "1e400"],
+            "stereovision board: error: argument --square: expected a positive finite number, "
+            "got '1e400' (see stereovision board --help)",
+        ),
         # capture --square 25mm: "expected a number"; nan: the library's "square_size:"
         (
             ["capture", "--left", "l.avi", "--right", "r.avi", "--charuco", "5x7", "--square",
@@ -3541,6 +3547,7 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
         ),
     ],
     ids=["calibrate-square", "calibrate-unit", "board-square", "info-baseline", "check-tolerance",
+         "board-square-overflow",
          "capture-square-unit", "capture-marker-nan", "info-hfov-tiny", "info-hfov-unit",
          "bench-file", "batch-grid-ground", "batch-grid-range", "board-charuco-marker",
          "board-charuco-squares", "board-charuco-dictionary", "capture-charuco-squares",

@@ -3655,11 +3655,15 @@ def _add_board_options(p: argparse.ArgumentParser) -> None:
 
 def length(text: str) -> float:
     """argparse type of ``--square`` and ``--marker``: a number in ``--unit``'s unit; ``25mm``
-    said only "expected a number", not where the unit goes."""
+    said only "expected a number", not where the unit goes. A value past any float (``1e400``)
+    is refused here, as typed: after the parsing it was said as "got inf"."""
     from stereovision.cli import _UNIT_SUFFIXED
 
     try:
-        return float(text)
+        value = float(text)
+        if math.isinf(value) and "inf" not in text.lower():
+            raise argparse.ArgumentTypeError(f"expected a positive finite number, got {text!r}")
+        return value
     except ValueError:
         if _UNIT_SUFFIXED.match(text):
             raise argparse.ArgumentTypeError(
