@@ -2403,6 +2403,16 @@ def test_depth_rectification_takes_an_explicit_max_disparity(
     assert "fast: max_disparity 24 px," in capsys.readouterr().out
     assert main([*argv, "-o", str(tmp_path / "b")]) == 0
     assert "fast: max_disparity 40 px," in capsys.readouterr().out
+    # the file's range edited to the width: it was "give a --max-disparity below 160", an
+    # option not given; the file is named, and nothing is written
+    (tmp_path / "rect.json").write_text(json.dumps(rect | {"max_disparity": 160}))
+    assert main([*argv, "-o", str(tmp_path / "c")]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {tmp_path / 'rect.json'}: its max_disparity 160 is not smaller "
+        "than the rectified width 160: edit it below 160 there, or give a --max-disparity "
+        "below 160\n"
+    )
+    assert not (tmp_path / "c").exists()
 
 
 def test_depth_failing_before_its_first_move_leaves_no_folder_and_the_old_manifest(

@@ -821,6 +821,15 @@ def cmd_depth(args: argparse.Namespace) -> int:
             raise CliError("--rectification and --calib: give one way to rectify the pair")
         rect = UncalibratedRectification.load(args.rectification)
         left, right = rect.rectify(left, right)
+        width = np.shape(left)[1]
+        if max_disparity is None and width >= 2 and rect.max_disparity >= width:
+            # the file's range (hand-edited) was told "give a --max-disparity below N", an
+            # option the user had not given: the file is named as where the value came from
+            raise CliError(
+                f"{args.rectification}: its max_disparity {rect.max_disparity} is not smaller "
+                f"than the rectified width {width}: edit it below {width} there, or give a "
+                f"--max-disparity below {width}"
+            )
         max_disparity = max_disparity or rect.max_disparity
         # the pair as it is matched, refused alone (before the same-image warning below)
         _check_pair(left, right, None, max_disparity)
