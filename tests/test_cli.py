@@ -3523,6 +3523,17 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
             ["batch", "{tmp}", "-o", "{tmp}/out", "--ground", "--grid", "nan"],
             "stereovision: error: --grid: expected a cell side from 0.01 to 10 m, got nan",
         ),
+        # --grid 1e400 was said as "got inf", 1e-400 as "got 0.0": as typed, by the parser
+        (
+            ["depth", "l.png", "r.png", "-o", "out", "--ground", "--grid", "1e400"],
+            "stereovision depth: error: argument --grid: expected a cell side from 0.01 to 10 m, "
+            "got '1e400' (see stereovision depth --help)",
+        ),
+        (
+            ["depth", "l.png", "r.png", "-o", "out", "--ground", "--grid", "1e-400"],
+            "stereovision depth: error: argument --grid: expected a cell side from 0.01 to 10 m, "
+            "got '1e-400' (see stereovision depth --help)",
+        ),
         # a ChArUco board's refusal named CharucoBoard's parameters (marker_size, square_size,
         # squares, dictionary) after "--board charuco:" (board, calibrate) / "--charuco:"
         (
@@ -3559,7 +3570,8 @@ def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_with
     ids=["calibrate-square", "calibrate-unit", "board-square", "info-baseline", "check-tolerance",
          "board-square-overflow",
          "capture-square-unit", "capture-marker-nan", "info-hfov-tiny", "info-hfov-unit",
-         "bench-file", "batch-grid-ground", "batch-grid-range", "board-charuco-marker",
+         "bench-file", "batch-grid-ground", "batch-grid-range", "depth-grid-overflow",
+         "depth-grid-underflow", "board-charuco-marker",
          "board-charuco-squares", "board-charuco-dictionary", "capture-charuco-squares",
          "capture-charuco-marker"],
 )  # fmt: skip

@@ -2525,11 +2525,26 @@ def metres(text: str, within: tuple[float, float] | None = None) -> float:
 GRID_CELL_M = (0.01, 10.0)
 
 
+def _past_float(text: str, value: float) -> bool:
+    """Whether ``value``, ``float(text)``, is not the number typed: past the largest float
+    (``1e400`` read as inf) or below the smallest (``1e-400`` read as 0)."""
+    if math.isinf(value):
+        return "inf" not in text.lower()
+    return value == 0 and re.search(r"[1-9]", re.split(r"[eE]", text)[0]) is not None
+
+
 def cell_metres(text: str) -> float:
     """argparse type of ``depth --grid``: :func:`metres` (its range is checked with the other
     options, in :func:`run_depth`) whose unit hint keeps to :data:`GRID_CELL_M`: ``50ft`` was
-    told "give 15.24", which the option then refused."""
-    return metres(text, within=GRID_CELL_M)
+    told "give 15.24", which the option then refused. A value past any float (``1e400``,
+    ``1e-400``) is refused here, as typed: after the parsing it was said as "got inf" ("0.0")."""
+    value = metres(text, within=GRID_CELL_M)
+    if _past_float(text, value):
+        lo, hi = GRID_CELL_M
+        raise argparse.ArgumentTypeError(
+            f"expected a cell side from {lo:g} to {hi:g} m, got {text!r}"
+        )
+    return value
 
 
 #: The length units typed as a mark: 5' is 5 ft, 5" 5 in.
