@@ -653,11 +653,12 @@ def test_info_on_paper_refuses_a_baseline_past_1000_km(
 def test_info_on_paper_refuses_a_baseline_past_any_float_as_typed(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """``info --baseline 1e400`` said "got inf" (the parsed float), a value not typed: the
-    value as typed now, by the parser, as ``check --tolerance 1e400``."""
+    """``info --baseline 1e400`` said "got inf" (the parsed float; 1e-400 "got 0.0"), a value
+    not typed: the value as typed now, by the parser, as ``check --tolerance 1e400``."""
     for bad, expected in (
         ("1e400", "at most 1e+06 m (a rig on paper)"),
         ("-1e400", "a positive number of metres"),
+        ("1e-400", "a positive number of metres"),  # was "got 0.0"
         ("nan", "a positive number of metres"),
     ):
         with pytest.raises(SystemExit) as exit_:

@@ -1634,9 +1634,10 @@ MAX_PAPER_BASELINE_M = 1e6
 def paper_baseline(text: str) -> float:
     """argparse type of ``info --baseline``: :func:`metres` (its range is checked with the other
     options) whose unit hint keeps to :data:`MAX_PAPER_BASELINE_M`. A value past any float
-    (``1e400``), or NaN, is refused here, as typed: after the parsing it was said as "got inf"."""
+    (``1e400``, ``1e-400``), or NaN, is refused here, as typed: after the parsing it was said
+    as "got inf" ("got 0.0")."""
     value = metres(text, within=(0.0, MAX_PAPER_BASELINE_M))
-    if math.isfinite(value):
+    if math.isfinite(value) and not _past_float(text, value):
         return value
     if value > 0:
         raise argparse.ArgumentTypeError(
