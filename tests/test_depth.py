@@ -1638,7 +1638,8 @@ def test_a_negative_min_disparity_with_fused_names_the_channels_that_run() -> No
 def test_a_misspelt_keyword_of_depth_map_names_the_keyword() -> None:
     """``depth_map(..., max_disparty=8)`` was "unknown fusion option(s) ['max_disparty']" (a
     list of 22 options without the one meant), and the SGM's or Gabor's list with the others:
-    now named as depth_map's own keyword, as match() names its own, before any work."""
+    now named as depth_map's own keyword, as match() names its own, before any work. A
+    method of match() given as method= was said as unknown, as if no function had it."""
     img = np.zeros((8, 12), np.uint8)
     for method in ("fused", "gabor", "census", "fast"):
         for typo, meant in (("max_disparty", "max_disparity"), ("refin", "refine")):
@@ -1647,6 +1648,13 @@ def test_a_misspelt_keyword_of_depth_map_names_the_keyword() -> None:
             assert str(err.value) == (
                 f"depth_map: unknown keyword argument {typo!r} (did you mean {meant!r}?)"
             )
+    # match's methods: said as unknown, as if no function had them
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(img, img, method="hopfield", max_disparity=4)
+    assert str(err.value) == (
+        "unknown method 'hopfield': expected one of fused, gabor, census, fast ('hopfield' is a "
+        "method of stereovision.match, not of depth_map)"
+    )
     # a key nearest to an option of the method is still the method's to name
     with pytest.raises(ValueError, match=r"^unknown SGM option\(s\) \['radius'\] \(did you"):
         sv.depth_map(img, img, method="census", max_disparity=4, radius=3)

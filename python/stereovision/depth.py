@@ -1649,7 +1649,16 @@ def depth_map(
 
     # a str first: an array as the method failed in the test ("truth value ... ambiguous")
     if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
+        # match's own ("hopfield", "best", "mcgm") said as unknown, as if no matcher had it,
+        # where depth_map(l, r, "hopfield") names stereovision.match
+        other = (
+            f" ({method!r} is a method of stereovision.match, not of depth_map)"
+            if isinstance(method, str) and method in _ALL_METHODS
+            else ""
+        )
+        raise ValueError(
+            f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}{other}"
+        )
     if "calibration" in params:  # the result's field is .calibration; the argument is calib
         raise TypeError("depth_map: the calibration is the argument calib, not calibration")
     names = params.get("channels")
