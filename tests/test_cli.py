@@ -1762,7 +1762,8 @@ def test_demo_checks_its_output_folder_first(
         (["--max-disparity", "5000"], "disparity range 5000 is not smaller than the image width"),
         (["--right", "tsukuba"], "left is 713x434 px, right is 384x288 px: the two images of"),
         (["--calib", "tsukuba"], "calibration is for 713x434 images, got 384x288"),
-        (["--no-calib", "--max-sigma", "0.1"], "--max-depth and --max-sigma need --calib"),
+        # --max-sigma alone was told "--max-depth and --max-sigma need --calib"
+        (["--no-calib", "--max-sigma", "0.1"], "error: --max-sigma needs --calib (no depth"),
         # accepted with no effect (no depth, no cloud) before
         (["--no-calib", "--unit", "ft"], "--unit needs --calib (no depth to say in it without"),
         (["--no-calib", "--voxel", "0.1"], "--voxel needs --calib (no cloud.ply without one)"),

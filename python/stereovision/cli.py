@@ -401,8 +401,12 @@ def depth_outputs(
         raise CliError(f"--unit: expected one of {', '.join(UNIT_TO_METRES)}, got {unit!r}")
     # Every usage error that needs no work first, then a file of the user's under an output
     # name, then the work: a wrong --max-depth was reported as that file, then as itself.
-    if calib is None and (max_depth is not None or max_sigma is not None):
-        raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
+    given = [
+        f for f, v in (("--max-depth", max_depth), ("--max-sigma", max_sigma)) if v is not None
+    ]
+    if calib is None and given:  # the ones given: --max-sigma alone was told of --max-depth too
+        need = "needs" if len(given) == 1 else "need"
+        raise CliError(f"{' and '.join(given)} {need} --calib (no depth without one)")
     if ground and calib is None:
         raise CliError("--ground needs --calib (the floor is found in metres)")
     if grid is not None and not ground:
