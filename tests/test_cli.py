@@ -2663,6 +2663,11 @@ def test_commit_outputs_keeps_a_link_the_user_put_under_an_earlier_output_name(
             ["info", "RIG", "--hfov", "60", "--baseline", "0.1"],
             "--hfov and --baseline describe a rig on paper: give no calibration",
         ),
+        # --baseline alone was told "--hfov and --baseline describe ..."
+        (
+            ["info", "RIG", "--baseline", "0.1"],
+            "--baseline describes a rig on paper: give no calibration",
+        ),
         (
             ["info", "BAG", "--size", "640x480"],
             "--size and --calib-unit are for a calibration file, not a bag",

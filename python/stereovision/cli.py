@@ -1713,8 +1713,10 @@ def cmd_info(args: argparse.Namespace) -> int:
         print("a rig on paper (two ideal cameras, rectified):")
         print(rig.describe())
         return 0
-    if (args.hfov, args.baseline) != (None, None):
-        raise CliError("--hfov and --baseline describe a rig on paper: give no calibration")
+    paper = [f for f, v in (("--hfov", args.hfov), ("--baseline", args.baseline)) if v is not None]
+    if paper:  # the ones given: --hfov alone was told of --baseline too
+        verb = "describes" if len(paper) == 1 else "describe"
+        raise CliError(f"{' and '.join(paper)} {verb} a rig on paper: give no calibration")
     topics = (args.left_topic, args.right_topic)
     # a missing bag (run.bag, or a link to one since moved) was "calibration file not found":
     # a name a bag's is said as the bag reader says it ("bag not found: run.bag")
