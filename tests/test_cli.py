@@ -1667,14 +1667,15 @@ def test_check_warns_of_one_file_given_twice(
     data_dir: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """``check LEFT LEFT`` said "rectification ok" without a word about the pair being one
-    file. It warns, and the verdict cannot tell (exit 3), not "rectification ok" (exit 0)."""
+    file. It warns, and the verdict cannot tell (exit 3), not "rectification ok" (exit 0). The
+    warning said "every disparity comes out 0" of a command that finds none: said of the rows."""
     left = data_dir / "middlebury2003" / "cones" / "left.png"
     assert main(["check", str(left), str(left)]) == 3
     out, err = capsys.readouterr()
     assert out.startswith("rectification: cannot tell, the two images are identical")
     assert err == (
-        f"stereovision: warning: {left} and {left} are the same file: every disparity comes "
-        "out 0 (two views of the scene are needed)\n"
+        f"stereovision: warning: {left} and {left} are the same file: their rows agree by "
+        "themselves (two views of the scene are needed)\n"
     )
 
 
@@ -4086,8 +4087,8 @@ def test_a_path_with_a_newline_is_shown_escaped_in_a_warning(
     # one image twice cannot be told rectified or not (17c4983): exit 3, the warning still said
     assert main(["check", "a\nb.png", "c\nd.png"]) == 3
     assert capsys.readouterr().err == (
-        "stereovision: warning: a\\nb.png and c\\nd.png are the same image: every disparity "
-        "comes out 0 (two views of the scene are needed)\n"
+        "stereovision: warning: a\\nb.png and c\\nd.png are the same image: their rows agree "
+        "by themselves (two views of the scene are needed)\n"
     )
 
 

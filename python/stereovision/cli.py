@@ -1133,8 +1133,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     same = (
         None if left.shape != right.shape else check_pair_files(left, right, args.left, args.right)
     )
-    if same:
-        warnings.warn(same, stacklevel=1)
+    if same:  # said of the rows: check finds no disparity (the warning spoke of depth's)
+        one_pair = same.replace("every disparity comes out 0", "their rows agree by themselves")
+        warnings.warn(one_pair, stacklevel=1)
     # check has no --rectification, which the refusal of rectify's homographies named
     calib = load_calibration(
         args.calib,
