@@ -113,15 +113,8 @@ def _refuse_own_typos(method: str, params: dict[str, Any]) -> None:
     without the one meant. Any other unknown key is left to :func:`_refuse_unknown_params`."""
     import difflib
 
-    from stereovision.matching import fusion, gabor, sgm
-
-    if method == "gabor":
-        valid = list(gabor.DEFAULTS)
-    elif method == "fused":
-        own = ("channels", "check_members", "edge_members", "semi_global")
-        valid = [*fusion.DEFAULTS, *own, *fusion.DENSE_DEFAULTS, *_FUSED_SET_HERE]
-    else:
-        valid = [*sgm.DEFAULTS, *_CENSUS_DENSE]
+    # the options depth_map sets itself are refused in their own words, not as typos
+    valid = [*_method_params(method), *(_FUSED_SET_HERE if method == "fused" else ())]
     for key in params:
         if key in valid:
             continue
@@ -130,6 +123,19 @@ def _refuse_own_typos(method: str, params: dict[str, Any]) -> None:
             raise ValueError(
                 f"depth_map: unknown keyword argument {key!r} (did you mean {near[0]!r}?)"
             )
+
+
+def _method_params(method: str) -> list[str]:
+    """The ``**params`` keys :func:`depth_map`'s ``method`` takes (one list for the typo hint
+    and the refusal)."""
+    from stereovision.matching import fusion, gabor, sgm
+
+    if method == "gabor":
+        return list(gabor.DEFAULTS)
+    if method == "fused":
+        own = ("channels", "check_members", "edge_members", "semi_global")
+        return [*fusion.DEFAULTS, *own, *fusion.DENSE_DEFAULTS]
+    return [*sgm.DEFAULTS, *_CENSUS_DENSE]
 
 
 def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
@@ -141,23 +147,25 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
     (``second_confidence``, ...), which it takes, and ``"fused"`` the dense map's and
     ``semi_global`` while naming ``remeasure_gabor``, ``dense_sgm`` and ``census_members``,
     which then failed as ``fuse_pair() got multiple values for keyword argument``."""
-    from stereovision.matching import fusion, gabor, sgm
+    from stereovision.matching import fusion
 
     _refuse_own_typos(method, params)
     if method == "gabor":
         refuse_unknown(
-            "Gabor parameter", params, gabor.DEFAULTS, "stereovision.matching.gabor.DEFAULTS"
+            "Gabor parameter",
+            params,
+            _method_params(method),
+            "stereovision.matching.gabor.DEFAULTS",
         )
     elif method == "fused":
         for key, instead in _FUSED_SET_HERE.items():
             if key in params:
                 how = f"give {instead}= instead" if instead else "its dense map is checked anyway"
                 raise ValueError(f"{key}: depth_map sets this fuse_pair option itself ({how})")
-        own = ("channels", "check_members", "edge_members", "semi_global")
         refuse_unknown(
             "fusion option",
             params,
-            [*fusion.DEFAULTS, *own, *fusion.DENSE_DEFAULTS],
+            _method_params(method),
             "stereovision.matching.fusion.DEFAULTS and DENSE_DEFAULTS",
         )
         for switch in ("semi_global", "check_members", "edge_members"):
@@ -176,7 +184,7 @@ def _refuse_unknown_params(method: str, params: dict[str, Any]) -> None:
         refuse_unknown(
             "SGM option",
             params,
-            [*sgm.DEFAULTS, *_CENSUS_DENSE],
+            _method_params(method),
             "stereovision.matching.sgm.DEFAULTS and the dense map's",
         )
     if method != "gabor":
