@@ -1925,7 +1925,8 @@ def test_view_of_a_16_bit_scene_matches_its_16_bits(tmp_path, monkeypatch, resul
     src = bundled_data_dir() / "cones"
     shutil.copy(src / "calib.txt", tmp_path / "calib.txt")
     for name in ("left.png", "right.png"):
-        img = cv2.imread(str(src / name), cv2.IMREAD_COLOR)[:60, :80]
+        # whole: a crop no longer fits the calib.txt copied (load_scene refuses it, 328e8bf)
+        img = cv2.imread(str(src / name), cv2.IMREAD_COLOR)
         cv2.imwrite(str(tmp_path / name), np.rint(img * (4095 / 255)).astype(np.uint16))
     seen = []
 
