@@ -379,6 +379,13 @@ def test_a_misspelt_keyword_of_match_names_the_keyword() -> None:
         ValueError, match=r"^unknown fusion option\(s\) \['mod'\] \(did you mean 'mode'"
     ):
         sv.match(ok, ok, method="fused", max_disparity=8, mod="vote")
+    # depth_map's own method, given by keyword, was "unknown" alone (positional: test_newuser)
+    with pytest.raises(ValueError) as err:
+        sv.match(ok, ok, method="census")
+    assert str(err.value) == (
+        "unknown method 'census': expected one of hopfield, best, mcgm, fused, gabor ('census' "
+        "is a method of stereovision.depth_map, not of match)"
+    )
 
 
 _NON_NEGATIVE = ["A", "B", "D", "theta", "compat_theta", "compat_slope", "compat_grad",

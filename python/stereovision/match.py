@@ -121,7 +121,18 @@ def match(
     """
     # a str first: an array as the method failed in the test ("truth value ... ambiguous")
     if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}")
+        from stereovision.depth import METHODS as DEPTH_METHODS
+
+        # depth_map's own ("census", "fast") said as unknown, as if no function had it, where
+        # match(l, r, "census") and depth_map(method="hopfield") name the other function
+        other = (
+            f" ({method!r} is a method of stereovision.depth_map, not of match)"
+            if isinstance(method, str) and method in DEPTH_METHODS
+            else ""
+        )
+        raise ValueError(
+            f"unknown method {_shown(method)}: expected one of {', '.join(METHODS)}{other}"
+        )
     _refuse_own_typos(method, params)
     # the range's type first, in depth_map's words: a 0-d array, True or None passed "gabor"'s
     # check (or failed in another class) and was refused by the others as not "non-negative"
