@@ -1697,7 +1697,6 @@ class StereoApp:
         st.change("unit")(self._on_unit)
         st.change("scene")(self._on_scene)
         st.change("save_dir")(self._on_save_dir)
-        st.change("error")(self._on_error)
         self.ctrl.on_server_ready.add(self._on_ready)
 
     # ------------------------------------------------------------------------- helpers
@@ -1831,13 +1830,6 @@ class StereoApp:
         if in_data:
             where += f" (relative to the --data folder {display_path(self._save_roots[0])})"
         return where
-
-    def _on_error(self, error: str | None = None, **_: Any) -> None:
-        """The page's error emptied (its alert closed on the page, or cleared here): a refused
-        max disparity went with it, and the field shows the range in use again
-        (:meth:`_max_disp_back`); the alert's close button left "500" in it, no error said."""
-        if not error:
-            self._max_disp_back()
 
     def _on_save_dir(self, save_dir: str | None = None, **_: Any) -> None:
         self.state.save_dir_title = self._save_title(save_dir)
